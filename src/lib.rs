@@ -1,0 +1,13 @@
+//! lsyc: a language and toolchain for parametric Open L-systems.
+//!
+//! The pipeline: `lexer` → `parser` (LALRPOP, `grammar/lsy.lalrpop`) → `trivia`
+//! and `resolve` → `check`; `fmt` prints any `ast::File` back to canonical text.
+#![deny(unsafe_code)]
+
+pub mod ast;
+pub mod diagnostic;
+pub mod lexer;
+pub mod parser;
+pub mod resolve;
+pub mod span;
+pub mod trivia;
