@@ -5,9 +5,16 @@
 #![deny(unsafe_code)]
 
 pub mod ast;
+pub mod builtins;
+pub mod check;
 pub mod diagnostic;
+pub mod dump;
+pub mod frontend;
+pub mod fmt;
 pub mod lexer;
 pub mod parser;
+pub mod query;
 pub mod resolve;
+pub mod source;
 pub mod span;
 pub mod trivia;

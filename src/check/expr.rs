@@ -1,0 +1,339 @@
+//! Expression checking: names, types (number or boolean), calls, and constant
+//! evaluation of what must be known before derivation.
+
+use super::Checker;
+use crate::ast::{BinOp, Expr, ExprKind, UnOp};
+use crate::builtins;
+use crate::diagnostic::{Code, Diagnostic};
+use crate::span::Span;
+use std::cell::Cell;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ty {
+    Num,
+    Bool,
+    /// Already reported; stay quiet.
+    Err,
+}
+
+impl Ty {
+    fn name(self) -> &'static str {
+        match self {
+            Ty::Num => "a number",
+            Ty::Bool => "a boolean",
+            Ty::Err => "an error",
+        }
+    }
+}
+
+/// A value known at check time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Value {
+    Num(f64),
+    Bool(bool),
+}
+
+/// Names in scope for an expression besides the constants: parameters.
+#[derive(Default)]
+pub struct Env {
+    pub params: Vec<Param>,
+}
+
+pub struct Param {
+    pub name: String,
+    pub span: Span,
+    pub used: Cell<bool>,
+}
+
+impl Env {
+    pub fn new() -> Env {
+        Env::default()
+    }
+
+    pub fn add(&mut self, name: &str, span: Span) {
+        self.params.push(Param {
+            name: name.to_string(),
+            span,
+            used: Cell::new(false),
+        });
+    }
+
+    fn find(&self, name: &str) -> Option<&Param> {
+        self.params.iter().find(|p| p.name == name)
+    }
+}
+
+/// Levenshtein distance, for "did you mean".
+pub fn distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(row[j + 1] + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+/// The closest candidate within a small edit distance.
+pub fn suggest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let len = name.chars().count();
+    if len < 2 {
+        return None;
+    }
+    let limit = (len / 3).max(1);
+    candidates
+        .into_iter()
+        .filter(|c| *c != name)
+        .map(|c| (distance(name, c), c))
+        .filter(|(d, _)| *d <= limit)
+        .min()
+        .map(|(_, c)| c)
+}
+
+impl Checker<'_> {
+    /// The type of an expression, reporting every problem inside it.
+    pub fn expr(&mut self, e: &Expr, env: &Env) -> Ty {
+        match &e.kind {
+            ExprKind::Num(_) => Ty::Num,
+            ExprKind::Bool(_) => Ty::Bool,
+            ExprKind::Error => Ty::Err,
+            ExprKind::Var(name) => {
+                if let Some(p) = env.find(name) {
+                    p.used.set(true);
+                    return Ty::Num;
+                }
+                if let Some(c) = self.consts.get(name.as_str()) {
+                    self.used_consts.insert(name.clone());
+                    return c.ty;
+                }
+                let mut d = Diagnostic::error(Code::UnknownName, format!("unknown name `{name}`"))
+                    .primary(e.span, "not a parameter of this rule or a constant");
+                let names: Vec<&str> = env
+                    .params
+                    .iter()
+                    .map(|p| p.name.as_str())
+                    .chain(self.consts.keys().copied())
+                    .collect();
+                if let Some(s) = suggest(name, names) {
+                    d = d.help(format!("did you mean `{s}`?"));
+                } else if builtins::lookup(name).is_some() {
+                    d = d.help(format!("`{name}` is a function: call it as `{name}(…)`"));
+                } else {
+                    d = d.help("parameters are bound by the predecessor, as in `A(x) -> F(x);`; constants by `const x = 1;`");
+                }
+                self.diags.push(d);
+                Ty::Err
+            }
+            ExprKind::Unary(op, a) => {
+                let (want, out) = match op {
+                    UnOp::Neg => (Ty::Num, Ty::Num),
+                    UnOp::Not => (Ty::Bool, Ty::Bool),
+                };
+                self.expect(a, env, want);
+                out
+            }
+            ExprKind::Binary(op, a, b) => match op {
+                BinOp::Or | BinOp::And => {
+                    self.expect(a, env, Ty::Bool);
+                    self.expect(b, env, Ty::Bool);
+                    Ty::Bool
+                }
+                BinOp::Eq | BinOp::Ne => {
+                    let ta = self.expr(a, env);
+                    let tb = self.expr(b, env);
+                    if ta != Ty::Err && tb != Ty::Err && ta != tb {
+                        self.diags.push(
+                            Diagnostic::error(
+                                Code::TypeMismatch,
+                                format!("`{}` compares {} with {}", op.text(), ta.name(), tb.name()),
+                            )
+                            .primary(b.span, format!("this is {}", tb.name()))
+                            .secondary(a.span, format!("this is {}", ta.name())),
+                        );
+                    }
+                    Ty::Bool
+                }
+                _ if op.is_comparison() => {
+                    self.expect(a, env, Ty::Num);
+                    self.expect(b, env, Ty::Num);
+                    Ty::Bool
+                }
+                _ => {
+                    self.expect(a, env, Ty::Num);
+                    self.expect(b, env, Ty::Num);
+                    Ty::Num
+                }
+            },
+            ExprKind::Call(f, args) => {
+                let Some(b) = builtins::lookup(&f.name) else {
+                    let mut d = Diagnostic::error(
+                        Code::UnknownFunction,
+                        format!("unknown function `{}`", f.name),
+                    )
+                    .primary(f.span, "no built-in function has this name");
+                    if let Some(s) = suggest(&f.name, builtins::BUILTINS.iter().map(|b| b.name)) {
+                        d = d.help(format!("did you mean `{s}`?"));
+                    } else {
+                        d = d.note("the functions are listed in docs/language.md");
+                    }
+                    self.diags.push(d);
+                    for a in args {
+                        self.expr(a, env);
+                    }
+                    return Ty::Err;
+                };
+                if args.len() != b.arity {
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::ArityFunction,
+                            format!(
+                                "`{}` takes {} argument{}, but {} {} given",
+                                b.name,
+                                b.arity,
+                                plural(b.arity),
+                                args.len(),
+                                if args.len() == 1 { "was" } else { "were" }
+                            ),
+                        )
+                        .primary(e.span, format!("{}: {}", b.name, b.doc)),
+                    );
+                }
+                for a in args {
+                    self.expect(a, env, Ty::Num);
+                }
+                Ty::Num
+            }
+        }
+    }
+
+    /// Checks an expression and reports it if it is not of type `want`.
+    pub fn expect(&mut self, e: &Expr, env: &Env, want: Ty) -> Ty {
+        let got = self.expr(e, env);
+        if got != Ty::Err && got != want {
+            self.diags.push(
+                Diagnostic::error(
+                    Code::TypeMismatch,
+                    format!("expected {}, found {}", want.name(), got.name()),
+                )
+                .primary(e.span, format!("this is {}", got.name())),
+            );
+        }
+        got
+    }
+
+    /// The value of an expression made only of literals, constants and
+    /// deterministic functions; `None` otherwise.
+    pub fn eval(&self, e: &Expr) -> Option<Value> {
+        Some(match &e.kind {
+            ExprKind::Num(v) => Value::Num(*v),
+            ExprKind::Bool(b) => Value::Bool(*b),
+            ExprKind::Var(n) => return self.consts.get(n.as_str()).and_then(|c| c.value),
+            ExprKind::Error => return None,
+            ExprKind::Unary(UnOp::Neg, a) => Value::Num(-num(self.eval(a)?)?),
+            ExprKind::Unary(UnOp::Not, a) => Value::Bool(!boolean(self.eval(a)?)?),
+            ExprKind::Binary(op, a, b) => {
+                let (x, y) = (self.eval(a)?, self.eval(b)?);
+                match op {
+                    BinOp::Or => Value::Bool(boolean(x)? || boolean(y)?),
+                    BinOp::And => Value::Bool(boolean(x)? && boolean(y)?),
+                    BinOp::Eq => Value::Bool(x == y),
+                    BinOp::Ne => Value::Bool(x != y),
+                    _ => {
+                        let (x, y) = (num(x)?, num(y)?);
+                        match op {
+                            BinOp::Lt => Value::Bool(x < y),
+                            BinOp::Le => Value::Bool(x <= y),
+                            BinOp::Gt => Value::Bool(x > y),
+                            BinOp::Ge => Value::Bool(x >= y),
+                            BinOp::Add => Value::Num(x + y),
+                            BinOp::Sub => Value::Num(x - y),
+                            BinOp::Mul => Value::Num(x * y),
+                            BinOp::Div => Value::Num(x / y),
+                            BinOp::Rem => Value::Num(x % y),
+                            BinOp::Pow => Value::Num(x.powf(y)),
+                            _ => return None,
+                        }
+                    }
+                }
+            }
+            ExprKind::Call(f, args) => {
+                let vals: Option<Vec<f64>> =
+                    args.iter().map(|a| self.eval(a).and_then(num)).collect();
+                Value::Num(builtins::eval(&f.name, &vals?)?)
+            }
+        })
+    }
+
+    /// Checks an expression that must be a number known before derivation
+    /// (constants allowed, parameters and random functions not) and returns it.
+    pub fn const_num(&mut self, e: &Expr, what: &str) -> Option<f64> {
+        let env = Env::new();
+        let before = self.diags.len();
+        let ty = self.expect(e, &env, Ty::Num);
+        if ty != Ty::Num || self.diags.len() > before {
+            return None;
+        }
+        match self.eval(e) {
+            Some(Value::Num(v)) if v.is_finite() => Some(v),
+            Some(_) => {
+                self.diags.push(
+                    Diagnostic::error(Code::OutOfRange, format!("{what} is not a finite number"))
+                        .primary(e.span, "this evaluates to infinity or NaN"),
+                );
+                None
+            }
+            None => {
+                self.diags.push(
+                    Diagnostic::error(
+                        Code::NotConstant,
+                        format!("{what} must be known before derivation"),
+                    )
+                    .primary(e.span, "this uses a random function or a constant that is not known")
+                    .help("use numbers, constants and deterministic functions here"),
+                );
+                None
+            }
+        }
+    }
+
+    /// Like `const_num`, and the value must be a whole number in `lo..=hi`.
+    pub fn const_int(&mut self, e: &Expr, what: &str, lo: f64, hi: f64) -> Option<i64> {
+        let v = self.const_num(e, what)?;
+        if v.fract() != 0.0 || v < lo || v > hi {
+            let range = if hi >= 1e15 {
+                format!("a whole number ≥ {lo}")
+            } else {
+                format!("a whole number from {lo} to {hi}")
+            };
+            self.diags.push(
+                Diagnostic::error(Code::OutOfRange, format!("{what} must be {range}"))
+                    .primary(e.span, format!("this is {v}")),
+            );
+            return None;
+        }
+        Some(v as i64)
+    }
+}
+
+fn num(v: Value) -> Option<f64> {
+    match v {
+        Value::Num(x) => Some(x),
+        Value::Bool(_) => None,
+    }
+}
+
+fn boolean(v: Value) -> Option<bool> {
+    match v {
+        Value::Bool(b) => Some(b),
+        Value::Num(_) => None,
+    }
+}
+
+pub fn plural(n: usize) -> &'static str {
+    if n == 1 { "" } else { "s" }
+}

@@ -1,0 +1,379 @@
+//! The checker: names, arities, types, constants and scenes of a parsed file.
+//!
+//! Owns: every rule of meaning that can be decided without running the program,
+//! reported as diagnostics (errors and warnings), and the constant values the
+//! run starts from. Must not derive or draw; it never stops at the first problem.
+
+mod expr;
+mod lsystem;
+mod scene;
+
+pub use expr::{Env, Ty, Value, distance, suggest};
+
+use crate::ast::{ConstDecl, Expr, ExprKind, File, Item};
+use crate::diagnostic::{Code, Diagnostic};
+use crate::span::Span;
+use std::collections::{BTreeMap, HashMap, HashSet};
+
+/// A `-D NAME=VALUE` from the command line, as typed.
+#[derive(Clone, Debug)]
+pub struct Override {
+    pub name: String,
+    pub value: String,
+}
+
+impl Override {
+    /// Parses `NAME=VALUE`.
+    pub fn parse(s: &str) -> Result<Override, String> {
+        match s.split_once('=') {
+            Some((n, v)) if !n.trim().is_empty() => Ok(Override {
+                name: n.trim().to_string(),
+                value: v.trim().to_string(),
+            }),
+            _ => Err(format!("`{s}` is not of the form NAME=VALUE")),
+        }
+    }
+}
+
+/// What the checker learned, for the phases after it.
+#[derive(Debug, Default)]
+pub struct Checked {
+    pub diagnostics: Vec<Diagnostic>,
+    /// Constant values known at check time (overrides applied).
+    pub consts: BTreeMap<String, f64>,
+}
+
+impl Checked {
+    pub fn has_errors(&self) -> bool {
+        self.diagnostics.iter().any(Diagnostic::is_error)
+    }
+}
+
+struct ConstInfo<'a> {
+    decl: &'a ConstDecl,
+    span: Span,
+    ty: Ty,
+    value: Option<Value>,
+}
+
+struct ModuleInfo {
+    /// `None` for elements (any number of parameters).
+    arity: Option<usize>,
+    span: Span,
+    element: bool,
+}
+
+struct Checker<'a> {
+    diags: Vec<Diagnostic>,
+    consts: HashMap<&'a str, ConstInfo<'a>>,
+    used_consts: HashSet<String>,
+    modules: HashMap<&'a str, ModuleInfo>,
+    used_modules: HashSet<String>,
+    systems: HashMap<&'a str, (Span, usize)>,
+    used_systems: HashSet<String>,
+}
+
+/// Checks a parsed file. `overrides` are the command line's `-D` values.
+pub fn check(file: &File, overrides: &[Override]) -> Checked {
+    let mut c = Checker {
+        diags: Vec::new(),
+        consts: HashMap::new(),
+        used_consts: HashSet::new(),
+        modules: HashMap::new(),
+        used_modules: HashSet::new(),
+        systems: HashMap::new(),
+        used_systems: HashSet::new(),
+    };
+    c.declarations(file);
+    c.constants(file, overrides);
+    for item in &file.items.stmts {
+        match &item.node {
+            Item::Lsystem(ls) => c.lsystem(ls),
+            Item::Element(e) => c.element(e),
+            Item::Scene(s) => c.scene(s),
+            Item::Module(_) | Item::Const(_) | Item::Error => {}
+        }
+    }
+    c.unused(file);
+    let consts = c
+        .consts
+        .iter()
+        .filter_map(|(k, v)| match v.value {
+            Some(Value::Num(x)) => Some((k.to_string(), x)),
+            _ => None,
+        })
+        .collect();
+    let mut diagnostics = c.diags;
+    crate::diagnostic::sort(&mut diagnostics);
+    Checked {
+        diagnostics,
+        consts,
+    }
+}
+
+fn duplicate(what: &str, name: &str, span: Span, first: Span) -> Diagnostic {
+    Diagnostic::error(Code::Duplicate, format!("{what} `{name}` is defined twice"))
+        .primary(span, "defined again here")
+        .secondary(first, "first defined here")
+        .help("rename one of them")
+}
+
+impl<'a> Checker<'a> {
+    fn declarations(&mut self, file: &'a File) {
+        for item in &file.items.stmts {
+            match &item.node {
+                Item::Module(m) => {
+                    if let Some(prev) = self.modules.get(m.name.name.as_str()) {
+                        self.diags.push(duplicate("module", &m.name.name, m.name.span, prev.span));
+                        continue;
+                    }
+                    self.check_param_names(&m.params);
+                    self.modules.insert(
+                        &m.name.name,
+                        ModuleInfo {
+                            arity: Some(m.params.len()),
+                            span: m.name.span,
+                            element: false,
+                        },
+                    );
+                }
+                Item::Element(e) => {
+                    if let Some(prev) = self.modules.get(e.name.name.as_str()) {
+                        self.diags.push(duplicate("module", &e.name.name, e.name.span, prev.span));
+                        continue;
+                    }
+                    self.modules.insert(
+                        &e.name.name,
+                        ModuleInfo {
+                            arity: None,
+                            span: e.name.span,
+                            element: true,
+                        },
+                    );
+                }
+                Item::Lsystem(l) => {
+                    if let Some((prev, _)) = self.systems.get(l.name.name.as_str()) {
+                        self.diags.push(duplicate("lsystem", &l.name.name, l.name.span, *prev));
+                        continue;
+                    }
+                    self.check_param_names(&l.params);
+                    self.systems.insert(&l.name.name, (l.name.span, l.params.len()));
+                }
+                Item::Scene(s) => {
+                    if let Some((prev, _)) = self.systems.get(s.name.name.as_str()) {
+                        self.diags.push(duplicate("item", &s.name.name, s.name.span, *prev));
+                    }
+                }
+                Item::Const(_) | Item::Error => {}
+            }
+        }
+    }
+
+    fn check_param_names(&mut self, params: &[crate::ast::Ident]) {
+        for (i, p) in params.iter().enumerate() {
+            if let Some(first) = params[..i].iter().find(|q| q.name == p.name && p.name != "_") {
+                self.diags.push(duplicate("parameter", &p.name, p.span, first.span));
+            }
+        }
+    }
+
+    fn constants(&mut self, file: &'a File, overrides: &[Override]) {
+        let mut order: Vec<&'a str> = Vec::new();
+        for item in &file.items.stmts {
+            let Item::Const(c) = &item.node else { continue };
+            if let Some(prev) = self.consts.get(c.name.name.as_str()) {
+                self.diags.push(duplicate("constant", &c.name.name, c.name.span, prev.span));
+                continue;
+            }
+            order.push(&c.name.name);
+            self.consts.insert(
+                &c.name.name,
+                ConstInfo {
+                    decl: c,
+                    span: c.name.span,
+                    ty: Ty::Err,
+                    value: None,
+                },
+            );
+        }
+        // Dependencies between constants, then a depth-first order that reports cycles.
+        let deps: HashMap<&str, Vec<(String, Span)>> = order
+            .iter()
+            .map(|n| {
+                let mut refs = Vec::new();
+                names_in(&self.consts[n].decl.value, &mut refs);
+                refs.retain(|(r, _)| self.consts.contains_key(r.as_str()));
+                (*n, refs)
+            })
+            .collect();
+        let mut state: HashMap<&str, u8> = HashMap::new(); // 1 visiting, 2 done
+        let mut sorted: Vec<&'a str> = Vec::new();
+        let mut in_cycle: HashSet<String> = HashSet::new();
+        for &n in &order {
+            self.visit_const(n, &deps, &mut state, &mut Vec::new(), &mut sorted, &mut in_cycle);
+        }
+        let overridden: HashMap<&str, &Override> =
+            overrides.iter().map(|o| (o.name.as_str(), o)).collect();
+        for o in overrides {
+            if !self.consts.contains_key(o.name.as_str()) {
+                let mut d = Diagnostic::error(
+                    Code::BadOverride,
+                    format!("`-D {}`: the program has no constant `{}`", o.name, o.name),
+                );
+                let names: Vec<&str> = self.consts.keys().copied().collect();
+                if let Some(s) = suggest(&o.name, names.iter().copied()) {
+                    d = d.help(format!("did you mean `{s}`?"));
+                } else if names.is_empty() {
+                    d = d.note("the program declares no constants; add `const NAME = VALUE;` to make a value overridable");
+                } else {
+                    let mut names = names;
+                    names.sort_unstable();
+                    d = d.note(format!("its constants are: {}", names.join(", ")));
+                }
+                self.diags.push(d);
+            }
+        }
+        for n in sorted {
+            let decl = self.consts[n].decl;
+            let ty = if in_cycle.contains(n) {
+                Ty::Err
+            } else {
+                self.expr(&decl.value, &Env::new())
+            };
+            let mut value = if ty == Ty::Err { None } else { self.eval(&decl.value) };
+            if let Some(o) = overridden.get(n) {
+                match parse_value(&o.value) {
+                    Some(v) => {
+                        let vty = match v {
+                            Value::Num(_) => Ty::Num,
+                            Value::Bool(_) => Ty::Bool,
+                        };
+                        if ty != Ty::Err && vty != ty {
+                            self.diags.push(
+                                Diagnostic::error(
+                                    Code::BadOverride,
+                                    format!("`-D {}={}` gives {} a value of the wrong kind", o.name, o.value, o.name),
+                                )
+                                .secondary(decl.value.span, "the constant is defined here with a value of another kind"),
+                            );
+                        } else {
+                            value = Some(v);
+                        }
+                    }
+                    None => self.diags.push(
+                        Diagnostic::error(
+                            Code::BadOverride,
+                            format!("`-D {}={}`: `{}` is not a number", o.name, o.value, o.value),
+                        )
+                        .help("write the value as a number, e.g. `-D N=7` or `-D angle=22.5`"),
+                    ),
+                }
+            }
+            if let Some(info) = self.consts.get_mut(n) {
+                info.ty = ty;
+                info.value = value;
+            }
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn visit_const(
+        &mut self,
+        n: &'a str,
+        deps: &HashMap<&str, Vec<(String, Span)>>,
+        state: &mut HashMap<&'a str, u8>,
+        path: &mut Vec<&'a str>,
+        sorted: &mut Vec<&'a str>,
+        in_cycle: &mut HashSet<String>,
+    ) {
+        match state.get(n) {
+            Some(2) => return,
+            Some(1) => {
+                let start = path.iter().position(|p| *p == n).unwrap_or(0);
+                let cycle: Vec<&str> = path[start..].to_vec();
+                if cycle.iter().any(|c| in_cycle.contains(*c)) {
+                    return;
+                }
+                let first = self.consts[cycle[0]].span;
+                let mut d = Diagnostic::error(
+                    Code::ConstCycle,
+                    format!("constant `{}` is defined in terms of itself", cycle[0]),
+                )
+                .primary(first, "this constant depends on itself");
+                for c in &cycle[1..] {
+                    d = d.secondary(self.consts[c].span, "which depends on this one");
+                }
+                let mut chain: Vec<&str> = cycle.clone();
+                chain.push(cycle[0]);
+                d = d
+                    .note(format!("the cycle: {}", chain.join(" → ")))
+                    .help("give one of them a value that does not refer back");
+                self.diags.push(d);
+                for c in cycle {
+                    in_cycle.insert(c.to_string());
+                }
+                return;
+            }
+            _ => {}
+        }
+        state.insert(n, 1);
+        path.push(n);
+        let ds: Vec<String> = deps.get(n).map_or(Vec::new(), |v| v.iter().map(|(s, _)| s.clone()).collect());
+        for d in ds {
+            if let Some((&key, _)) = self.consts.get_key_value(d.as_str()) {
+                self.visit_const(key, deps, state, path, sorted, in_cycle);
+            }
+        }
+        path.pop();
+        state.insert(n, 2);
+        sorted.push(n);
+    }
+
+    fn unused(&mut self, file: &File) {
+        let has_scene = file.items.stmts.iter().any(|i| matches!(i.node, Item::Scene(_)));
+        for item in &file.items.stmts {
+            let (what, name, span) = match &item.node {
+                Item::Const(c) if !self.used_consts.contains(&c.name.name) => {
+                    ("constant", &c.name.name, c.name.span)
+                }
+                Item::Module(m) if !self.used_modules.contains(&m.name.name) => {
+                    ("module", &m.name.name, m.name.span)
+                }
+                Item::Element(e) if !self.used_modules.contains(&e.name.name) => {
+                    ("element", &e.name.name, e.name.span)
+                }
+                Item::Lsystem(l) if has_scene && !self.used_systems.contains(&l.name.name) => {
+                    ("lsystem", &l.name.name, l.name.span)
+                }
+                _ => continue,
+            };
+            self.diags.push(
+                Diagnostic::warning(Code::Unused, format!("{what} `{name}` is never used"))
+                    .primary(span, "declared here")
+                    .help(format!("remove it, or use it in a rule{}", if what == "lsystem" { " or a guide's `system`" } else { "" })),
+            );
+        }
+    }
+}
+
+/// All variable names an expression refers to.
+pub fn names_in(e: &Expr, out: &mut Vec<(String, Span)>) {
+    match &e.kind {
+        ExprKind::Var(n) => out.push((n.clone(), e.span)),
+        ExprKind::Unary(_, a) => names_in(a, out),
+        ExprKind::Binary(_, a, b) => {
+            names_in(a, out);
+            names_in(b, out);
+        }
+        ExprKind::Call(_, args) => args.iter().for_each(|a| names_in(a, out)),
+        ExprKind::Num(_) | ExprKind::Bool(_) | ExprKind::Error => {}
+    }
+}
+
+fn parse_value(s: &str) -> Option<Value> {
+    match s {
+        "true" => Some(Value::Bool(true)),
+        "false" => Some(Value::Bool(false)),
+        _ => s.parse::<f64>().ok().filter(|v| v.is_finite()).map(Value::Num),
+    }
+}

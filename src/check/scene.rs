@@ -1,0 +1,289 @@
+//! Checks of `element` items (properties, SVG path data) and `scene` items
+//! (guides, polygons, systems, seeds, links).
+
+use super::expr::{plural, Env, Ty};
+use super::{duplicate, suggest, Checker};
+use crate::ast::{EdgeRef, Element, GuideStmt, LinkStmt, PropValue, Scene, SceneStmt};
+use crate::diagnostic::{Code, Diagnostic};
+use crate::span::Span;
+use std::collections::HashMap;
+
+const PROPS: &[(&str, bool)] = &[("path", true), ("fill", true), ("stroke", true), ("width", false)];
+
+impl<'a> Checker<'a> {
+    pub(super) fn element(&mut self, e: &'a Element) {
+        let mut seen: HashMap<&str, Span> = HashMap::new();
+        for p in &e.props.stmts {
+            let key = p.node.key.name.as_str();
+            if key.is_empty() {
+                continue; // a property the parser skipped
+            }
+            let Some(&(_, wants_string)) = PROPS.iter().find(|(k, _)| *k == key) else {
+                let mut d = Diagnostic::error(
+                    Code::UnknownProperty,
+                    format!("elements have no property `{key}`"),
+                )
+                .primary(p.node.key.span, "unknown property");
+                if let Some(s) = suggest(key, PROPS.iter().map(|(k, _)| *k)) {
+                    d = d.help(format!("did you mean `{s}`?"));
+                } else {
+                    d = d.note("the properties are path, fill, stroke and width");
+                }
+                self.diags.push(d);
+                continue;
+            };
+            if let Some(first) = seen.get(key) {
+                self.diags.push(
+                    Diagnostic::error(Code::DuplicateSetting, format!("`{key}` is given twice"))
+                        .primary(p.node.key.span, "given again here")
+                        .secondary(*first, "first given here"),
+                );
+                continue;
+            }
+            seen.insert(key, p.node.key.span);
+            match (&p.node.value, wants_string) {
+                (PropValue::Str(s, span), true) => match key {
+                    "path" => self.path_data(s, *span),
+                    _ => {
+                        if s.parse::<svgtypes::Color>().is_err() && s != "none" {
+                            self.diags.push(
+                                Diagnostic::error(Code::PropertyKind, format!("`{s}` is not a colour"))
+                                    .primary(*span, "not an SVG colour")
+                                    .help("use a name such as \"green\", \"#3a7\" or \"rgb(40, 120, 60)\""),
+                            );
+                        }
+                    }
+                },
+                (PropValue::Expr(x), false) => {
+                    if let Some(v) = self.const_num(x, "the width") {
+                        if v < 0.0 {
+                            self.diags.push(
+                                Diagnostic::error(Code::OutOfRange, "a width must be zero or positive")
+                                    .primary(x.span, format!("this is {v}")),
+                            );
+                        }
+                    }
+                }
+                (PropValue::Expr(x), true) => self.diags.push(
+                    Diagnostic::error(Code::PropertyKind, format!("`{key}` takes a string"))
+                        .primary(x.span, "not a string")
+                        .help(format!("write it in quotes: {key} \"…\";")),
+                ),
+                (PropValue::Str(_, span), false) => self.diags.push(
+                    Diagnostic::error(Code::PropertyKind, format!("`{key}` takes a number"))
+                        .primary(*span, "a string")
+                        .help(format!("write a number: {key} 1.5;")),
+                ),
+            }
+        }
+        if !seen.contains_key("path") {
+            self.diags.push(
+                Diagnostic::error(Code::MissingPath, format!("element `{}` has no path", e.name.name))
+                    .primary(e.name.span, "an element draws SVG path data")
+                    .help("add `path \"M0 0 L0 10\";` (local frame: base at the origin, pointing +y)"),
+            );
+        }
+    }
+
+    fn path_data(&mut self, s: &str, span: Span) {
+        let mut count = 0usize;
+        for seg in svgtypes::PathParser::from(s) {
+            match seg {
+                Ok(_) => count += 1,
+                Err(e) => {
+                    self.diags.push(
+                        Diagnostic::error(Code::InvalidPath, "invalid SVG path data")
+                            .primary(span, e.to_string())
+                            .help("path data is SVG's `d` attribute: commands M L H V C S Q T A Z with numbers"),
+                    );
+                    return;
+                }
+            }
+        }
+        if count == 0 {
+            self.diags.push(
+                Diagnostic::error(Code::InvalidPath, "the path is empty")
+                    .primary(span, "no drawing commands")
+                    .help("start with a move, e.g. \"M0 0 L0 10\""),
+            );
+        }
+    }
+
+    pub(super) fn scene(&mut self, s: &'a Scene) {
+        // Guides first, so links may refer to guides declared after them.
+        let mut guides: HashMap<&str, (Span, Option<usize>)> = HashMap::new();
+        for st in &s.body.stmts {
+            let SceneStmt::Guide(g) = &st.node else { continue };
+            if let Some((first, _)) = guides.get(g.name.name.as_str()) {
+                self.diags.push(duplicate("guide", &g.name.name, g.name.span, *first));
+                continue;
+            }
+            let mut polygon: Option<(Span, usize)> = None;
+            let mut system: Option<(Span, Option<usize>)> = None;
+            for gs in &g.body.stmts {
+                match &gs.node {
+                    GuideStmt::Polygon(pts) => {
+                        if let Some((first, _)) = polygon {
+                            self.setting_twice("polygon", gs.span, first);
+                            continue;
+                        }
+                        for p in pts {
+                            self.const_num(&p.x, "a polygon coordinate");
+                            self.const_num(&p.y, "a polygon coordinate");
+                        }
+                        if pts.len() < 3 {
+                            self.diags.push(
+                                Diagnostic::error(
+                                    Code::PolygonTooSmall,
+                                    format!("a guide polygon needs at least 3 vertices, this one has {}", pts.len()),
+                                )
+                                .primary(gs.span, "too few vertices")
+                                .help("list the corners in order: polygon (0, 0) (10, 0) (10, 10);"),
+                            );
+                        }
+                        polygon = Some((gs.span, pts.len()));
+                    }
+                    GuideStmt::System(name) => {
+                        if let Some((first, _)) = system {
+                            self.setting_twice("system", gs.span, first);
+                            continue;
+                        }
+                        let params = match self.systems.get(name.name.as_str()) {
+                            Some(&(_, n)) => {
+                                self.used_systems.insert(name.name.clone());
+                                Some(n)
+                            }
+                            None => {
+                                let mut d = Diagnostic::error(
+                                    Code::UnknownSystem,
+                                    format!("there is no lsystem `{}`", name.name),
+                                )
+                                .primary(name.span, "not defined in this file");
+                                if let Some(sg) = suggest(&name.name, self.systems.keys().copied()) {
+                                    d = d.help(format!("did you mean `{sg}`?"));
+                                }
+                                self.diags.push(d);
+                                None
+                            }
+                        };
+                        system = Some((name.span, params));
+                    }
+                    GuideStmt::Seed(_) | GuideStmt::Error => {}
+                }
+            }
+            // Seeds, now that the system's parameters are known.
+            for gs in &g.body.stmts {
+                let GuideStmt::Seed(seed) = &gs.node else { continue };
+                self.const_num(&seed.at.x, "a seed coordinate");
+                self.const_num(&seed.at.y, "a seed coordinate");
+                if let Some(h) = &seed.heading {
+                    self.const_num(h, "a seed heading");
+                }
+                let given = seed.args.as_ref().map_or(0, Vec::len);
+                for a in seed.args.iter().flatten() {
+                    self.expect(a, &Env::new(), Ty::Num);
+                }
+                if let Some((sys_span, Some(want))) = system {
+                    if given != want {
+                        self.diags.push(
+                            Diagnostic::error(
+                                Code::SeedArguments,
+                                format!("this seed passes {given} value{}, but the guide's lsystem takes {want}", plural(given)),
+                            )
+                            .primary(gs.span, format!("{given} passed"))
+                            .secondary(sys_span, format!("this lsystem has {want} parameter{}", plural(want)))
+                            .help(if want == 0 {
+                                "remove `with (…)`".to_string()
+                            } else {
+                                format!("pass them with `with (…)`: {want} value{}", plural(want))
+                            }),
+                        );
+                    }
+                }
+            }
+            let mut missing = Vec::new();
+            if polygon.is_none() {
+                missing.push("a `polygon`");
+            }
+            if system.is_none() {
+                missing.push("a `system`");
+            }
+            if !missing.is_empty() {
+                self.diags.push(
+                    Diagnostic::error(
+                        Code::GuideIncomplete,
+                        format!("guide `{}` has no {}", g.name.name, missing.join(" and no ").trim_start_matches("a ")),
+                    )
+                    .primary(g.name.span, format!("needs {}", missing.join(" and ")))
+                    .help("a guide is a polygon hosting one lsystem: `polygon (0, 0) (10, 0) (10, 10); system Name;`"),
+                );
+            }
+            guides.insert(&g.name.name, (g.name.span, polygon.map(|p| p.1)));
+        }
+        for st in &s.body.stmts {
+            let SceneStmt::Link(l) = &st.node else { continue };
+            self.edge_ref(&l.from, &guides);
+            self.edge_ref(&l.to, &guides);
+            let mut seen: HashMap<&str, Span> = HashMap::new();
+            for ls in &l.body.stmts {
+                let (key, e) = match &ls.node {
+                    LinkStmt::Tokens(e) => ("tokens", e),
+                    LinkStmt::Heading(e) => ("heading", e),
+                    LinkStmt::Error => continue,
+                };
+                if let Some(first) = seen.get(key) {
+                    self.setting_twice(key, ls.span, *first);
+                    continue;
+                }
+                seen.insert(key, ls.span);
+                if key == "tokens" {
+                    self.const_int(e, "a token count", 0.0, 1e9);
+                } else {
+                    self.const_num(e, "a link heading");
+                }
+            }
+        }
+    }
+
+    fn setting_twice(&mut self, key: &str, span: Span, first: Span) {
+        self.diags.push(
+            Diagnostic::error(Code::DuplicateSetting, format!("`{key}` is given twice"))
+                .primary(span, "given again here")
+                .secondary(first, "first given here")
+                .help("keep one of them"),
+        );
+    }
+
+    fn edge_ref(&mut self, r: &EdgeRef, guides: &HashMap<&str, (Span, Option<usize>)>) {
+        let Some(&(gspan, edges)) = guides.get(r.guide.name.as_str()) else {
+            let mut d = Diagnostic::error(
+                Code::UnknownGuide,
+                format!("there is no guide `{}` in this scene", r.guide.name),
+            )
+            .primary(r.guide.span, "unknown guide");
+            if let Some(s) = suggest(&r.guide.name, guides.keys().copied()) {
+                d = d.help(format!("did you mean `{s}`?"));
+            }
+            self.diags.push(d);
+            return;
+        };
+        let Some(n) = edges else {
+            self.const_num(&r.index, "an edge index");
+            return;
+        };
+        let Some(i) = self.const_int(&r.index, "an edge index", 0.0, 1e9) else {
+            return;
+        };
+        if i as usize >= n {
+            self.diags.push(
+                Diagnostic::error(
+                    Code::EdgeOutOfRange,
+                    format!("guide `{}` has {n} edges, numbered 0 to {}", r.guide.name, n.saturating_sub(1)),
+                )
+                .primary(r.index.span, format!("edge {i} does not exist"))
+                .secondary(gspan, format!("its polygon has {n} vertices"))
+                .note("edge i joins vertex i to vertex i + 1; the last edge closes the polygon"),
+            );
+        }
+    }
+}

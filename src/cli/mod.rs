@@ -1,0 +1,136 @@
+//! Command-line parsing (clap) and the commands.
+//!
+//! Owns: arguments, exit statuses (0 success, 1 an error in the input, 2 a usage
+//! error) and where output goes: results on stdout, diagnostics on stderr.
+
+mod check;
+mod fmt;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use lsyc::diagnostic::{self, Diagnostic, Format};
+use std::io::{IsTerminal, Write};
+use std::process::ExitCode;
+
+const EXAMPLES: &str = "\
+Examples:
+  lsyc check lang-examples/koch-island.lsy
+  lsyc check tree.lsy -D depth=9 --error-format json
+  lsyc fmt tree.lsy                 # print the canonical form
+  lsyc fmt --write tree.lsy         # rewrite the file in place (atomically)
+  lsyc fmt --check lang-examples/*.lsy";
+
+/// lsyc: parametric Open L-systems — write .lsy programs, check, format and run them.
+#[derive(Parser, Debug)]
+#[command(name = "lsyc", version, about, after_help = EXAMPLES)]
+pub struct Cli {
+    /// When to colour diagnostics.
+    #[arg(long, value_enum, default_value_t = ColorChoice::Auto, global = true)]
+    pub color: ColorChoice,
+
+    /// How to write diagnostics: for people, or one JSON object per line.
+    #[arg(long, value_enum, default_value_t = ErrorFormat::Human, global = true)]
+    pub error_format: ErrorFormat,
+
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ColorChoice {
+    Auto,
+    Always,
+    Never,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ErrorFormat {
+    Human,
+    Json,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Check a program and report every problem found (nothing is run).
+    #[command(after_help = "Examples:\n  lsyc check plant.lsy\n  lsyc check plant.lsy -D angle=25\n  lsyc check plant.lsy --error-format json")]
+    Check(check::Args),
+    /// Print a program in canonical form (comments kept).
+    #[command(after_help = "Examples:\n  lsyc fmt plant.lsy > tidy.lsy\n  lsyc fmt --write plant.lsy\n  lsyc fmt --check lang-examples/*.lsy")]
+    Fmt(fmt::Args),
+}
+
+/// Where diagnostics go and how they look.
+pub struct Reporter {
+    format: Format,
+}
+
+impl Reporter {
+    fn new(cli: &Cli) -> Reporter {
+        let format = match cli.error_format {
+            ErrorFormat::Json => Format::Json,
+            ErrorFormat::Human => Format::Human {
+                color: match cli.color {
+                    ColorChoice::Always => true,
+                    ColorChoice::Never => false,
+                    ColorChoice::Auto => {
+                        std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none()
+                    }
+                },
+            },
+        };
+        Reporter { format }
+    }
+
+    /// Writes diagnostics about `source` (named `file`) to stderr.
+    pub fn emit(&self, diags: &[Diagnostic], file: &str, source: &str) {
+        if diags.is_empty() {
+            return;
+        }
+        let text = diagnostic::render(diags, file, source, self.format);
+        let _ = std::io::stderr().write_all(text.as_bytes());
+    }
+
+    pub fn is_json(&self) -> bool {
+        self.format == Format::Json
+    }
+
+    /// A one-line message for a person on stderr (suppressed in JSON mode).
+    pub fn say(&self, msg: &str) {
+        if !self.is_json() {
+            eprintln!("{msg}");
+        }
+    }
+}
+
+pub fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            return match e.kind() {
+                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => {
+                    ExitCode::SUCCESS
+                }
+                _ => ExitCode::from(2),
+            };
+        }
+    };
+    let reporter = Reporter::new(&cli);
+    let status = match &cli.command {
+        Command::Check(args) => check::run(args, &reporter),
+        Command::Fmt(args) => fmt::run(args, &reporter),
+    };
+    ExitCode::from(status)
+}
+
+/// Counts for a summary line: "2 errors, 1 warning".
+pub fn summary(diags: &[Diagnostic]) -> String {
+    let errors = diags.iter().filter(|d| d.is_error()).count();
+    let warnings = diags.len() - errors;
+    let part = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
+    match (errors, warnings) {
+        (0, 0) => "no problems found".to_string(),
+        (0, w) => part(w, "warning"),
+        (e, 0) => part(e, "error"),
+        (e, w) => format!("{}, {}", part(e, "error"), part(w, "warning")),
+    }
+}

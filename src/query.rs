@@ -1,0 +1,88 @@
+//! The query modules of Open L-systems and their fixed signatures.
+//!
+//! Owns: which `?` modules exist, which leading parameters the environment fills
+//! (outputs) and how many pass-through parameters each needs at least. A query in
+//! a predecessor is written with its outputs first and then the pass-through
+//! parameters; in an axiom or successor only the pass-through parameters are
+//! written (the outputs start at 0 until the environment answers).
+
+#[derive(Clone, Copy, Debug)]
+pub struct Query {
+    pub name: &'static str,
+    /// Names of the outputs, in order.
+    pub outputs: &'static [&'static str],
+    /// Pass-through parameters the environment reads (at least this many).
+    pub inputs: &'static [&'static str],
+    pub doc: &'static str,
+}
+
+pub const QUERIES: &[Query] = &[
+    Query {
+        name: "?P",
+        outputs: &["x", "y", "z"],
+        inputs: &[],
+        doc: "turtle position",
+    },
+    Query {
+        name: "?H",
+        outputs: &["hx", "hy", "hz"],
+        inputs: &[],
+        doc: "turtle heading (unit vector)",
+    },
+    Query {
+        name: "?D_L",
+        outputs: &["found", "d", "beta", "id"],
+        inputs: &[],
+        doc: "distance d and turning angle beta to the closest link edge of the guide",
+    },
+    Query {
+        name: "?D_G",
+        outputs: &["found", "d", "beta", "id"],
+        inputs: &[],
+        doc: "distance d and turning angle beta to the closest guide edge",
+    },
+    Query {
+        name: "?D_A",
+        outputs: &["found", "d", "beta", "id"],
+        inputs: &[],
+        doc: "distance d and turning angle beta to the closest element in the guide",
+    },
+    Query {
+        name: "?N_L",
+        outputs: &["found", "d", "id"],
+        inputs: &[],
+        doc: "distance along the heading to the next link edge",
+    },
+    Query {
+        name: "?N_G",
+        outputs: &["found", "d", "id"],
+        inputs: &[],
+        doc: "distance along the heading to the next guide edge",
+    },
+    Query {
+        name: "?N_A",
+        outputs: &["found", "d", "id"],
+        inputs: &[],
+        doc: "distance along the heading to the next guide edge or element",
+    },
+    Query {
+        name: "?X",
+        outputs: &["found", "id"],
+        inputs: &["delta"],
+        doc: "whether the next element of length delta collides with a guide edge, link or element",
+    },
+];
+
+pub fn lookup(name: &str) -> Option<&'static Query> {
+    QUERIES.iter().find(|q| q.name == name)
+}
+
+impl Query {
+    /// The form written in a predecessor, e.g. `?X(found, id, delta, …)`.
+    pub fn signature(&self) -> String {
+        let mut parts: Vec<&str> = self.outputs.to_vec();
+        parts.extend_from_slice(self.inputs);
+        parts.push("…");
+        format!("{}({})", self.name, parts.join(", "))
+    }
+}
