@@ -1,0 +1,56 @@
+//! Diagnostics snapshots: every program under tests/data/check/err names the codes
+//! it must produce on its first line (`// expect: E0402`), and its plain
+//! rendering is snapshotted.
+
+use crate::support::{lsy_files, read_text, rel, render_plain};
+use lsyc::diagnostic::Code;
+use lsyc::frontend;
+use std::collections::BTreeSet;
+
+/// Codes tested from the command line instead (tests/it/cli.rs).
+const CLI_ONLY: &[Code] = &[Code::ReadFile, Code::FileTooLarge, Code::BadOverride];
+
+fn expected_codes(text: &str) -> Vec<String> {
+    text.lines()
+        .next()
+        .and_then(|l| l.trim().strip_prefix("// expect:"))
+        .map(|rest| rest.split_whitespace().map(str::to_string).collect())
+        .unwrap_or_default()
+}
+
+#[test]
+fn error_programs_produce_their_codes() {
+    let mut settings = insta::Settings::clone_current();
+    settings.set_prepend_module_to_snapshot(false);
+    settings.bind(|| {
+        insta::glob!("../..", "tests/data/check/err/*.lsy", |path| {
+            let text = read_text(path);
+            let name = rel(path);
+            let want = expected_codes(&text);
+            assert!(!want.is_empty(), "{name}: the first line must be `// expect: CODE…`");
+            let bytes = std::fs::read(path).unwrap_or_default();
+            let src = lsyc::source::from_bytes(name.clone(), &bytes);
+            let fe = frontend::run(&src.text, src.diagnostics, &[]);
+            let got: BTreeSet<&str> = fe.diagnostics.iter().map(|d| d.code.as_str()).collect();
+            let rendered = render_plain(&fe.diagnostics, &name, &src.text);
+            for w in &want {
+                assert!(got.contains(w.as_str()), "{name}: expected {w}, got {got:?}\n{rendered}");
+            }
+            insta::assert_snapshot!("diagnostics", rendered);
+        });
+    });
+}
+
+#[test]
+fn every_code_has_an_error_program() {
+    let mut covered = BTreeSet::new();
+    for path in lsy_files(&["tests/data/check/err"]) {
+        covered.extend(expected_codes(&read_text(&path)));
+    }
+    let missing: Vec<&str> = Code::ALL
+        .iter()
+        .filter(|c| !CLI_ONLY.contains(c) && !covered.contains(c.as_str()))
+        .map(|c| c.as_str())
+        .collect();
+    assert!(missing.is_empty(), "codes without a program in tests/data/check/err: {missing:?}");
+}

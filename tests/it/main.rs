@@ -1,0 +1,6 @@
+//! All integration tests, in one binary so that `cargo test` links once.
+
+mod cli;
+mod corpus;
+mod diagnostics;
+mod support;
