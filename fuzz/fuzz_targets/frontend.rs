@@ -1,0 +1,31 @@
+//! Fuzzes the whole front end: bytes → lexer → parser → checker, and for every
+//! input that parses, the formatter's promises (its output parses to the same
+//! tree and formatting it again changes nothing).
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use lsyc::{dump, fmt, frontend, parser, source};
+
+fuzz_target!(|data: &[u8]| {
+    let src = source::from_bytes("fuzz.lsy".to_string(), data);
+    let fe = frontend::run(&src.text, src.diagnostics, &[]);
+    // Rendering must not panic either.
+    let _ = lsyc::diagnostic::render(
+        &fe.diagnostics,
+        "fuzz.lsy",
+        &src.text,
+        lsyc::diagnostic::Format::Human { color: false },
+    );
+    let parsed = parser::parse(&src.text);
+    if parsed.diagnostics.iter().any(|d| d.is_error()) {
+        return;
+    }
+    let once = fmt::format_file(&parsed.file);
+    let again = parser::parse(&once);
+    assert!(
+        !again.diagnostics.iter().any(|d| d.is_error()),
+        "formatted text does not parse:\n{once}"
+    );
+    assert_eq!(dump::dump(&parsed.file, false), dump::dump(&again.file, false));
+    assert_eq!(once, fmt::format_file(&again.file));
+});
