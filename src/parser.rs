@@ -194,6 +194,21 @@ fn list(items: &[String]) -> String {
     }
 }
 
+/// Where a `;` was probably forgotten: the token at `at` (or the first token of
+/// its line) starts a line, and the token before it ends an earlier line without `;`.
+fn missing_semicolon(tokens: &[(usize, Token, usize)], at: usize, index: &LineIndex) -> Option<usize> {
+    let pos = tokens.partition_point(|t| t.0 < at);
+    let line = index.line(at);
+    // The first token on the unexpected token's line.
+    let mut first = pos;
+    while first > 0 && index.line(tokens[first - 1].0) == line {
+        first -= 1;
+    }
+    let prev = tokens.get(first.checked_sub(1)?)?;
+    let ends_statement = matches!(prev.1, Token::Semi | Token::LBrace | Token::RBrace);
+    (!ends_statement && index.line(prev.2) < line).then_some(prev.2)
+}
+
 fn syntax_error(
     e: ParseError<usize, Token, LexError>,
     tokens: &[(usize, Token, usize)],
@@ -212,17 +227,20 @@ fn syntax_error(
                 format!("expected {}, found {tok}", list(&wanted)),
             )
             .primary(span, format!("unexpected {tok}"));
-            // A missing `;` shows up on the next line: point at the end of the last one.
-            let prev = tokens.iter().rev().find(|t| t.2 <= l);
-            if let Some(&(_, _, pend)) = prev {
-                let semi = expected.iter().any(|e| e == "\";\"");
-                if semi && index.line(pend) < index.line(l) {
+            // A missing `;` shows up on a later line: point at the end of the line
+            // before the statement that swallowed the next one.
+            let semi = expected.iter().any(|e| e == "\";\"");
+            if semi {
+                if let Some(pend) = missing_semicolon(tokens, l, index) {
                     d = d
                         .secondary(Span::new(pend, pend), "`;` may be missing here")
                         .help("end each statement with `;`");
                 }
             }
-            if tok.is_keyword() && expected.iter().any(|e| e == "\"name\"") {
+            if tok.is_keyword()
+                && expected.iter().any(|e| e == "\"name\"")
+                && !wanted.iter().any(|w| w == "a module")
+            {
                 d = d.note(format!(
                     "{tok} is a keyword of the language and cannot be used as a name"
                 ));
