@@ -7,6 +7,7 @@
 pub mod ast;
 pub mod builtins;
 pub mod check;
+pub mod compile;
 pub mod diagnostic;
 pub mod dump;
 pub mod frontend;
@@ -18,3 +19,4 @@ pub mod resolve;
 pub mod source;
 pub mod span;
 pub mod trivia;
+pub mod vm;

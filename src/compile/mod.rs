@@ -1,0 +1,483 @@
+//! The compiler: one checked `lsystem` to a `Program` the engine runs.
+//!
+//! Owns: the symbol table (a symbol is a module name with an arity, so `F` and
+//! `F(2)` are different symbols, as in cpfg), rules as patterns plus bytecode,
+//! successor templates, constant folding, and the D0L fast-path table. Must not
+//! report user mistakes the checker can find: it runs only on checked files.
+
+mod expr;
+
+use crate::ast::{File, Item, Lsystem, ModName, Module, Rule, Stmt};
+use crate::check::Checked;
+use crate::span::Span;
+use crate::vm::{Chunk, Code, Op};
+use std::collections::HashMap;
+
+pub use expr::ExprCompiler;
+
+/// A symbol id: index into `Symbols`.
+pub type Sym = u16;
+
+/// What the turtle does with a symbol.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Action {
+    None,
+    /// `F`: move and draw.
+    Draw,
+    /// `f`: move without drawing.
+    Move,
+    TurnLeft,
+    TurnRight,
+    PitchDown,
+    PitchUp,
+    RollLeft,
+    RollRight,
+    TurnAround,
+    RollHorizontal,
+    Scale,
+    Push,
+    Pop,
+    PolygonStart,
+    PolygonEnd,
+    Vertex,
+    Width,
+    Color,
+    Cut,
+    /// Prints element `n` (index into `Program::elements`).
+    Element(u16),
+}
+
+#[derive(Clone, Debug)]
+pub struct SymbolInfo {
+    pub name: ModName,
+    pub arity: u8,
+    pub action: Action,
+}
+
+/// The symbols of a program, each a (name, arity) pair.
+#[derive(Clone, Debug, Default)]
+pub struct Symbols {
+    pub info: Vec<SymbolInfo>,
+    map: HashMap<(ModName, u8), Sym>,
+}
+
+/// The most distinct (name, arity) pairs a program may use.
+pub const MAX_SYMBOLS: usize = u16::MAX as usize;
+
+impl Symbols {
+    pub fn get(&self, name: &ModName, arity: usize) -> Option<Sym> {
+        let a = u8::try_from(arity).ok()?;
+        self.map.get(&(name.clone(), a)).copied()
+    }
+
+    pub fn len(&self) -> usize {
+        self.info.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.info.is_empty()
+    }
+
+    pub fn arity(&self, s: Sym) -> usize {
+        self.info[s as usize].arity as usize
+    }
+}
+
+/// A module to emit: a symbol and the code of its parameters.
+#[derive(Clone, Debug)]
+pub struct Emit {
+    pub sym: Sym,
+    pub args: Vec<Code>,
+}
+
+/// A context module pattern: its symbol and where its parameters go.
+#[derive(Clone, Debug)]
+pub struct Pattern {
+    pub sym: Sym,
+    /// First slot for its parameters.
+    pub slot: u16,
+}
+
+#[derive(Clone, Debug)]
+pub struct CompiledRule {
+    pub left: Vec<Pattern>,
+    pub right: Vec<Pattern>,
+    pub cond: Option<Code>,
+    /// Stochastic weight; rules with the same `group` are alternatives.
+    pub weight: Option<Code>,
+    pub group: u32,
+    pub succ: Vec<Emit>,
+    /// Parameter slots the rule binds (predecessor first, then contexts).
+    pub slots: u16,
+    pub span: Span,
+}
+
+/// An element: a terminal that prints SVG path data.
+#[derive(Clone, Debug)]
+pub struct ElementDef {
+    pub name: String,
+    pub path: String,
+    pub fill: Option<String>,
+    pub stroke: Option<String>,
+    pub width: Option<f64>,
+}
+
+/// One lsystem, ready to derive and interpret.
+#[derive(Clone, Debug)]
+pub struct Program {
+    pub name: String,
+    pub symbols: Symbols,
+    pub chunk: Chunk,
+    /// The axiom, evaluated once (it may use the lsystem's parameters).
+    pub axiom: Vec<Emit>,
+    /// Derivation rules per symbol, in source order.
+    pub rules: Vec<Vec<CompiledRule>>,
+    /// Interpretation (homomorphism) rules per symbol.
+    pub interpret: Vec<Vec<CompiledRule>>,
+    /// For D0L programs: the fixed successor of every symbol.
+    pub d0l: Option<Vec<Vec<Sym>>>,
+    /// Symbols skipped when matching context.
+    pub ignore: Vec<bool>,
+    pub has_context: bool,
+    pub has_cut: bool,
+    pub angle: f64,
+    pub step: f64,
+    pub derive: u32,
+    pub params: Vec<String>,
+    pub elements: Vec<ElementDef>,
+    /// Whether any 3D symbol (& ^ \ / | $) appears.
+    pub is_3d: bool,
+}
+
+/// Compiles the lsystem called `name` (or the first one) of a checked file.
+pub fn compile(file: &File, checked: &Checked, name: Option<&str>) -> Result<Program, String> {
+    let systems: Vec<&Lsystem> = file
+        .items
+        .stmts
+        .iter()
+        .filter_map(|i| match &i.node {
+            Item::Lsystem(l) => Some(l),
+            _ => None,
+        })
+        .collect();
+    let ls = match name {
+        Some(n) => systems.iter().find(|l| l.name.name == n).copied().ok_or_else(|| {
+            let names: Vec<&str> = systems.iter().map(|l| l.name.name.as_str()).collect();
+            format!("there is no lsystem `{n}`; the file has: {}", names.join(", "))
+        })?,
+        None => *systems.first().ok_or("the file has no lsystem to run")?,
+    };
+    Compiler::new(file, checked).lsystem(ls)
+}
+
+struct Compiler<'a> {
+    file: &'a File,
+    checked: &'a Checked,
+    symbols: Symbols,
+    chunk: Chunk,
+    elements: Vec<ElementDef>,
+    element_index: HashMap<String, u16>,
+    /// Declared arity of query modules' outputs, to pad successors.
+    group: u32,
+}
+
+fn action_of(name: &ModName, element: Option<u16>) -> Action {
+    match name {
+        ModName::Name(n) if n == "F" => Action::Draw,
+        ModName::Name(n) if n == "f" => Action::Move,
+        ModName::Name(_) => element.map_or(Action::None, Action::Element),
+        ModName::Symbol(c) => match c {
+            '+' => Action::TurnLeft,
+            '-' => Action::TurnRight,
+            '&' => Action::PitchDown,
+            '^' => Action::PitchUp,
+            '\\' => Action::RollLeft,
+            '/' => Action::RollRight,
+            '|' => Action::TurnAround,
+            '$' => Action::RollHorizontal,
+            '*' => Action::Scale,
+            '[' => Action::Push,
+            ']' => Action::Pop,
+            '{' => Action::PolygonStart,
+            '}' => Action::PolygonEnd,
+            '.' => Action::Vertex,
+            '!' => Action::Width,
+            '\'' => Action::Color,
+            '%' => Action::Cut,
+            _ => Action::None,
+        },
+        ModName::Cut => Action::Cut,
+        ModName::Query(_) => Action::None,
+    }
+}
+
+impl<'a> Compiler<'a> {
+    fn new(file: &'a File, checked: &'a Checked) -> Compiler<'a> {
+        let mut elements = Vec::new();
+        let mut element_index = HashMap::new();
+        for item in &file.items.stmts {
+            if let Item::Element(e) = &item.node {
+                let mut def = ElementDef {
+                    name: e.name.name.clone(),
+                    path: String::new(),
+                    fill: None,
+                    stroke: None,
+                    width: None,
+                };
+                for p in &e.props.stmts {
+                    match (&p.node.key.name[..], &p.node.value) {
+                        ("path", crate::ast::PropValue::Str(s, _)) => def.path = s.clone(),
+                        ("fill", crate::ast::PropValue::Str(s, _)) => def.fill = Some(s.clone()),
+                        ("stroke", crate::ast::PropValue::Str(s, _)) => def.stroke = Some(s.clone()),
+                        ("width", crate::ast::PropValue::Expr(x)) => {
+                            def.width = ExprCompiler::fold_const(x, checked)
+                        }
+                        _ => {}
+                    }
+                }
+                element_index.insert(def.name.clone(), elements.len() as u16);
+                elements.push(def);
+            }
+        }
+        Compiler {
+            file,
+            checked,
+            symbols: Symbols::default(),
+            chunk: Chunk::default(),
+            elements,
+            element_index,
+            group: 0,
+        }
+    }
+
+    /// The symbol of a module as it appears in a string (queries with outputs padded).
+    fn intern(&mut self, name: &ModName, arity: usize) -> Result<Sym, String> {
+        let name = match name {
+            ModName::Cut => ModName::Symbol('%'),
+            n => n.clone(),
+        };
+        let a = u8::try_from(arity).map_err(|_| format!("`{}` has more than 255 parameters", name.text()))?;
+        if let Some(&s) = self.symbols.map.get(&(name.clone(), a)) {
+            return Ok(s);
+        }
+        if self.symbols.info.len() >= MAX_SYMBOLS {
+            return Err("the program uses more than 65535 distinct modules".to_string());
+        }
+        let element = match &name {
+            ModName::Name(n) => self.element_index.get(n).copied(),
+            _ => None,
+        };
+        let s = self.symbols.info.len() as Sym;
+        self.symbols.info.push(SymbolInfo {
+            action: action_of(&name, element),
+            name: name.clone(),
+            arity: a,
+        });
+        self.symbols.map.insert((name, a), s);
+        Ok(s)
+    }
+
+    /// Full arity of a module written in a successor or axiom (queries gain their outputs).
+    fn written_arity(m: &Module) -> usize {
+        match &m.name {
+            ModName::Query(q) => {
+                crate::query::lookup(q).map_or(0, |q| q.outputs.len()) + m.arity()
+            }
+            _ => m.arity(),
+        }
+    }
+
+    fn emit_list(&mut self, ms: &[Module], env: &HashMap<String, u16>) -> Result<Vec<Emit>, String> {
+        let mut out = Vec::with_capacity(ms.len());
+        for m in ms {
+            let sym = self.intern(&m.name, Self::written_arity(m))?;
+            let mut args = Vec::new();
+            if let ModName::Query(q) = &m.name {
+                let k = crate::query::lookup(q).map_or(0, |q| q.outputs.len());
+                for _ in 0..k {
+                    let start = self.chunk.len();
+                    self.chunk.push(Op::Const(0.0), m.span);
+                    args.push(Code { start, end: start + 1 });
+                }
+            }
+            for a in m.args.iter().flatten() {
+                args.push(ExprCompiler::new(&mut self.chunk, self.file, self.checked, env).compile(a));
+            }
+            out.push(Emit { sym, args });
+        }
+        Ok(out)
+    }
+
+    fn rule(&mut self, r: &Rule) -> Result<(Sym, CompiledRule), String> {
+        let mut env: HashMap<String, u16> = HashMap::new();
+        let mut slot: u16 = 0;
+        let mut bind = |m: &Module, env: &mut HashMap<String, u16>| -> u16 {
+            let first = slot;
+            for a in m.args.iter().flatten() {
+                if let crate::ast::ExprKind::Var(n) = &a.kind {
+                    if n != "_" {
+                        env.insert(n.clone(), slot);
+                    }
+                }
+                slot += 1;
+            }
+            first
+        };
+        bind(&r.pred, &mut env);
+        let mut left = Vec::new();
+        for m in r.left.iter().flatten() {
+            let s = bind(m, &mut env);
+            left.push((m, s));
+        }
+        let mut right = Vec::new();
+        for m in r.right.iter().flatten() {
+            let s = bind(m, &mut env);
+            right.push((m, s));
+        }
+        let pred = self.intern(&r.pred.name, r.pred.arity())?;
+        let mut lp = Vec::new();
+        for (m, s) in left {
+            lp.push(Pattern { sym: self.intern(&m.name, m.arity())?, slot: s });
+        }
+        let mut rp = Vec::new();
+        for (m, s) in right {
+            rp.push(Pattern { sym: self.intern(&m.name, m.arity())?, slot: s });
+        }
+        let cond = r
+            .cond
+            .as_ref()
+            .map(|c| ExprCompiler::new(&mut self.chunk, self.file, self.checked, &env).compile(c));
+        let weight = r
+            .weight
+            .as_ref()
+            .map(|w| ExprCompiler::new(&mut self.chunk, self.file, self.checked, &env).compile(w));
+        let succ = self.emit_list(&r.succ, &env)?;
+        Ok((
+            pred,
+            CompiledRule {
+                left: lp,
+                right: rp,
+                cond,
+                weight,
+                group: 0,
+                succ,
+                slots: slot,
+                span: r.pred.span.to(r.succ.last().map_or(r.pred.span, |m| m.span)),
+            },
+        ))
+    }
+
+    fn lsystem(mut self, ls: &Lsystem) -> Result<Program, String> {
+        let mut angle = 90.0;
+        let mut step = 1.0;
+        let mut derive = 1u32;
+        let mut axiom_mods: &[Module] = &[];
+        let mut ignore_mods: Vec<&Module> = Vec::new();
+        for s in &ls.body.stmts {
+            match &s.node {
+                Stmt::Angle(e) => angle = ExprCompiler::fold_const(e, self.checked).unwrap_or(angle),
+                Stmt::Step(e) => step = ExprCompiler::fold_const(e, self.checked).unwrap_or(step),
+                Stmt::Derive(e) => {
+                    derive = ExprCompiler::fold_const(e, self.checked).map_or(derive, |v| v as u32)
+                }
+                Stmt::Axiom(ms) => axiom_mods = ms,
+                Stmt::Ignore(ms) => ignore_mods.extend(ms.iter()),
+                _ => {}
+            }
+        }
+        let axiom_env: HashMap<String, u16> = ls
+            .params
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.name.clone(), i as u16))
+            .collect();
+        let axiom = self.emit_list(axiom_mods, &axiom_env)?;
+        let mut rules: Vec<(Sym, CompiledRule, bool)> = Vec::new();
+        let mut prev: Option<(Sym, bool, bool)> = None;
+        for s in &ls.body.stmts {
+            let Stmt::Rule(r) = &s.node else { continue };
+            let (sym, mut cr) = self.rule(r)?;
+            // Consecutive weighted rules for one symbol form one stochastic group.
+            let weighted = cr.weight.is_some();
+            let continues = weighted && prev == Some((sym, r.interpret, true));
+            if !continues {
+                self.group += 1;
+            }
+            cr.group = self.group;
+            prev = Some((sym, r.interpret, weighted));
+            rules.push((sym, cr, r.interpret));
+        }
+        let n = self.symbols.len();
+        let mut by_sym: Vec<Vec<CompiledRule>> = vec![Vec::new(); n];
+        let mut interp: Vec<Vec<CompiledRule>> = vec![Vec::new(); n];
+        let mut has_context = false;
+        for (sym, cr, is_interp) in rules {
+            has_context |= !cr.left.is_empty() || !cr.right.is_empty();
+            if is_interp {
+                interp[sym as usize].push(cr);
+            } else {
+                by_sym[sym as usize].push(cr);
+            }
+        }
+        let mut ignore = vec![false; n];
+        for m in ignore_mods {
+            for (i, info) in self.symbols.info.iter().enumerate() {
+                if info.name == m.name || (m.name == ModName::Cut && info.name == ModName::Symbol('%')) {
+                    ignore[i] = true;
+                }
+            }
+        }
+        let has_cut = self.symbols.info.iter().any(|i| i.action == Action::Cut);
+        let is_3d = self.symbols.info.iter().any(|i| {
+            matches!(
+                i.action,
+                Action::PitchDown
+                    | Action::PitchUp
+                    | Action::RollLeft
+                    | Action::RollRight
+                    | Action::TurnAround
+                    | Action::RollHorizontal
+            )
+        });
+        let d0l = d0l_table(&self.symbols, &by_sym, &self.chunk);
+        Ok(Program {
+            name: ls.name.name.clone(),
+            symbols: self.symbols,
+            chunk: self.chunk,
+            axiom,
+            rules: by_sym,
+            interpret: interp,
+            d0l,
+            ignore,
+            has_context,
+            has_cut,
+            angle,
+            step,
+            derive,
+            params: ls.params.iter().map(|p| p.name.clone()).collect(),
+            elements: self.elements,
+            is_3d,
+        })
+    }
+}
+
+/// A D0L program: every symbol has no parameters, and every rule is
+/// unconditional, context-free and not stochastic (the first rule wins).
+fn d0l_table(symbols: &Symbols, rules: &[Vec<CompiledRule>], _chunk: &Chunk) -> Option<Vec<Vec<Sym>>> {
+    if symbols.info.iter().any(|i| i.arity != 0) {
+        return None;
+    }
+    let mut table = Vec::with_capacity(symbols.len());
+    for (s, rs) in rules.iter().enumerate() {
+        match rs.first() {
+            None => table.push(vec![s as Sym]),
+            Some(r) => {
+                if r.cond.is_some() || r.weight.is_some() || !r.left.is_empty() || !r.right.is_empty() {
+                    return None;
+                }
+                table.push(r.succ.iter().map(|e| e.sym).collect());
+            }
+        }
+    }
+    Some(table)
+}

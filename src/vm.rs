@@ -1,0 +1,279 @@
+//! The expression VM: a small stack machine over `f64`, with booleans as 0 and 1.
+//!
+//! Owns: the instruction set (`Op`), code chunks with their debug table (which
+//! source span each instruction came from), evaluation, and the disassembler.
+//! Must not know about modules or rules: the compiler hands it parameter slots.
+
+use crate::span::Span;
+use std::fmt::Write;
+
+/// One instruction. Each documents its stack effect as `[before] -> [after]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Op {
+    /// `[] -> [v]`: push a constant.
+    Const(f64),
+    /// `[] -> [p]`: push parameter slot `n` of the current match.
+    Load(u16),
+    /// `[a] -> [-a]`
+    Neg,
+    /// `[a] -> [a == 0]`: logical not.
+    Not,
+    /// `[a, b] -> [a + b]`
+    Add,
+    /// `[a, b] -> [a - b]`
+    Sub,
+    /// `[a, b] -> [a * b]`
+    Mul,
+    /// `[a, b] -> [a / b]`; division by zero is a runtime error.
+    Div,
+    /// `[a, b] -> [a % b]` (sign of `a`); modulo by zero is a runtime error.
+    Rem,
+    /// `[a, b] -> [a ^ b]`
+    Pow,
+    /// `[a, b] -> [a == b]`
+    Eq,
+    /// `[a, b] -> [a != b]`
+    Ne,
+    /// `[a, b] -> [a < b]`
+    Lt,
+    /// `[a, b] -> [a <= b]`
+    Le,
+    /// `[a, b] -> [a > b]`
+    Gt,
+    /// `[a, b] -> [a >= b]`
+    Ge,
+    /// `[args…] -> [f(args…)]`: a deterministic built-in (index into `builtins::BUILTINS`).
+    Call(u8),
+    /// `[] -> [u]`: uniform in [0, 1) from the run's generator.
+    Rand,
+    /// `[a, b] -> [u]`: uniform in [a, b).
+    Uniform,
+    /// `[m, s] -> [x]`: Gaussian with mean m and deviation s.
+    Normal,
+    /// `[c] -> [c]`: if c is 0 jump to the instruction index, else pop c.
+    /// Used for `&&`: the left value stays as the result when it is false.
+    AndJump(u32),
+    /// `[c] -> [c]`: if c is not 0 jump, else pop c. Used for `||`.
+    OrJump(u32),
+    /// `[a] -> [a != 0]`: turns a number into 0 or 1 (the right side of `&&`/`||`).
+    Truth,
+}
+
+/// What a runtime error is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fault {
+    DivisionByZero,
+    /// The result is NaN or infinite.
+    NotFinite,
+}
+
+/// A runtime error with the source span of the instruction that caused it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VmError {
+    pub fault: Fault,
+    pub span: Span,
+}
+
+/// Instructions of many expressions, each a range, with a span per instruction.
+#[derive(Clone, Debug, Default)]
+pub struct Chunk {
+    pub code: Vec<Op>,
+    pub spans: Vec<Span>,
+}
+
+/// Where one compiled expression lives in a chunk.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Code {
+    pub start: u32,
+    pub end: u32,
+}
+
+impl Code {
+    /// A constant expression is a single `Const`.
+    pub fn constant(self, chunk: &Chunk) -> Option<f64> {
+        match &chunk.code[self.start as usize..self.end as usize] {
+            [Op::Const(v)] => Some(*v),
+            _ => None,
+        }
+    }
+}
+
+/// The generator behind `rand`, `uniform` and `normal`: a pure function of
+/// (seed, step, position, draw), so results do not depend on thread count.
+#[derive(Clone, Copy, Debug)]
+pub struct Random {
+    pub seed: u64,
+    pub step: u32,
+    pub position: u64,
+    pub draw: u32,
+}
+
+/// SplitMix64's finaliser: a good 64-bit mix.
+pub fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+impl Random {
+    pub fn new(seed: u64, step: u32, position: u64) -> Random {
+        Random {
+            seed,
+            step,
+            position,
+            draw: 0,
+        }
+    }
+
+    /// The next uniform number in [0, 1).
+    pub fn next(&mut self) -> f64 {
+        let h = mix(mix(mix(self.seed ^ 0x5eed) ^ u64::from(self.step)) ^ self.position)
+            ^ u64::from(self.draw).wrapping_mul(0xd6e8_feb8_6659_fd93);
+        self.draw += 1;
+        (mix(h) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+impl Chunk {
+    /// Appends an instruction with its span; returns its index.
+    pub fn push(&mut self, op: Op, span: Span) -> u32 {
+        self.code.push(op);
+        self.spans.push(span);
+        (self.code.len() - 1) as u32
+    }
+
+    pub fn len(&self) -> u32 {
+        self.code.len() as u32
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.code.is_empty()
+    }
+
+    /// Evaluates one expression. `stack` is scratch space reused between calls.
+    pub fn eval(
+        &self,
+        code: Code,
+        params: &[f64],
+        rng: &mut Random,
+        stack: &mut Vec<f64>,
+    ) -> Result<f64, VmError> {
+        stack.clear();
+        let mut pc = code.start as usize;
+        let end = code.end as usize;
+        while pc < end {
+            let op = self.code[pc];
+            let fault = |fault| VmError {
+                fault,
+                span: self.spans[pc],
+            };
+            match op {
+                Op::Const(v) => stack.push(v),
+                Op::Load(n) => stack.push(params.get(n as usize).copied().unwrap_or(0.0)),
+                Op::Neg => {
+                    let a = pop(stack);
+                    stack.push(-a);
+                }
+                Op::Not => {
+                    let a = pop(stack);
+                    stack.push(f64::from(a == 0.0));
+                }
+                Op::Truth => {
+                    let a = pop(stack);
+                    stack.push(f64::from(a != 0.0));
+                }
+                Op::AndJump(to) => {
+                    if top(stack) == 0.0 {
+                        pc = to as usize;
+                        continue;
+                    }
+                    stack.pop();
+                }
+                Op::OrJump(to) => {
+                    if top(stack) != 0.0 {
+                        pc = to as usize;
+                        continue;
+                    }
+                    stack.pop();
+                }
+                Op::Rand => stack.push(rng.next()),
+                Op::Uniform => {
+                    let b = pop(stack);
+                    let a = pop(stack);
+                    stack.push(a + (b - a) * rng.next());
+                }
+                Op::Normal => {
+                    let s = pop(stack);
+                    let m = pop(stack);
+                    // Box–Muller from two uniforms; u1 in (0, 1] keeps the log finite.
+                    let u1 = 1.0 - rng.next();
+                    let u2 = rng.next();
+                    let z = (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
+                    stack.push(m + s * z);
+                }
+                Op::Call(f) => {
+                    let b = &crate::builtins::BUILTINS[f as usize];
+                    let at = stack.len().saturating_sub(b.arity);
+                    let v = crate::builtins::eval(b.name, &stack[at..]).unwrap_or(f64::NAN);
+                    stack.truncate(at);
+                    if !v.is_finite() {
+                        return Err(fault(Fault::NotFinite));
+                    }
+                    stack.push(v);
+                }
+                _ => {
+                    let b = pop(stack);
+                    let a = pop(stack);
+                    let v = match op {
+                        Op::Add => a + b,
+                        Op::Sub => a - b,
+                        Op::Mul => a * b,
+                        Op::Div | Op::Rem if b == 0.0 => return Err(fault(Fault::DivisionByZero)),
+                        Op::Div => a / b,
+                        Op::Rem => a % b,
+                        Op::Pow => a.powf(b),
+                        Op::Eq => f64::from(a == b),
+                        Op::Ne => f64::from(a != b),
+                        Op::Lt => f64::from(a < b),
+                        Op::Le => f64::from(a <= b),
+                        Op::Gt => f64::from(a > b),
+                        Op::Ge => f64::from(a >= b),
+                        _ => unreachable!("unary and control ops are handled above"),
+                    };
+                    if !v.is_finite() {
+                        return Err(fault(Fault::NotFinite));
+                    }
+                    stack.push(v);
+                }
+            }
+            pc += 1;
+        }
+        Ok(stack.pop().unwrap_or(0.0))
+    }
+
+    /// A readable listing of one expression: index, instruction, source span.
+    pub fn disassemble(&self, code: Code, out: &mut String) {
+        for pc in code.start..code.end {
+            let op = self.code[pc as usize];
+            let span = self.spans[pc as usize];
+            let text = match op {
+                Op::Const(v) => format!("const {v}"),
+                Op::Load(n) => format!("load ${n}"),
+                Op::Call(f) => format!("call {}", crate::builtins::BUILTINS[f as usize].name),
+                Op::AndJump(t) => format!("and-jump {t}"),
+                Op::OrJump(t) => format!("or-jump {t}"),
+                other => format!("{other:?}").to_lowercase(),
+            };
+            let _ = writeln!(out, "    {pc:>4}  {text:<18} @{}..{}", span.start, span.end);
+        }
+    }
+}
+
+fn pop(stack: &mut Vec<f64>) -> f64 {
+    stack.pop().unwrap_or(0.0)
+}
+
+fn top(stack: &[f64]) -> f64 {
+    stack.last().copied().unwrap_or(0.0)
+}
