@@ -8,6 +8,7 @@ pub mod ast;
 pub mod builtins;
 pub mod check;
 pub mod compile;
+pub mod derive;
 pub mod diagnostic;
 pub mod dump;
 pub mod frontend;

@@ -1,0 +1,464 @@
+//! The derivation engine: parallel rewriting of a flat module string.
+//!
+//! Owns: the module string (symbol ids and one flat parameter array — a module's
+//! parameters are found by summing arities, so a parameterless module costs two
+//! bytes), the D0L fast path, parametric/stochastic/context-sensitive rewriting,
+//! `cut`, and the limits that stop an explosion before it allocates. Results are
+//! the same on any number of threads: random choices are keyed by
+//! (seed, step, position). Must not draw.
+
+mod context;
+
+use crate::compile::{Action, CompiledRule, Program, Sym};
+use crate::vm::{Random, VmError};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Modules per parallel work unit.
+const CHUNK: usize = 1 << 15;
+
+/// A derived string: `syms[i]` is module i; its parameters follow those of the
+/// modules before it in `params` (each symbol has a fixed arity).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ModString {
+    pub syms: Vec<Sym>,
+    pub params: Vec<f64>,
+}
+
+impl ModString {
+    pub fn len(&self) -> usize {
+        self.syms.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.syms.is_empty()
+    }
+
+    /// Bytes held by the string.
+    pub fn bytes(&self) -> usize {
+        self.syms.len() * std::mem::size_of::<Sym>() + self.params.len() * 8
+    }
+}
+
+/// Limits that end a derivation with a message instead of exhausting memory.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    pub max_modules: usize,
+    pub max_bytes: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Limits {
+        Limits {
+            max_modules: 250_000_000,
+            max_bytes: 4 << 30,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum DeriveError {
+    /// Step `step` would produce `modules` modules, over the limit.
+    TooManyModules { step: u32, modules: usize, limit: usize },
+    /// Step `step` would need about `bytes` bytes, over the limit.
+    TooMuchMemory { step: u32, bytes: usize, limit: usize },
+    /// An expression failed while deriving step `step` (0: the axiom).
+    Vm { step: u32, error: VmError },
+}
+
+/// Evaluates the axiom with the lsystem's parameters.
+pub fn axiom(prog: &Program, args: &[f64], seed: u64) -> Result<ModString, DeriveError> {
+    let mut out = ModString::default();
+    let mut rng = Random::new(seed, 0, u64::MAX);
+    let mut stack = Vec::new();
+    for e in &prog.axiom {
+        out.syms.push(e.sym);
+        for code in &e.args {
+            let v = prog
+                .chunk
+                .eval(*code, args, &mut rng, &mut stack)
+                .map_err(|error| DeriveError::Vm { step: 0, error })?;
+            out.params.push(v);
+        }
+    }
+    if prog.has_cut {
+        out = apply_cut(prog, out);
+    }
+    Ok(out)
+}
+
+/// Runs `steps` derivation steps from `start`; `progress(step)` is called after each.
+pub fn derive(
+    prog: &Program,
+    start: ModString,
+    steps: u32,
+    seed: u64,
+    limits: Limits,
+    progress: &(dyn Fn(u32, usize) + Sync),
+) -> Result<ModString, DeriveError> {
+    let mut s = start;
+    for k in 1..=steps {
+        s = step(prog, &s, k, seed, limits)?;
+        progress(k, s.len());
+    }
+    Ok(s)
+}
+
+/// One parallel rewriting step (step numbers start at 1).
+pub fn step(
+    prog: &Program,
+    s: &ModString,
+    step: u32,
+    seed: u64,
+    limits: Limits,
+) -> Result<ModString, DeriveError> {
+    let out = match &prog.d0l {
+        Some(table) => d0l_step(table, s, step, limits)?,
+        None => parametric_step(prog, s, step, seed, limits)?,
+    };
+    Ok(if prog.has_cut { apply_cut(prog, out) } else { out })
+}
+
+fn check_limits(step: u32, modules: usize, params: usize, limits: Limits) -> Result<(), DeriveError> {
+    if modules > limits.max_modules {
+        return Err(DeriveError::TooManyModules {
+            step,
+            modules,
+            limit: limits.max_modules,
+        });
+    }
+    let bytes = modules.saturating_mul(std::mem::size_of::<Sym>()).saturating_add(params.saturating_mul(8));
+    if bytes > limits.max_bytes {
+        return Err(DeriveError::TooMuchMemory {
+            step,
+            bytes,
+            limit: limits.max_bytes,
+        });
+    }
+    Ok(())
+}
+
+/// D0L: every symbol has one fixed successor. Count, check, then fill in place.
+fn d0l_step(table: &[Vec<Sym>], s: &ModString, step: u32, limits: Limits) -> Result<ModString, DeriveError> {
+    let lens: Vec<usize> = table.iter().map(Vec::len).collect();
+    let counts: Vec<usize> = s
+        .syms
+        .par_chunks(CHUNK)
+        .map(|c| c.iter().map(|&x| lens[x as usize]).sum())
+        .collect();
+    let total = counts.iter().try_fold(0usize, |a, &c| a.checked_add(c)).unwrap_or(usize::MAX);
+    check_limits(step, total, 0, limits)?;
+    let mut out = vec![0 as Sym; total];
+    let mut slices = Vec::with_capacity(counts.len());
+    let mut rest: &mut [Sym] = &mut out;
+    for &c in &counts {
+        let (a, b) = rest.split_at_mut(c);
+        slices.push(a);
+        rest = b;
+    }
+    s.syms
+        .par_chunks(CHUNK)
+        .zip(slices.into_par_iter())
+        .for_each(|(inp, outp)| {
+            let mut k = 0;
+            for &x in inp {
+                let succ = &table[x as usize];
+                match succ.len() {
+                    0 => {}
+                    1 => {
+                        outp[k] = succ[0];
+                        k += 1;
+                    }
+                    n => {
+                        outp[k..k + n].copy_from_slice(succ);
+                        k += n;
+                    }
+                }
+            }
+        });
+    Ok(ModString {
+        syms: out,
+        params: Vec::new(),
+    })
+}
+
+/// Where each chunk's parameters start, and (for context) every module's offset.
+fn param_offsets(prog: &Program, s: &ModString, all: bool) -> (Vec<usize>, Vec<u32>) {
+    let arity: Vec<usize> = prog.symbols.info.iter().map(|i| i.arity as usize).collect();
+    let sums: Vec<usize> = s
+        .syms
+        .par_chunks(CHUNK)
+        .map(|c| c.iter().map(|&x| arity[x as usize]).sum())
+        .collect();
+    let mut starts = Vec::with_capacity(sums.len());
+    let mut acc = 0usize;
+    for c in sums {
+        starts.push(acc);
+        acc += c;
+    }
+    let offsets = if all {
+        let mut off = vec![0u32; s.len()];
+        off.par_chunks_mut(CHUNK)
+            .zip(s.syms.par_chunks(CHUNK))
+            .zip(starts.par_iter())
+            .for_each(|((o, c), &start)| {
+                let mut p = start as u32;
+                for (oi, &x) in o.iter_mut().zip(c) {
+                    *oi = p;
+                    p += arity[x as usize] as u32;
+                }
+            });
+        off
+    } else {
+        Vec::new()
+    };
+    (starts, offsets)
+}
+
+/// The string being rewritten, with what context matching needs.
+pub(crate) struct View<'a> {
+    pub prog: &'a Program,
+    pub s: &'a ModString,
+    /// Parameter offset of every module (only for context-sensitive programs).
+    pub offsets: Vec<u32>,
+}
+
+impl View<'_> {
+    pub fn params_at(&self, i: usize) -> &[f64] {
+        let start = self.offsets[i] as usize;
+        let n = self.prog.symbols.arity(self.s.syms[i]);
+        &self.s.params[start..start + n]
+    }
+
+    pub fn action(&self, i: usize) -> Action {
+        self.prog.symbols.info[self.s.syms[i] as usize].action
+    }
+}
+
+struct ChunkOut {
+    syms: Vec<Sym>,
+    params: Vec<f64>,
+}
+
+fn parametric_step(
+    prog: &Program,
+    s: &ModString,
+    step: u32,
+    seed: u64,
+    limits: Limits,
+) -> Result<ModString, DeriveError> {
+    let (starts, offsets) = param_offsets(prog, s, prog.has_context);
+    let view = View { prog, s, offsets };
+    let produced = AtomicUsize::new(0);
+    let parts: Vec<Result<ChunkOut, DeriveError>> = s
+        .syms
+        .par_chunks(CHUNK)
+        .enumerate()
+        .map(|(ci, chunk)| {
+            rewrite_chunk(&view, ci * CHUNK, chunk, starts[ci], step, seed, limits, &produced)
+        })
+        .collect();
+    let mut outs = Vec::with_capacity(parts.len());
+    for p in parts {
+        outs.push(p?);
+    }
+    let total: usize = outs.iter().map(|o| o.syms.len()).sum();
+    let total_params: usize = outs.iter().map(|o| o.params.len()).sum();
+    check_limits(step, total, total_params, limits)?;
+    let mut syms = Vec::with_capacity(total);
+    let mut params = Vec::with_capacity(total_params);
+    for o in outs {
+        syms.extend_from_slice(&o.syms);
+        params.extend_from_slice(&o.params);
+    }
+    Ok(ModString { syms, params })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn rewrite_chunk(
+    view: &View,
+    base: usize,
+    chunk: &[Sym],
+    param_start: usize,
+    step: u32,
+    seed: u64,
+    limits: Limits,
+    produced: &AtomicUsize,
+) -> Result<ChunkOut, DeriveError> {
+    let prog = view.prog;
+    let s = view.s;
+    let mut out = ChunkOut {
+        syms: Vec::with_capacity(chunk.len() * 2),
+        params: Vec::with_capacity((s.params.len() / s.len().max(1) + 1) * chunk.len()),
+    };
+    let mut p = param_start;
+    let mut slots: Vec<f64> = Vec::new();
+    let mut stack: Vec<f64> = Vec::new();
+    let mut weights: Vec<(usize, f64)> = Vec::new();
+    let mut reported = 0usize;
+    for (j, &sym) in chunk.iter().enumerate() {
+        let i = base + j;
+        let arity = prog.symbols.arity(sym);
+        let params = &s.params[p..p + arity];
+        p += arity;
+        let rules = &prog.rules[sym as usize];
+        if rules.is_empty() {
+            out.syms.push(sym);
+            out.params.extend_from_slice(params);
+            continue;
+        }
+        let mut rng = Random::new(seed, step, i as u64);
+        let vm = |error| DeriveError::Vm { step, error };
+        let chosen = choose(view, rules, i, params, &mut slots, &mut stack, &mut rng, &mut weights)
+            .map_err(vm)?;
+        match chosen {
+            Some(r) => {
+                for e in &r.succ {
+                    out.syms.push(e.sym);
+                    for code in &e.args {
+                        let v = prog.chunk.eval(*code, &slots, &mut rng, &mut stack).map_err(vm)?;
+                        out.params.push(v);
+                    }
+                }
+            }
+            None => {
+                out.syms.push(sym);
+                out.params.extend_from_slice(params);
+            }
+        }
+        // Share progress so a runaway step stops early, not after filling memory.
+        if j % 1024 == 1023 {
+            let now = out.syms.len();
+            let total = produced.fetch_add(now - reported, Ordering::Relaxed) + now - reported;
+            reported = now;
+            check_limits(step, total, out.params.len(), limits)?;
+        }
+    }
+    produced.fetch_add(out.syms.len() - reported, Ordering::Relaxed);
+    Ok(out)
+}
+
+/// The rule that rewrites module `i`, with its parameters bound in `slots`.
+#[allow(clippy::too_many_arguments)]
+fn choose<'r>(
+    view: &View,
+    rules: &'r [CompiledRule],
+    i: usize,
+    params: &[f64],
+    slots: &mut Vec<f64>,
+    stack: &mut Vec<f64>,
+    rng: &mut Random,
+    weights: &mut Vec<(usize, f64)>,
+) -> Result<Option<&'r CompiledRule>, VmError> {
+    let chunk = &view.prog.chunk;
+    let mut k = 0;
+    while k < rules.len() {
+        let group = rules[k].group;
+        let end = k + rules[k..].iter().take_while(|r| r.group == group).count();
+        if rules[k].weight.is_none() {
+            let r = &rules[k];
+            if bind(view, r, i, params, slots) && holds(chunk, r, slots, stack, rng)? {
+                return Ok(Some(r));
+            }
+        } else {
+            weights.clear();
+            let mut sum = 0.0;
+            for (idx, r) in rules[k..end].iter().enumerate() {
+                if bind(view, r, i, params, slots) && holds(chunk, r, slots, stack, rng)? {
+                    let w = match r.weight {
+                        Some(code) => chunk.eval(code, slots, rng, stack)?,
+                        None => 1.0,
+                    };
+                    if w > 0.0 {
+                        sum += w;
+                        weights.push((k + idx, w));
+                    }
+                }
+            }
+            if sum > 0.0 {
+                let mut x = rng.next() * sum;
+                let mut pick = weights[weights.len() - 1].0;
+                for &(idx, w) in weights.iter() {
+                    if x < w {
+                        pick = idx;
+                        break;
+                    }
+                    x -= w;
+                }
+                let r = &rules[pick];
+                // Rebind: the slots hold the last candidate's context.
+                bind(view, r, i, params, slots);
+                return Ok(Some(r));
+            }
+        }
+        k = end;
+    }
+    Ok(None)
+}
+
+/// Binds the predecessor's parameters and matches the context; false if it fails.
+fn bind(view: &View, r: &CompiledRule, i: usize, params: &[f64], slots: &mut Vec<f64>) -> bool {
+    slots.clear();
+    slots.resize(r.slots as usize, 0.0);
+    slots[..params.len()].copy_from_slice(params);
+    if !r.left.is_empty() && !context::left(view, &r.left, i, slots) {
+        return false;
+    }
+    if !r.right.is_empty() && !context::right(view, &r.right, i, slots) {
+        return false;
+    }
+    true
+}
+
+fn holds(
+    chunk: &crate::vm::Chunk,
+    r: &CompiledRule,
+    slots: &[f64],
+    stack: &mut Vec<f64>,
+    rng: &mut Random,
+) -> Result<bool, VmError> {
+    match r.cond {
+        None => Ok(true),
+        Some(code) => Ok(chunk.eval(code, slots, rng, stack)? != 0.0),
+    }
+}
+
+/// Erases, after each `cut`, the rest of its branch (up to the `]` that closes it).
+fn apply_cut(prog: &Program, s: ModString) -> ModString {
+    let info = &prog.symbols.info;
+    if !s.syms.iter().any(|&x| info[x as usize].action == Action::Cut) {
+        return s;
+    }
+    let mut out = ModString {
+        syms: Vec::with_capacity(s.len()),
+        params: Vec::with_capacity(s.params.len()),
+    };
+    let mut p = 0;
+    let mut skip_depth: Option<usize> = None;
+    for &x in &s.syms {
+        let a = info[x as usize].arity as usize;
+        let params = &s.params[p..p + a];
+        p += a;
+        let action = info[x as usize].action;
+        if let Some(d) = skip_depth.as_mut() {
+            match action {
+                Action::Push => *d += 1,
+                Action::Pop if *d == 0 => {
+                    skip_depth = None;
+                    out.syms.push(x);
+                    out.params.extend_from_slice(params);
+                }
+                Action::Pop => *d -= 1,
+                _ => {}
+            }
+            continue;
+        }
+        if action == Action::Cut {
+            skip_depth = Some(0);
+            continue;
+        }
+        out.syms.push(x);
+        out.params.extend_from_slice(params);
+    }
+    out
+}
