@@ -3,5 +3,13 @@ fn main() {
     let src = std::fs::read_to_string(&p).unwrap();
     let r = lsyc::parser::parse(&src);
     println!("{:#?}", r.file);
-    print!("{}", lsyc::diagnostic::render(&r.diagnostics, &p, &src, lsyc::diagnostic::Format::Human{color:false}));
+    print!(
+        "{}",
+        lsyc::diagnostic::render(
+            &r.diagnostics,
+            &p,
+            &src,
+            lsyc::diagnostic::Format::Human { color: false }
+        )
+    );
 }

@@ -32,6 +32,9 @@ pub struct Trivia {
     pub trailing: Option<Comment>,
     /// Whether a blank line separates the node from the one before it.
     pub blank_before: bool,
+    /// Whether a blank line separates the leading comments from the node (a file
+    /// header stays apart from the first item).
+    pub blank_after_leading: bool,
 }
 
 /// A statement-like node: an item, a statement in a block, a property.
@@ -93,6 +96,8 @@ pub struct Lsystem {
     pub body: Block<Stmt>,
 }
 
+// Rules are most statements; boxing them would only add indirection.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 pub enum Stmt {
     Angle(Expr),

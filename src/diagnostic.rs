@@ -235,7 +235,8 @@ fn render_human(diags: &[Diagnostic], file: &str, source: &str, color: bool) -> 
         let mut buf = term::termcolor::Buffer::ansi();
         for d in diags {
             // Rendering into memory cannot fail for spans clamped to the source.
-            let _ = term::emit_to_write_style(&mut buf, &config, &files, &to_codespan(d, source.len()));
+            let _ =
+                term::emit_to_write_style(&mut buf, &config, &files, &to_codespan(d, source.len()));
         }
         String::from_utf8_lossy(buf.as_slice()).into_owned()
     } else {

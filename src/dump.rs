@@ -48,19 +48,26 @@ impl Dumper {
     }
 
     fn block<T>(&mut self, b: &Block<T>, mut f: impl FnMut(&mut Dumper, &T)) {
-        let Block { stmts, end_comments } = b;
+        let Block {
+            stmts,
+            end_comments,
+        } = b;
         for n in stmts {
             let Node { trivia, node, span } = n;
             let Trivia {
                 leading,
                 trailing,
                 blank_before,
+                blank_after_leading,
             } = trivia;
             if *blank_before {
                 self.line("(blank)");
             }
             for c in leading {
                 self.comment("lead", c);
+            }
+            if *blank_after_leading {
+                self.line("(blank)");
             }
             let s = format!("node{}", self.sp(*span));
             self.line(&s);
@@ -81,7 +88,10 @@ impl Dumper {
     }
 
     fn idents(&self, is: &[Ident]) -> String {
-        is.iter().map(|i| self.ident(i)).collect::<Vec<_>>().join(", ")
+        is.iter()
+            .map(|i| self.ident(i))
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 
     fn item(&mut self, item: &Item) {
@@ -231,11 +241,19 @@ impl Dumper {
 
     fn edge(&self, e: &EdgeRef) -> String {
         let EdgeRef { guide, index, span } = e;
-        format!("{}.edge({}){}", self.ident(guide), self.expr(index), self.sp(*span))
+        format!(
+            "{}.edge({}){}",
+            self.ident(guide),
+            self.expr(index),
+            self.sp(*span)
+        )
     }
 
     fn modules(&self, ms: &[Module]) -> String {
-        ms.iter().map(|m| self.module(m)).collect::<Vec<_>>().join(" ")
+        ms.iter()
+            .map(|m| self.module(m))
+            .collect::<Vec<_>>()
+            .join(" ")
     }
 
     fn module(&self, m: &Module) -> String {
@@ -262,7 +280,10 @@ impl Dumper {
     }
 
     fn exprs(&self, es: &[Expr]) -> String {
-        es.iter().map(|e| self.expr(e)).collect::<Vec<_>>().join(", ")
+        es.iter()
+            .map(|e| self.expr(e))
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 
     /// Fully parenthesised, so the tree shape is visible.
@@ -285,7 +306,12 @@ impl Dumper {
             ExprKind::Call(f, args) => format!("{}({})", self.ident(f), self.exprs(args)),
             ExprKind::Error => "<error>".to_string(),
         };
-        if self.spans && !matches!(kind, ExprKind::Num(_) | ExprKind::Var(_) | ExprKind::Bool(_)) {
+        if self.spans
+            && !matches!(
+                kind,
+                ExprKind::Num(_) | ExprKind::Var(_) | ExprKind::Bool(_)
+            )
+        {
             format!("{body}{}", self.sp(*span))
         } else {
             body

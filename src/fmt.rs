@@ -5,8 +5,8 @@
 //! space) and the promise that `parse(format(parse(x)))` equals `parse(x)` up to
 //! spans, comments and blank lines included, and that formatting is idempotent.
 //! Blank lines follow `trivia::blank_between`, the policy shared with the parser;
-//! blank lines between a node's leading comments and the node are not in the AST,
-//! so none are printed there.
+//! a blank line between a node's leading comments and the node is kept
+//! (`Trivia::blank_after_leading`); blank lines among the comments are not.
 //! Must not read source text or spans (it prints ASTs built in code too), must not
 //! check or change meaning, and must never panic: `Error` nodes are skipped
 //! (`ExprKind::Error` prints as `0`).
@@ -164,6 +164,9 @@ impl Printer {
             }
             for c in &node.trivia.leading {
                 self.comment_line(c, level);
+            }
+            if node.trivia.blank_after_leading && !node.trivia.leading.is_empty() {
+                self.out.push('\n');
             }
             self.indent(level);
             print(self, &node.node, level);
@@ -661,8 +664,9 @@ mod tests {
         );
         // A second comment on the same line leads the next node.
         assert!(out.contains("module M; /* block */\n\n// second on same line\nlsystem A {\n"));
-        assert!(out.contains("lsystem A {\n    // after brace\n    angle 90;"));
-        assert!(out.contains("    angle 90; // angle\n\n    // before rule\n    /* inside */\n    F -> FF;\n    /* multi\n     line */\n    axiom F;\n"));
+        // A blank line after leading comments is kept (a header stays apart).
+        assert!(out.contains("lsystem A {\n    // after brace\n\n    angle 90;"));
+        assert!(out.contains("    angle 90; // angle\n\n    // before rule\n    /* inside */\n    F -> FF; /* multi\n     line */\n    axiom F;\n"));
         assert!(out.contains("    // before close\n}\n"));
         assert!(out.contains("element Leaf { path \"M0 0\"; fill \"green\"; } // leaf\n"));
         assert!(out.contains(

@@ -155,7 +155,7 @@ pub enum Token {
     #[token("%")]
     Percent,
 
-    #[regex(r"//[^\n]*", |lex| lex.slice().to_string(), allow_greedy = true)]
+    #[regex(r"//[^\r\n]*", |lex| lex.slice().to_string(), allow_greedy = true)]
     LineComment(String),
     #[token("/*", block_comment)]
     BlockComment(String),
@@ -203,9 +203,9 @@ fn string(lex: &mut logos::Lexer<Token>) -> Result<String, LexError> {
                     lex.bump(j);
                     // Skip to the closing quote so one bad escape is one error.
                     let tail = lex.remainder();
-                    let stop = tail.find(['"', '\n']).map_or(tail.len(), |k| {
-                        k + usize::from(tail[k..].starts_with('"'))
-                    });
+                    let stop = tail
+                        .find(['"', '\n'])
+                        .map_or(tail.len(), |k| k + usize::from(tail[k..].starts_with('"')));
                     lex.bump(stop);
                     return Err(LexError::InvalidEscape(at));
                 }
@@ -214,7 +214,15 @@ fn string(lex: &mut logos::Lexer<Token>) -> Result<String, LexError> {
             _ => out.push(c),
         }
     }
-    let stop = rest.find('\n').unwrap_or(rest.len());
+    // The string runs to the end of its line; a `;` there most likely ends the
+    // statement, so it is left for the parser.
+    let line_end = rest.find('\n').unwrap_or(rest.len());
+    let line = rest[..line_end].trim_end();
+    let stop = if line.ends_with(';') {
+        line.len() - 1
+    } else {
+        line_end
+    };
     lex.bump(stop);
     Err(LexError::UnterminatedString)
 }
@@ -261,7 +269,15 @@ pub fn lex(source: &str) -> Lexed {
                 }
             }
             Err(LexError::Unexpected) => {
-                let is_nul = source[range.clone()].contains('\0');
+                let text = &source[range.clone()];
+                if text == "→" {
+                    // Reported, then read as the arrow it stands for.
+                    flush_stray(&mut stray, &mut diagnostics);
+                    diagnostics.push(stray_diagnostic(source, range.start, range.end));
+                    tokens.push((range.start, Token::Arrow, range.end));
+                    continue;
+                }
+                let is_nul = text.contains('\0');
                 if is_nul {
                     flush_stray(&mut stray, &mut diagnostics);
                     diagnostics.push(
@@ -282,6 +298,17 @@ pub fn lex(source: &str) -> Lexed {
             }
             Err(e) => {
                 flush_stray(&mut stray, &mut diagnostics);
+                // Keep a stand-in token so that the parser does not trip over the gap.
+                let stand_in = match e {
+                    LexError::UnterminatedString | LexError::InvalidEscape(_) => {
+                        Some(Token::Str(String::new()))
+                    }
+                    LexError::NumberOutOfRange => Some(Token::Number(0.0)),
+                    _ => None,
+                };
+                if let Some(t) = stand_in {
+                    tokens.push((range.start, t, range.end));
+                }
                 diagnostics.push(token_error(e, span));
             }
         }
@@ -308,7 +335,9 @@ fn stray_diagnostic(source: &str, start: usize, end: usize) -> Diagnostic {
     );
     d = match first {
         '#' => d.help("lsyc sets the line width with `!(w)`; `#` is cpfg's width symbol"),
-        '@' => d.help("cpfg's `@` commands are not part of lsyc; see the turtle table in docs/language.md"),
+        '@' => d.help(
+            "cpfg's `@` commands are not part of lsyc; see the turtle table in docs/language.md",
+        ),
         '~' => d.help("surfaces are drawn by declared `element` items, not `~`"),
         '?' => d.help("a query module is written `?` followed directly by its name, as in `?X(d)`"),
         '"' => d.help("strings are written in double quotes: \"…\""),
@@ -320,30 +349,29 @@ fn stray_diagnostic(source: &str, start: usize, end: usize) -> Diagnostic {
 
 fn token_error(e: LexError, span: Span) -> Diagnostic {
     match e {
-        LexError::UnterminatedComment => Diagnostic::error(
-            Code::UnterminatedComment,
-            "block comment is never closed",
-        )
-        .primary(Span::new(span.start as usize, span.start as usize + 2), "comment starts here")
-        .help("close it with `*/`"),
-        LexError::UnterminatedString => Diagnostic::error(
-            Code::UnterminatedString,
-            "string is never closed",
-        )
-        .primary(span, "this string has no closing `\"` on its line")
-        .help("add `\"` at the end of the string"),
-        LexError::InvalidEscape(at) => Diagnostic::error(
-            Code::InvalidEscape,
-            "unknown escape sequence in string",
-        )
-        .primary(Span::new(at, at + 2), "not an escape lsyc knows")
-        .help("the escapes are \\\" \\\\ \\n \\t"),
-        LexError::NumberOutOfRange => Diagnostic::error(
-            Code::NumberOutOfRange,
-            "number is too large to represent",
-        )
-        .primary(span, "this literal overflows a 64-bit float")
-        .help("numbers must be below about 1.8e308"),
+        LexError::UnterminatedComment => {
+            Diagnostic::error(Code::UnterminatedComment, "block comment is never closed")
+                .primary(
+                    Span::new(span.start as usize, span.start as usize + 2),
+                    "comment starts here",
+                )
+                .help("close it with `*/`")
+        }
+        LexError::UnterminatedString => {
+            Diagnostic::error(Code::UnterminatedString, "string is never closed")
+                .primary(span, "this string has no closing `\"` on its line")
+                .help("add `\"` at the end of the string")
+        }
+        LexError::InvalidEscape(at) => {
+            Diagnostic::error(Code::InvalidEscape, "unknown escape sequence in string")
+                .primary(Span::new(at, at + 2), "not an escape lsyc knows")
+                .help("the escapes are \\\" \\\\ \\n \\t")
+        }
+        LexError::NumberOutOfRange => {
+            Diagnostic::error(Code::NumberOutOfRange, "number is too large to represent")
+                .primary(span, "this literal overflows a 64-bit float")
+                .help("numbers must be below about 1.8e308")
+        }
         LexError::Unexpected => Diagnostic::error(Code::UnexpectedChar, "unexpected character")
             .primary(span, "no token of the language starts here"),
     }
@@ -356,7 +384,7 @@ impl fmt::Display for Token {
             Token::Label(s) => write!(f, "label `{s}:`"),
             Token::Query(s) => write!(f, "query module `{s}`"),
             Token::Number(n) => write!(f, "number `{n}`"),
-            Token::Str(_) => write!(f, "a string"),
+            Token::Str(_) => write!(f, "string"),
             Token::LineComment(_) | Token::BlockComment(_) => write!(f, "a comment"),
             other => write!(f, "`{}`", other.text().unwrap_or("?")),
         }

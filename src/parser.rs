@@ -28,6 +28,32 @@ pub fn sp(l: usize, r: usize) -> Span {
     Span::new(l, r)
 }
 
+/// `&&` or `||` in a module string: two modules, the parameters on the second.
+pub fn doubled(
+    c: char,
+    l: usize,
+    r: usize,
+    args: Option<Vec<Expr>>,
+    end: usize,
+) -> Vec<crate::ast::Module> {
+    use crate::ast::{ModName, Module};
+    let mid = l + 1;
+    vec![
+        Module {
+            name: ModName::Symbol(c),
+            name_span: Span::new(l, mid),
+            args: None,
+            span: Span::new(l, mid),
+        },
+        Module {
+            name: ModName::Symbol(c),
+            name_span: Span::new(mid, r),
+            args,
+            span: Span::new(mid, end),
+        },
+    ]
+}
+
 /// State the grammar actions write to.
 #[derive(Default)]
 pub struct ParseState {
@@ -93,24 +119,35 @@ pub fn parse(source: &str) -> Parsed {
     let mut diagnostics = lexed.diagnostics;
     let mut state = ParseState::default();
     let tokens = lexed.tokens.clone();
-    let result = grammar::FileParser::new().parse(
-        &mut state,
-        lexed.tokens.into_iter().map(Ok::<_, LexError>),
-    );
+    let result = grammar::FileParser::new()
+        .parse(&mut state, lexed.tokens.into_iter().map(Ok::<_, LexError>));
     let index = LineIndex::new(source);
     let mut syntax = Vec::new();
     for rec in state.recovered.drain(..) {
-        syntax.push(syntax_error(rec.error, &tokens, source, &index));
+        syntax.push(syntax_error(
+            rec.error,
+            &tokens,
+            &lexed.comments,
+            source,
+            &index,
+        ));
     }
     let mut file = match result {
         Ok(file) => file,
         Err(e) => {
-            syntax.push(syntax_error(e, &tokens, source, &index));
+            syntax.push(syntax_error(e, &tokens, &lexed.comments, source, &index));
             File::default()
         }
     };
     // One error per place: recovery can report the same token twice.
     syntax.dedup_by(|a, b| a.position() == b.position());
+    // A comment or string that runs to the end of the file explains the end.
+    if diagnostics
+        .iter()
+        .any(|d| matches!(d.code, Code::UnterminatedComment))
+    {
+        syntax.retain(|d| d.code != Code::UnexpectedEof);
+    }
     diagnostics.extend(syntax);
     diagnostics.append(&mut state.diags);
     trivia::attach(&mut file, lexed.comments, source);
@@ -139,25 +176,72 @@ pub fn decode(bytes: &[u8]) -> (String, Option<Diagnostic>) {
 
 fn describe_expected(expected: &[String]) -> Vec<String> {
     const MODULE_STARTS: &[&str] = &[
-        "\"name\"", "\"query\"", "\"cut\"", "\"+\"", "\"-\"", "\"&\"", "\"^\"", "\"\\\\\"",
-        "\"/\"", "\"|\"", "\"$\"", "\"*\"", "\"[\"", "\"]\"", "\"{\"", "\".\"", "\"!\"",
-        "\"'\"", "\"%\"",
+        "\"name\"",
+        "\"query\"",
+        "\"cut\"",
+        "\"+\"",
+        "\"-\"",
+        "\"&\"",
+        "\"^\"",
+        "\"\\\\\"",
+        "\"/\"",
+        "\"|\"",
+        "\"$\"",
+        "\"*\"",
+        "\"[\"",
+        "\"]\"",
+        "\"{\"",
+        "\".\"",
+        "\"!\"",
+        "\"'\"",
+        "\"%\"",
+        "\"&&\"",
+        "\"||\"",
     ];
     const EXPR_STARTS: &[&str] = &[
-        "\"number\"", "\"name\"", "\"true\"", "\"false\"", "\"(\"", "\"-\"", "\"!\"",
+        "\"number\"",
+        "\"name\"",
+        "\"true\"",
+        "\"false\"",
+        "\"(\"",
+        "\"-\"",
+        "\"!\"",
     ];
     const OPERATORS: &[&str] = &[
         "\"+\"", "\"-\"", "\"*\"", "\"/\"", "\"%\"", "\"^\"", "\"==\"", "\"!=\"", "\"<\"",
         "\"<=\"", "\">\"", "\">=\"", "\"&&\"", "\"||\"",
     ];
+    const STATEMENT_STARTS: &[&str] = &[
+        "\"angle\"",
+        "\"derive\"",
+        "\"step\"",
+        "\"axiom\"",
+        "\"ignore\"",
+        "\"module\"",
+        "\"interpret\"",
+        "\"label\"",
+    ];
     let has = |set: &[&str]| set.iter().all(|t| expected.iter().any(|e| e == t));
+    // Most of the module symbols (some are left out where a rule starts).
+    let has_modules = MODULE_STARTS
+        .iter()
+        .filter(|t| expected.iter().any(|e| e == *t))
+        .count()
+        >= 12;
     let mut rest: Vec<&String> = expected.iter().collect();
     let mut out = Vec::new();
     let mut take = |set: &[&str], phrase: &str, rest: &mut Vec<&String>| {
         rest.retain(|e| !set.contains(&e.as_str()));
         out.push(phrase.to_string());
     };
-    if has(MODULE_STARTS) {
+    if has(STATEMENT_STARTS) {
+        take(
+            STATEMENT_STARTS,
+            "a statement (`axiom …;`, a rule, …)",
+            &mut rest,
+        );
+        rest.retain(|e| !MODULE_STARTS.contains(&e.as_str()));
+    } else if has_modules {
         take(MODULE_STARTS, "a module", &mut rest);
     }
     if has(EXPR_STARTS) {
@@ -196,7 +280,11 @@ fn list(items: &[String]) -> String {
 
 /// Where a `;` was probably forgotten: the token at `at` (or the first token of
 /// its line) starts a line, and the token before it ends an earlier line without `;`.
-fn missing_semicolon(tokens: &[(usize, Token, usize)], at: usize, index: &LineIndex) -> Option<usize> {
+fn missing_semicolon(
+    tokens: &[(usize, Token, usize)],
+    at: usize,
+    index: &LineIndex,
+) -> Option<usize> {
     let pos = tokens.partition_point(|t| t.0 < at);
     let line = index.line(at);
     // The first token on the unexpected token's line.
@@ -210,6 +298,62 @@ fn missing_semicolon(tokens: &[(usize, Token, usize)], at: usize, index: &LineIn
 }
 
 fn syntax_error(
+    e: ParseError<usize, Token, LexError>,
+    tokens: &[(usize, Token, usize)],
+    comments: &[lexer::Comment],
+    source: &str,
+    index: &LineIndex,
+) -> Diagnostic {
+    let d = syntax_error_at(e, tokens, source, index);
+    explain_context(d, tokens, comments, source, index)
+}
+
+/// Adds notes for the usual traps near a syntax error: `//` glued to modules
+/// (a comment, not two rolls) and `name:` (a label, not a condition).
+fn explain_context(
+    mut d: Diagnostic,
+    tokens: &[(usize, Token, usize)],
+    comments: &[lexer::Comment],
+    source: &str,
+    index: &LineIndex,
+) -> Diagnostic {
+    let at = d.position() as usize;
+    let line = index.line(at);
+    let near = |pos: usize| {
+        let l = index.line(pos);
+        l == line || l + 1 == line
+    };
+    for c in comments {
+        let start = c.span.start as usize;
+        let glued = start > 0
+            && source[..start]
+                .chars()
+                .next_back()
+                .is_some_and(|ch| !ch.is_whitespace() && ch != ';');
+        if c.text.starts_with("//") && glued && near(start) {
+            d = d
+                .secondary(Span::new(start, start + 2), "this `//` starts a comment")
+                .note("`//` always starts a comment; two rolls are written `/ /`");
+            break;
+        }
+    }
+    // A label on this statement: `A: x > 2 -> …` reads `A:` as a label.
+    let pos = tokens.partition_point(|t| t.0 < at);
+    for t in tokens[..pos].iter().rev() {
+        if matches!(t.1, Token::Semi | Token::LBrace) {
+            break;
+        }
+        if let Token::Label(name) = &t.1 {
+            d = d.note(format!(
+                "`{name}:` is read as a rule label; for a condition write a space before the colon: `{name} : …`"
+            ));
+            break;
+        }
+    }
+    d
+}
+
+fn syntax_error_at(
     e: ParseError<usize, Token, LexError>,
     tokens: &[(usize, Token, usize)],
     source: &str,
@@ -230,12 +374,10 @@ fn syntax_error(
             // A missing `;` shows up on a later line: point at the end of the line
             // before the statement that swallowed the next one.
             let semi = expected.iter().any(|e| e == "\";\"");
-            if semi {
-                if let Some(pend) = missing_semicolon(tokens, l, index) {
-                    d = d
-                        .secondary(Span::new(pend, pend), "`;` may be missing here")
-                        .help("end each statement with `;`");
-                }
+            if semi && let Some(pend) = missing_semicolon(tokens, l, index) {
+                d = d
+                    .secondary(Span::new(pend, pend), "`;` may be missing here")
+                    .help("end each statement with `;`");
             }
             if tok.is_keyword()
                 && expected.iter().any(|e| e == "\"name\"")
@@ -253,11 +395,26 @@ fn syntax_error(
         ParseError::UnrecognizedEof { location, expected } => {
             let wanted = describe_expected(&expected);
             let at = location.min(source.len());
-            Diagnostic::error(
+            let mut d = Diagnostic::error(
                 Code::UnexpectedEof,
                 format!("unexpected end of file, expected {}", list(&wanted)),
             )
-            .primary(Span::new(at, at), "the file ends here")
+            .primary(Span::new(at, at), "the file ends here");
+            // `F -> F+F` then `}`: the `}` was read as a module of the successor.
+            if expected.iter().any(|e| e == "\";\"")
+                && let Some(close) = tokens.iter().rev().find(|t| t.1 == Token::RBrace)
+                && let Some(pend) = missing_semicolon(tokens, close.0, index)
+            {
+                d = d
+                    .secondary(Span::new(pend, pend), "`;` may be missing here")
+                    .secondary(
+                        Span::new(close.0, close.2),
+                        "so this `}` was read as part of the successor",
+                    )
+                    .note("inside a successor `}` closes a polygon `{`")
+                    .help("end each statement with `;`");
+            }
+            d
         }
         ParseError::ExtraToken { token: (l, tok, r) } => {
             Diagnostic::error(Code::UnexpectedToken, format!("unexpected {tok}"))

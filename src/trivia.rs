@@ -94,7 +94,7 @@ fn attach_block<T: Nested>(block: &mut Block<T>, comments: Vec<Comment>, src: &s
                 .get(prev.span.end as usize..c.span.start as usize)
                 .unwrap_or("\n")
                 .contains('\n');
-            if same_line && prev.trivia.trailing.is_none() && inner[idx - 1].is_empty() {
+            if same_line && prev.trivia.trailing.is_none() {
                 prev.trivia.trailing = Some(c);
                 continue;
             }
@@ -104,10 +104,8 @@ fn attach_block<T: Nested>(block: &mut Block<T>, comments: Vec<Comment>, src: &s
             None => block.end_comments.push(c),
         }
     }
+    // Every nested block is visited, comments or not, so its blank lines are kept.
     for (node, comments) in stmts.iter_mut().zip(inner) {
-        if comments.is_empty() {
-            continue;
-        }
         let rest = node.node.take_inner(comments, src);
         node.trivia.leading.extend(rest);
     }
@@ -115,6 +113,20 @@ fn attach_block<T: Nested>(block: &mut Block<T>, comments: Vec<Comment>, src: &s
 }
 
 fn set_blank_lines<T: Nested>(stmts: &mut [Node<T>], src: &str) {
+    for node in stmts.iter_mut() {
+        // A blank line after the comments written before the node.
+        let last = node
+            .trivia
+            .leading
+            .iter()
+            .filter(|c| c.span.end <= node.span.start)
+            .map(|c| c.span.end)
+            .max();
+        node.trivia.blank_after_leading = last.is_some_and(|end| {
+            src.get(end as usize..node.span.start as usize)
+                .is_some_and(|gap| gap.matches('\n').count() >= 2)
+        });
+    }
     for i in 0..stmts.len() {
         if i == 0 {
             stmts[i].trivia.blank_before = false;

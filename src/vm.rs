@@ -127,7 +127,7 @@ impl Random {
     }
 
     /// The next uniform number in [0, 1).
-    pub fn next(&mut self) -> f64 {
+    pub fn uniform(&mut self) -> f64 {
         let h = mix(mix(mix(self.seed ^ 0x5eed) ^ u64::from(self.step)) ^ self.position)
             ^ u64::from(self.draw).wrapping_mul(0xd6e8_feb8_6659_fd93);
         self.draw += 1;
@@ -197,18 +197,18 @@ impl Chunk {
                     }
                     stack.pop();
                 }
-                Op::Rand => stack.push(rng.next()),
+                Op::Rand => stack.push(rng.uniform()),
                 Op::Uniform => {
                     let b = pop(stack);
                     let a = pop(stack);
-                    stack.push(a + (b - a) * rng.next());
+                    stack.push(a + (b - a) * rng.uniform());
                 }
                 Op::Normal => {
                     let s = pop(stack);
                     let m = pop(stack);
                     // Box–Muller from two uniforms; u1 in (0, 1] keeps the log finite.
-                    let u1 = 1.0 - rng.next();
-                    let u2 = rng.next();
+                    let u1 = 1.0 - rng.uniform();
+                    let u2 = rng.uniform();
                     let z = (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
                     stack.push(m + s * z);
                 }

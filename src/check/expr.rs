@@ -42,6 +42,7 @@ pub struct Env {
 pub struct Param {
     pub name: String,
     pub span: Span,
+    pub ty: Ty,
     pub used: Cell<bool>,
 }
 
@@ -51,9 +52,15 @@ impl Env {
     }
 
     pub fn add(&mut self, name: &str, span: Span) {
+        self.add_typed(name, span, Ty::Num);
+    }
+
+    /// A parameter of a known type: the `found` output of a query is a boolean.
+    pub fn add_typed(&mut self, name: &str, span: Span, ty: Ty) {
         self.params.push(Param {
             name: name.to_string(),
             span,
+            ty,
             used: Cell::new(false),
         });
     }
@@ -63,36 +70,53 @@ impl Env {
     }
 }
 
-/// Levenshtein distance, for "did you mean".
+/// Edit distance with adjacent transpositions (optimal string alignment), for
+/// "did you mean": `crwon` is one edit from `crown`.
 pub fn distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
     let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, &cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(row[j + 1] + 1);
-            prev = cur;
+    let (n, m) = (a.len(), b.len());
+    let mut d = vec![vec![0usize; m + 1]; n + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in d[0].iter_mut().enumerate() {
+        *cell = j;
+    }
+    for i in 1..=n {
+        for j in 1..=m {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut v = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                v = v.min(d[i - 2][j - 2] + 1);
+            }
+            d[i][j] = v;
         }
     }
-    row[b.len()]
+    d[n][m]
 }
 
-/// The closest candidate within a small edit distance.
+/// The closest candidate within a small edit distance; on a tie the earliest
+/// candidate wins, so callers list the likeliest (rule parameters) first.
 pub fn suggest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
     let len = name.chars().count();
     if len < 2 {
         return None;
     }
     let limit = (len / 3).max(1);
-    candidates
-        .into_iter()
-        .filter(|c| *c != name)
-        .map(|c| (distance(name, c), c))
-        .filter(|(d, _)| *d <= limit)
-        .min()
-        .map(|(_, c)| c)
+    let mut best: Option<(usize, &'a str)> = None;
+    for c in candidates {
+        if c == name {
+            continue;
+        }
+        let d = distance(name, c);
+        if d <= limit && best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, c));
+        }
+    }
+    best.map(|(_, c)| c)
 }
 
 impl Checker<'_> {
@@ -105,7 +129,7 @@ impl Checker<'_> {
             ExprKind::Var(name) => {
                 if let Some(p) = env.find(name) {
                     p.used.set(true);
-                    return Ty::Num;
+                    return p.ty;
                 }
                 if let Some(c) = self.consts.get(name.as_str()) {
                     self.used_consts.insert(name.clone());
@@ -113,14 +137,20 @@ impl Checker<'_> {
                 }
                 let mut d = Diagnostic::error(Code::UnknownName, format!("unknown name `{name}`"))
                     .primary(e.span, "not a parameter of this rule or a constant");
+                let mut consts: Vec<&str> = self.consts.keys().copied().collect();
+                consts.sort_unstable();
                 let names: Vec<&str> = env
                     .params
                     .iter()
                     .map(|p| p.name.as_str())
-                    .chain(self.consts.keys().copied())
+                    .chain(consts)
                     .collect();
                 if let Some(s) = suggest(name, names) {
                     d = d.help(format!("did you mean `{s}`?"));
+                } else if self.lsystem_params.iter().any(|p| p == name) {
+                    d = d.help(format!(
+                        "`{name}` is a parameter of the lsystem: it is visible in the axiom only; pass it on as a module parameter, e.g. `axiom A({name});`"
+                    ));
                 } else if builtins::lookup(name).is_some() {
                     d = d.help(format!("`{name}` is a function: call it as `{name}(…)`"));
                 } else {
@@ -150,7 +180,12 @@ impl Checker<'_> {
                         self.diags.push(
                             Diagnostic::error(
                                 Code::TypeMismatch,
-                                format!("`{}` compares {} with {}", op.text(), ta.name(), tb.name()),
+                                format!(
+                                    "`{}` compares {} with {}",
+                                    op.text(),
+                                    ta.name(),
+                                    tb.name()
+                                ),
                             )
                             .primary(b.span, format!("this is {}", tb.name()))
                             .secondary(a.span, format!("this is {}", ta.name())),
@@ -293,7 +328,10 @@ impl Checker<'_> {
                         Code::NotConstant,
                         format!("{what} must be known before derivation"),
                     )
-                    .primary(e.span, "this uses a random function or a constant that is not known")
+                    .primary(
+                        e.span,
+                        "this uses a random function or a constant that is not known",
+                    )
                     .help("use numbers, constants and deterministic functions here"),
                 );
                 None

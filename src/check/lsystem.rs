@@ -1,8 +1,8 @@
 //! Checks of one `lsystem`: settings, rules, module arities, query signatures,
 //! brackets, and the warnings about rules that cannot fire.
 
-use super::expr::{plural, Env, Ty, Value};
-use super::{duplicate, Checker};
+use super::expr::{Env, Ty, Value, plural};
+use super::{Checker, duplicate};
 use crate::ast::{ExprKind, Lsystem, ModName, Module, Rule, Stmt};
 use crate::diagnostic::{Code, Diagnostic};
 use crate::query::{self, Query};
@@ -43,16 +43,22 @@ struct Local {
     query_pass: HashMap<String, (usize, Span)>,
     /// (symbol, arity) pairs already warned about as never rewritten.
     warned: HashSet<(ModName, usize)>,
+    /// Queries whose pass-through mismatch is already reported.
+    pass_reported: HashSet<&'static str>,
 }
 
 impl<'a> Checker<'a> {
     pub(super) fn lsystem(&mut self, ls: &'a Lsystem) {
+        self.lsystem_params = ls.params.iter().map(|p| p.name.clone()).collect();
+        self.reported_queries.clear();
+        self.labels(ls);
         let mut local = Local {
             decls: HashMap::new(),
             rule_arity: HashMap::new(),
             turtle_arities: HashMap::new(),
             query_pass: HashMap::new(),
             warned: HashSet::new(),
+            pass_reported: HashSet::new(),
         };
         self.settings(ls, &mut local);
         let rules: Vec<&Rule> = ls
@@ -109,6 +115,21 @@ impl<'a> Checker<'a> {
         self.unreachable_rules(ls, &rules);
     }
 
+    /// Labels name rules, so two rules of one lsystem may not share one.
+    fn labels(&mut self, ls: &Lsystem) {
+        let mut seen: HashMap<&str, Span> = HashMap::new();
+        for s in &ls.body.stmts {
+            if let Stmt::Rule(Rule { label: Some(l), .. }) = &s.node {
+                if let Some(first) = seen.get(l.name.as_str()) {
+                    self.diags
+                        .push(duplicate("rule label", &l.name, l.span, *first));
+                } else {
+                    seen.insert(&l.name, l.span);
+                }
+            }
+        }
+    }
+
     fn kind(&self, m: &Module, local: &Local) -> Kind {
         match &m.name {
             ModName::Name(n) => {
@@ -139,9 +160,11 @@ impl<'a> Checker<'a> {
                 Stmt::Axiom(_) => "axiom",
                 Stmt::Module(m) => {
                     if let Some((_, first)) = local.decls.get(&m.name.name) {
-                        self.diags.push(duplicate("module", &m.name.name, m.name.span, *first));
+                        self.diags
+                            .push(duplicate("module", &m.name.name, m.name.span, *first));
                     } else if let Some(info) = self.modules.get(m.name.name.as_str()) {
-                        self.diags.push(duplicate("module", &m.name.name, m.name.span, info.span));
+                        self.diags
+                            .push(duplicate("module", &m.name.name, m.name.span, info.span));
                     } else {
                         self.check_param_names(&m.params);
                         local
@@ -299,12 +322,22 @@ impl<'a> Checker<'a> {
 
     fn unknown_query(&mut self, m: &Module) {
         let name = m.name.text();
+        if !self.reported_queries.insert(name.to_string()) {
+            return;
+        }
         let mut d = Diagnostic::error(
             Code::UnknownQuery,
             format!("`{name}` is not a query module"),
         )
         .primary(m.name_span, "the environment does not answer this query");
-        if let Some(s) = super::suggest(&name, query::QUERIES.iter().map(|q| q.name)) {
+        let prefixed: Vec<String> = query::QUERIES
+            .iter()
+            .filter(|q| q.name.starts_with(name.as_ref()))
+            .map(|q| format!("`{}`", q.name))
+            .collect();
+        if !prefixed.is_empty() {
+            d = d.help(format!("did you mean {}?", prefixed.join(" or ")));
+        } else if let Some(s) = super::suggest(&name, query::QUERIES.iter().map(|q| q.name)) {
             d = d.help(format!("did you mean `{s}`?"));
         } else {
             let names: Vec<&str> = query::QUERIES.iter().map(|q| q.name).collect();
@@ -321,10 +354,18 @@ impl<'a> Checker<'a> {
             self.diags.push(
                 Diagnostic::error(
                     Code::QuerySignature,
-                    format!("`{}` in a predecessor needs at least {} parameters", q.name, k + q.inputs.len()),
+                    format!(
+                        "`{}` in a predecessor needs at least {} parameters",
+                        q.name,
+                        k + q.inputs.len()
+                    ),
                 )
                 .primary(m.span, format!("{arity} given"))
-                .note(format!("its signature is {}: the environment fills {}", q.signature(), q.outputs.join(", ")))
+                .note(format!(
+                    "its signature is {}: the environment fills {}",
+                    q.signature(),
+                    q.outputs.join(", ")
+                ))
                 .help("write `_` for outputs you do not use"),
             );
             return;
@@ -334,7 +375,7 @@ impl<'a> Checker<'a> {
 
     fn record_pass(&mut self, m: &Module, q: &'static Query, pass: usize, local: &mut Local) {
         match local.query_pass.get(q.name) {
-            Some(&(p, first)) if p != pass => self.diags.push(
+            Some(&(p, first)) if p != pass && local.pass_reported.insert(q.name) => self.diags.push(
                 Diagnostic::error(
                     Code::QuerySignature,
                     format!("`{}` carries {} pass-through parameter{} here but {} elsewhere", q.name, pass, plural(pass), p),
@@ -357,17 +398,20 @@ impl<'a> Checker<'a> {
     fn module_list(&mut self, ms: &[Module], role: Role, local: &mut Local) {
         for m in ms {
             let arity = m.arity();
-            if let ModName::Name(n) = &m.name {
-                if !local.decls.contains_key(n) {
-                    self.used_modules.insert(n.clone());
-                }
+            if let ModName::Name(n) = &m.name
+                && !local.decls.contains_key(n)
+            {
+                self.used_modules.insert(n.clone());
             }
             if role == Role::Ignore {
                 if m.args.is_some() {
                     self.diags.push(
-                        Diagnostic::error(Code::ArgsNotAllowed, "an ignore list names modules without parameters")
-                            .primary(m.span, "parameters here")
-                            .help(format!("write just `{}`", m.name.text())),
+                        Diagnostic::error(
+                            Code::ArgsNotAllowed,
+                            "an ignore list names modules without parameters",
+                        )
+                        .primary(m.span, "parameters here")
+                        .help(format!("write just `{}`", m.name.text())),
                     );
                 }
                 continue;
@@ -413,23 +457,27 @@ impl<'a> Checker<'a> {
                     }
                 }
                 Kind::Turtle => {
-                    if let Some(set) = local.turtle_arities.get(&m.name) {
-                        if !set.contains(&arity)
-                            && role != Role::Context
-                            && local.warned.insert((m.name.clone(), arity))
-                        {
-                            let mut ar: Vec<usize> = set.iter().copied().collect();
-                            ar.sort_unstable();
-                            let ar: Vec<String> = ar.iter().map(ToString::to_string).collect();
-                            self.diags.push(
+                    if let Some(set) = local.turtle_arities.get(&m.name)
+                        && !set.contains(&arity)
+                        && role != Role::Context
+                        && local.warned.insert((m.name.clone(), arity))
+                    {
+                        let mut ar: Vec<usize> = set.iter().copied().collect();
+                        ar.sort_unstable();
+                        let ar: Vec<String> = ar.iter().map(ToString::to_string).collect();
+                        self.diags.push(
                                 Diagnostic::warning(
                                     Code::ArityNeverRewritten,
-                                    format!("this `{}` is never rewritten: its rules take {} parameter(s)", m.name.text(), ar.join(" or ")),
+                                    format!(
+                                        "this `{}` is never rewritten: its rules take {} parameter{}",
+                                        m.name.text(),
+                                        ar.join(" or "),
+                                        if ar.len() == 1 && ar[0] == "1" { "" } else { "s" }
+                                    ),
                                 )
                                 .primary(m.span, format!("{arity} parameter{}", plural(arity)))
                                 .help("give it the same number of parameters as the rules' predecessor, or add a rule for this form"),
                             );
-                        }
                     }
                 }
             }
@@ -452,57 +500,78 @@ impl<'a> Checker<'a> {
             .chain(std::iter::once(&r.pred))
             .chain(r.right.iter().flatten());
         for pm in pats {
-            for a in pm.args.iter().flatten() {
-                if let ExprKind::Var(n) = &a.kind {
-                    if n != "_" {
-                        if let Some((_, first)) = bound.iter().find(|(b, _)| b == n) {
-                            self.diags.push(duplicate("parameter", n, a.span, *first));
-                            continue;
-                        }
-                        bound.push((n.clone(), a.span));
-                        env.add(n, a.span);
+            let outputs = match &pm.name {
+                ModName::Query(q) => query::lookup(q).map_or(&[][..], |q| q.outputs),
+                _ => &[],
+            };
+            for (k, a) in pm.args.iter().flatten().enumerate() {
+                if let ExprKind::Var(n) = &a.kind
+                    && n != "_"
+                {
+                    if let Some((_, first)) = bound.iter().find(|(b, _)| b == n) {
+                        self.diags.push(duplicate("parameter", n, a.span, *first));
+                        continue;
                     }
+                    bound.push((n.clone(), a.span));
+                    let ty = if outputs.get(k) == Some(&"found") {
+                        Ty::Bool
+                    } else {
+                        Ty::Num
+                    };
+                    env.add_typed(n, a.span, ty);
                 }
             }
         }
         if let Some(c) = &r.cond {
+            let before = self.diags.len();
             let t = self.expr(c, &env);
+            let clean = self.diags.len() == before;
             if t == Ty::Num {
                 self.diags.push(
                     Diagnostic::error(Code::ConditionNotBool, "a condition must be true or false")
                         .primary(c.span, "this is a number")
                         .help("compare it, for example `x > 0` or `x != 0`"),
                 );
-            } else if t == Ty::Bool && self.eval(c) == Some(Value::Bool(false)) {
+            } else if clean && t == Ty::Bool && self.eval(c) == Some(Value::Bool(false)) {
                 self.diags.push(
-                    Diagnostic::warning(Code::AlwaysFalse, "this rule can never fire: its condition is always false")
-                        .primary(c.span, "always false")
-                        .help("check the constants it uses, or remove the rule"),
+                    Diagnostic::warning(
+                        Code::AlwaysFalse,
+                        "this rule can never fire: its condition is always false",
+                    )
+                    .primary(c.span, "always false")
+                    .help("check the constants it uses, or remove the rule"),
                 );
             }
         }
-        if let Some(w) = &r.weight {
-            if self.expect(w, &env, Ty::Num) == Ty::Num {
-                if let Some(Value::Num(v)) = self.eval(w) {
-                    if !(v >= 0.0 && v.is_finite()) {
-                        self.diags.push(
-                            Diagnostic::error(Code::OutOfRange, "a weight must be zero or positive")
-                                .primary(w.span, format!("this is {v}")),
-                        );
-                    }
-                }
-            }
+        if let Some(w) = &r.weight
+            && self.expect(w, &env, Ty::Num) == Ty::Num
+            && let Some(Value::Num(v)) = self.eval(w)
+            && !(v >= 0.0 && v.is_finite())
+        {
+            self.diags.push(
+                Diagnostic::error(Code::OutOfRange, "a weight must be zero or positive")
+                    .primary(w.span, format!("this is {v}")),
+            );
         }
         for m in &r.succ {
             self.module_args(m, &env);
         }
         self.brackets(&r.succ);
-        for p in &env.params {
+        let malformed_query = match &r.pred.name {
+            ModName::Query(q) => {
+                query::lookup(q).is_some_and(|q| r.pred.arity() < q.outputs.len() + q.inputs.len())
+            }
+            _ => false,
+        };
+        for p in env.params.iter().filter(|_| !malformed_query) {
             if !p.used.get() && !p.name.starts_with('_') {
                 self.diags.push(
-                    Diagnostic::warning(Code::UnusedParameter, format!("parameter `{}` is never used", p.name))
-                        .primary(p.span, "bound here")
-                        .help(format!("write `_` (or `_{}`) if it only matches", p.name)),
+                    Diagnostic::warning(
+                        Code::UnusedParameter,
+                        format!("parameter `{}` is never used", p.name),
+                    )
+                    .primary(p.span, "bound here")
+                    .help(format!("write `_` (or `_{}`) if it only matches", p.name)),
                 );
             }
         }
@@ -517,26 +586,28 @@ impl<'a> Checker<'a> {
             for m in ms {
                 match m.name {
                     ModName::Symbol(c) if c == open => stack.push(m.span),
-                    ModName::Symbol(c) if c == close => {
-                        if stack.pop().is_none() {
-                            self.diags.push(
+                    ModName::Symbol(c) if c == close && stack.pop().is_none() => {
+                        self.diags.push(
                                 Diagnostic::error(code, format!("`{close}` without a matching `{open}`"))
-                                    .primary(m.span, format!("nothing to close here"))
+                                    .primary(m.span, "nothing to close here".to_string())
                                     .help(format!("remove it or add `{open}` before it; each module string must balance")),
                             );
-                        }
                     }
                     _ => {}
                 }
             }
             if let Some(&first_open) = stack.first() {
-                let mut d = Diagnostic::error(
-                    code,
-                    format!("{} `{open}` never closed", stack.len()),
-                )
-                .primary(*stack.last().unwrap_or(&first_open), format!("this `{open}` has no `{close}`"));
+                let mut d =
+                    Diagnostic::error(code, format!("{} `{open}` never closed", stack.len()))
+                        .primary(
+                            *stack.last().unwrap_or(&first_open),
+                            format!("this `{open}` has no `{close}`"),
+                        );
                 if stack.len() > 1 {
-                    d = d.note(format!("{} unclosed `{open}` in this module string", stack.len()));
+                    d = d.note(format!(
+                        "{} unclosed `{open}` in this module string",
+                        stack.len()
+                    ));
                 }
                 self.diags.push(d.help(format!("add `{close}` at the end")));
             }
@@ -558,32 +629,62 @@ impl<'a> Checker<'a> {
         let mut prev: Option<&Rule> = None;
         for r in rules {
             let name = &r.pred.name;
-            let rewritable = !matches!(name, ModName::Symbol('[' | ']' | '{' | '}' | '%') | ModName::Cut);
+            let rewritable = !matches!(
+                name,
+                ModName::Symbol('[' | ']' | '{' | '}' | '%') | ModName::Cut
+            );
             let known = match name {
-                ModName::Name(n) => is_letter(n) || self.modules.contains_key(n.as_str()) || ls.body.stmts.iter().any(|s| matches!(&s.node, Stmt::Module(m) if &m.name.name == n)),
+                ModName::Name(n) => {
+                    is_letter(n)
+                        || self.modules.contains_key(n.as_str())
+                        || ls
+                            .body
+                            .stmts
+                            .iter()
+                            .any(|s| matches!(&s.node, Stmt::Module(m) if &m.name.name == n))
+                }
                 ModName::Query(q) => query::lookup(q).is_some(),
                 _ => true,
             };
             if rewritable && known && !produced.contains(name) && reported.insert(name) {
-                self.diags.push(
-                    Diagnostic::warning(
-                        Code::NeverProduced,
-                        format!("this rule can never fire: `{}` appears in no axiom or successor", name.text()),
-                    )
-                    .primary(r.pred.name_span, "never produced")
-                    .help(format!("add `{}` to the axiom or to a successor, or remove the rule", name.text())),
-                );
+                let mut d = Diagnostic::warning(
+                    Code::NeverProduced,
+                    format!(
+                        "this rule can never fire: `{}` appears in no axiom or successor",
+                        name.text()
+                    ),
+                )
+                .primary(r.pred.name_span, "never produced")
+                .help(format!(
+                    "add `{}` to the axiom or to a successor, or remove the rule",
+                    name.text()
+                ));
+                if let Some(l) = r.label.as_ref().filter(|l| is_letter(&l.name)) {
+                    d = d.secondary(l.span, "read as a rule label").note(format!(
+                        "`{0}:` is a rule label; if `{0}` is the predecessor and the rest a condition, write `{0} : …` with a space",
+                        l.name
+                    ));
+                }
+                self.diags.push(d);
             }
             let key = (r.interpret, name, r.pred.arity());
             let same_group = r.weight.is_some()
-                && prev.is_some_and(|p| p.weight.is_some() && p.pred.name == *name && p.interpret == r.interpret);
+                && prev.is_some_and(|p| {
+                    p.weight.is_some() && p.pred.name == *name && p.interpret == r.interpret
+                });
             if let Some(&earlier) = always.get(&key) {
                 if !same_group {
                     self.diags.push(
-                        Diagnostic::warning(Code::Shadowed, "this rule can never fire: an earlier rule always applies")
-                            .primary(r.pred.span, "hidden")
-                            .secondary(earlier, "this rule has no condition or context, so it always applies first")
-                            .help("move this rule above it, or give the earlier rule a condition"),
+                        Diagnostic::warning(
+                            Code::Shadowed,
+                            "this rule can never fire: an earlier rule always applies",
+                        )
+                        .primary(r.pred.span, "hidden")
+                        .secondary(
+                            earlier,
+                            "this rule has no condition or context, so it always applies first",
+                        )
+                        .help("move this rule above it, or give the earlier rule a condition"),
                     );
                 }
             } else if r.cond.is_none() && r.left.is_none() && r.right.is_none() {

@@ -71,6 +71,10 @@ struct Checker<'a> {
     used_modules: HashSet<String>,
     systems: HashMap<&'a str, (Span, usize)>,
     used_systems: HashSet<String>,
+    /// The parameters of the lsystem being checked (for a better "unknown name").
+    lsystem_params: Vec<String>,
+    /// Unknown query names already reported in this lsystem.
+    reported_queries: HashSet<String>,
 }
 
 /// Checks a parsed file. `overrides` are the command line's `-D` values.
@@ -83,6 +87,8 @@ pub fn check(file: &File, overrides: &[Override]) -> Checked {
         used_modules: HashSet::new(),
         systems: HashMap::new(),
         used_systems: HashSet::new(),
+        lsystem_params: Vec::new(),
+        reported_queries: HashSet::new(),
     };
     c.declarations(file);
     c.constants(file, overrides);
@@ -124,7 +130,8 @@ impl<'a> Checker<'a> {
             match &item.node {
                 Item::Module(m) => {
                     if let Some(prev) = self.modules.get(m.name.name.as_str()) {
-                        self.diags.push(duplicate("module", &m.name.name, m.name.span, prev.span));
+                        self.diags
+                            .push(duplicate("module", &m.name.name, m.name.span, prev.span));
                         continue;
                     }
                     self.check_param_names(&m.params);
@@ -139,7 +146,8 @@ impl<'a> Checker<'a> {
                 }
                 Item::Element(e) => {
                     if let Some(prev) = self.modules.get(e.name.name.as_str()) {
-                        self.diags.push(duplicate("module", &e.name.name, e.name.span, prev.span));
+                        self.diags
+                            .push(duplicate("module", &e.name.name, e.name.span, prev.span));
                         continue;
                     }
                     self.modules.insert(
@@ -153,15 +161,18 @@ impl<'a> Checker<'a> {
                 }
                 Item::Lsystem(l) => {
                     if let Some((prev, _)) = self.systems.get(l.name.name.as_str()) {
-                        self.diags.push(duplicate("lsystem", &l.name.name, l.name.span, *prev));
+                        self.diags
+                            .push(duplicate("lsystem", &l.name.name, l.name.span, *prev));
                         continue;
                     }
                     self.check_param_names(&l.params);
-                    self.systems.insert(&l.name.name, (l.name.span, l.params.len()));
+                    self.systems
+                        .insert(&l.name.name, (l.name.span, l.params.len()));
                 }
                 Item::Scene(s) => {
                     if let Some((prev, _)) = self.systems.get(s.name.name.as_str()) {
-                        self.diags.push(duplicate("item", &s.name.name, s.name.span, *prev));
+                        self.diags
+                            .push(duplicate("item", &s.name.name, s.name.span, *prev));
                     }
                 }
                 Item::Const(_) | Item::Error => {}
@@ -171,8 +182,12 @@ impl<'a> Checker<'a> {
 
     fn check_param_names(&mut self, params: &[crate::ast::Ident]) {
         for (i, p) in params.iter().enumerate() {
-            if let Some(first) = params[..i].iter().find(|q| q.name == p.name && p.name != "_") {
-                self.diags.push(duplicate("parameter", &p.name, p.span, first.span));
+            if let Some(first) = params[..i]
+                .iter()
+                .find(|q| q.name == p.name && p.name != "_")
+            {
+                self.diags
+                    .push(duplicate("parameter", &p.name, p.span, first.span));
             }
         }
     }
@@ -182,7 +197,8 @@ impl<'a> Checker<'a> {
         for item in &file.items.stmts {
             let Item::Const(c) = &item.node else { continue };
             if let Some(prev) = self.consts.get(c.name.name.as_str()) {
-                self.diags.push(duplicate("constant", &c.name.name, c.name.span, prev.span));
+                self.diags
+                    .push(duplicate("constant", &c.name.name, c.name.span, prev.span));
                 continue;
             }
             order.push(&c.name.name);
@@ -210,7 +226,14 @@ impl<'a> Checker<'a> {
         let mut sorted: Vec<&'a str> = Vec::new();
         let mut in_cycle: HashSet<String> = HashSet::new();
         for &n in &order {
-            self.visit_const(n, &deps, &mut state, &mut Vec::new(), &mut sorted, &mut in_cycle);
+            self.visit_const(
+                n,
+                &deps,
+                &mut state,
+                &mut Vec::new(),
+                &mut sorted,
+                &mut in_cycle,
+            );
         }
         let overridden: HashMap<&str, &Override> =
             overrides.iter().map(|o| (o.name.as_str(), o)).collect();
@@ -240,7 +263,11 @@ impl<'a> Checker<'a> {
             } else {
                 self.expr(&decl.value, &Env::new())
             };
-            let mut value = if ty == Ty::Err { None } else { self.eval(&decl.value) };
+            let mut value = if ty == Ty::Err {
+                None
+            } else {
+                self.eval(&decl.value)
+            };
             if let Some(o) = overridden.get(n) {
                 match parse_value(&o.value) {
                     Some(v) => {
@@ -252,9 +279,15 @@ impl<'a> Checker<'a> {
                             self.diags.push(
                                 Diagnostic::error(
                                     Code::BadOverride,
-                                    format!("`-D {}={}` gives {} a value of the wrong kind", o.name, o.value, o.name),
+                                    format!(
+                                        "`-D {}={}` gives {} a value of the wrong kind",
+                                        o.name, o.value, o.name
+                                    ),
                                 )
-                                .secondary(decl.value.span, "the constant is defined here with a value of another kind"),
+                                .secondary(
+                                    decl.value.span,
+                                    "the constant is defined here with a value of another kind",
+                                ),
                             );
                         } else {
                             value = Some(v);
@@ -295,9 +328,28 @@ impl<'a> Checker<'a> {
                     return;
                 }
                 let first = self.consts[cycle[0]].span;
+                if cycle.len() == 1 {
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::ConstCycle,
+                            format!("constant `{}` is defined in terms of itself", cycle[0]),
+                        )
+                        .primary(first, "its value uses its own name")
+                        .help("give it a value that does not refer to itself"),
+                    );
+                    in_cycle.insert(cycle[0].to_string());
+                    return;
+                }
                 let mut d = Diagnostic::error(
                     Code::ConstCycle,
-                    format!("constant `{}` is defined in terms of itself", cycle[0]),
+                    format!(
+                        "constants {} are defined in terms of each other",
+                        cycle
+                            .iter()
+                            .map(|c| format!("`{c}`"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
                 )
                 .primary(first, "this constant depends on itself");
                 for c in &cycle[1..] {
@@ -318,7 +370,9 @@ impl<'a> Checker<'a> {
         }
         state.insert(n, 1);
         path.push(n);
-        let ds: Vec<String> = deps.get(n).map_or(Vec::new(), |v| v.iter().map(|(s, _)| s.clone()).collect());
+        let ds: Vec<String> = deps
+            .get(n)
+            .map_or(Vec::new(), |v| v.iter().map(|(s, _)| s.clone()).collect());
         for d in ds {
             if let Some((&key, _)) = self.consts.get_key_value(d.as_str()) {
                 self.visit_const(key, deps, state, path, sorted, in_cycle);
@@ -330,10 +384,20 @@ impl<'a> Checker<'a> {
     }
 
     fn unused(&mut self, file: &File) {
-        let has_scene = file.items.stmts.iter().any(|i| matches!(i.node, Item::Scene(_)));
+        let has_scene = file
+            .items
+            .stmts
+            .iter()
+            .any(|i| matches!(i.node, Item::Scene(_)));
         for item in &file.items.stmts {
             let (what, name, span) = match &item.node {
-                Item::Const(c) if !self.used_consts.contains(&c.name.name) => {
+                Item::Const(c)
+                    if !self.used_consts.contains(&c.name.name)
+                        && self
+                            .consts
+                            .get(c.name.name.as_str())
+                            .is_none_or(|i| i.ty != Ty::Err) =>
+                {
                     ("constant", &c.name.name, c.name.span)
                 }
                 Item::Module(m) if !self.used_modules.contains(&m.name.name) => {
@@ -350,7 +414,14 @@ impl<'a> Checker<'a> {
             self.diags.push(
                 Diagnostic::warning(Code::Unused, format!("{what} `{name}` is never used"))
                     .primary(span, "declared here")
-                    .help(format!("remove it, or use it in a rule{}", if what == "lsystem" { " or a guide's `system`" } else { "" })),
+                    .help(format!(
+                        "remove it, or use it in a rule{}",
+                        if what == "lsystem" {
+                            " or a guide's `system`"
+                        } else {
+                            ""
+                        }
+                    )),
             );
         }
     }
@@ -374,6 +445,10 @@ fn parse_value(s: &str) -> Option<Value> {
     match s {
         "true" => Some(Value::Bool(true)),
         "false" => Some(Value::Bool(false)),
-        _ => s.parse::<f64>().ok().filter(|v| v.is_finite()).map(Value::Num),
+        _ => s
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .map(Value::Num),
     }
 }

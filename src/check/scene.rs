@@ -1,14 +1,19 @@
 //! Checks of `element` items (properties, SVG path data) and `scene` items
 //! (guides, polygons, systems, seeds, links).
 
-use super::expr::{plural, Env, Ty};
-use super::{duplicate, suggest, Checker};
+use super::expr::{Env, Ty, plural};
+use super::{Checker, duplicate, suggest};
 use crate::ast::{EdgeRef, Element, GuideStmt, LinkStmt, PropValue, Scene, SceneStmt};
 use crate::diagnostic::{Code, Diagnostic};
 use crate::span::Span;
 use std::collections::HashMap;
 
-const PROPS: &[(&str, bool)] = &[("path", true), ("fill", true), ("stroke", true), ("width", false)];
+const PROPS: &[(&str, bool)] = &[
+    ("path", true),
+    ("fill", true),
+    ("stroke", true),
+    ("width", false),
+];
 
 impl<'a> Checker<'a> {
     pub(super) fn element(&mut self, e: &'a Element) {
@@ -24,7 +29,13 @@ impl<'a> Checker<'a> {
                     format!("elements have no property `{key}`"),
                 )
                 .primary(p.node.key.span, "unknown property");
-                if let Some(s) = suggest(key, PROPS.iter().map(|(k, _)| *k)) {
+                let synonym = match key {
+                    "color" | "colour" => Some("fill"),
+                    "d" | "data" => Some("path"),
+                    "stroke_width" | "thickness" => Some("width"),
+                    _ => None,
+                };
+                if let Some(s) = synonym.or_else(|| suggest(key, PROPS.iter().map(|(k, _)| *k))) {
                     d = d.help(format!("did you mean `{s}`?"));
                 } else {
                     d = d.note("the properties are path, fill, stroke and width");
@@ -36,7 +47,8 @@ impl<'a> Checker<'a> {
                 self.diags.push(
                     Diagnostic::error(Code::DuplicateSetting, format!("`{key}` is given twice"))
                         .primary(p.node.key.span, "given again here")
-                        .secondary(*first, "first given here"),
+                        .secondary(*first, "first given here")
+                        .help("keep one of them"),
                 );
                 continue;
             }
@@ -55,13 +67,13 @@ impl<'a> Checker<'a> {
                     }
                 },
                 (PropValue::Expr(x), false) => {
-                    if let Some(v) = self.const_num(x, "the width") {
-                        if v < 0.0 {
-                            self.diags.push(
-                                Diagnostic::error(Code::OutOfRange, "a width must be zero or positive")
-                                    .primary(x.span, format!("this is {v}")),
-                            );
-                        }
+                    if let Some(v) = self.const_num(x, "the width")
+                        && v < 0.0
+                    {
+                        self.diags.push(
+                            Diagnostic::error(Code::OutOfRange, "a width must be zero or positive")
+                                .primary(x.span, format!("this is {v}")),
+                        );
                     }
                 }
                 (PropValue::Expr(x), true) => self.diags.push(
@@ -78,9 +90,12 @@ impl<'a> Checker<'a> {
         }
         if !seen.contains_key("path") {
             self.diags.push(
-                Diagnostic::error(Code::MissingPath, format!("element `{}` has no path", e.name.name))
-                    .primary(e.name.span, "an element draws SVG path data")
-                    .help("add `path \"M0 0 L0 10\";` (local frame: base at the origin, pointing +y)"),
+                Diagnostic::error(
+                    Code::MissingPath,
+                    format!("element `{}` has no path", e.name.name),
+                )
+                .primary(e.name.span, "an element draws SVG path data")
+                .help("add `path \"M0 0 L0 10\";` (local frame: base at the origin, pointing +y)"),
             );
         }
     }
@@ -91,9 +106,24 @@ impl<'a> Checker<'a> {
             match seg {
                 Ok(_) => count += 1,
                 Err(e) => {
+                    // svgtypes counts characters from 1; the string starts after its quote.
+                    let at = match &e {
+                        svgtypes::Error::UnexpectedData(p)
+                        | svgtypes::Error::InvalidNumber(p)
+                        | svgtypes::Error::InvalidChar(_, p)
+                        | svgtypes::Error::InvalidString(_, p) => Some(*p),
+                        _ => None,
+                    };
+                    let place = at
+                        .and_then(|p| s.char_indices().nth(p.saturating_sub(1)))
+                        .filter(|_| !s.contains('\\'))
+                        .map_or(span, |(b, c)| {
+                            let start = span.start as usize + 1 + b;
+                            Span::new(start, start + c.len_utf8())
+                        });
                     self.diags.push(
                         Diagnostic::error(Code::InvalidPath, "invalid SVG path data")
-                            .primary(span, e.to_string())
+                            .primary(place, e.to_string())
                             .help("path data is SVG's `d` attribute: commands M L H V C S Q T A Z with numbers"),
                     );
                     return;
@@ -113,9 +143,12 @@ impl<'a> Checker<'a> {
         // Guides first, so links may refer to guides declared after them.
         let mut guides: HashMap<&str, (Span, Option<usize>)> = HashMap::new();
         for st in &s.body.stmts {
-            let SceneStmt::Guide(g) = &st.node else { continue };
+            let SceneStmt::Guide(g) = &st.node else {
+                continue;
+            };
             if let Some((first, _)) = guides.get(g.name.name.as_str()) {
-                self.diags.push(duplicate("guide", &g.name.name, g.name.span, *first));
+                self.diags
+                    .push(duplicate("guide", &g.name.name, g.name.span, *first));
                 continue;
             }
             let mut polygon: Option<(Span, usize)> = None;
@@ -159,7 +192,8 @@ impl<'a> Checker<'a> {
                                     format!("there is no lsystem `{}`", name.name),
                                 )
                                 .primary(name.span, "not defined in this file");
-                                if let Some(sg) = suggest(&name.name, self.systems.keys().copied()) {
+                                if let Some(sg) = suggest(&name.name, self.systems.keys().copied())
+                                {
                                     d = d.help(format!("did you mean `{sg}`?"));
                                 }
                                 self.diags.push(d);
@@ -173,7 +207,9 @@ impl<'a> Checker<'a> {
             }
             // Seeds, now that the system's parameters are known.
             for gs in &g.body.stmts {
-                let GuideStmt::Seed(seed) = &gs.node else { continue };
+                let GuideStmt::Seed(seed) = &gs.node else {
+                    continue;
+                };
                 self.const_num(&seed.at.x, "a seed coordinate");
                 self.const_num(&seed.at.y, "a seed coordinate");
                 if let Some(h) = &seed.heading {
@@ -183,9 +219,10 @@ impl<'a> Checker<'a> {
                 for a in seed.args.iter().flatten() {
                     self.expect(a, &Env::new(), Ty::Num);
                 }
-                if let Some((sys_span, Some(want))) = system {
-                    if given != want {
-                        self.diags.push(
+                if let Some((sys_span, Some(want))) = system
+                    && given != want
+                {
+                    self.diags.push(
                             Diagnostic::error(
                                 Code::SeedArguments,
                                 format!("this seed passes {given} value{}, but the guide's lsystem takes {want}", plural(given)),
@@ -198,7 +235,6 @@ impl<'a> Checker<'a> {
                                 format!("pass them with `with (…)`: {want} value{}", plural(want))
                             }),
                         );
-                    }
                 }
             }
             let mut missing = Vec::new();
@@ -218,10 +254,15 @@ impl<'a> Checker<'a> {
                     .help("a guide is a polygon hosting one lsystem: `polygon (0, 0) (10, 0) (10, 10); system Name;`"),
                 );
             }
-            guides.insert(&g.name.name, (g.name.span, polygon.map(|p| p.1)));
+            guides.insert(
+                &g.name.name,
+                (polygon.map_or(g.name.span, |p| p.0), polygon.map(|p| p.1)),
+            );
         }
         for st in &s.body.stmts {
-            let SceneStmt::Link(l) = &st.node else { continue };
+            let SceneStmt::Link(l) = &st.node else {
+                continue;
+            };
             self.edge_ref(&l.from, &guides);
             self.edge_ref(&l.to, &guides);
             let mut seen: HashMap<&str, Span> = HashMap::new();
@@ -278,7 +319,11 @@ impl<'a> Checker<'a> {
             self.diags.push(
                 Diagnostic::error(
                     Code::EdgeOutOfRange,
-                    format!("guide `{}` has {n} edges, numbered 0 to {}", r.guide.name, n.saturating_sub(1)),
+                    format!(
+                        "guide `{}` has {n} edges, numbered 0 to {}",
+                        r.guide.name,
+                        n.saturating_sub(1)
+                    ),
                 )
                 .primary(r.index.span, format!("edge {i} does not exist"))
                 .secondary(gspan, format!("its polygon has {n} vertices"))

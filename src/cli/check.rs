@@ -1,6 +1,6 @@
 //! `lsyc check FILE`: diagnostics only.
 
-use super::{summary, Reporter};
+use super::{Reporter, summary};
 use lsyc::check::Override;
 use lsyc::diagnostic::{Code, Diagnostic};
 use lsyc::{frontend, source};
@@ -23,7 +23,8 @@ pub fn overrides(define: &[String]) -> Result<Vec<Override>, Diagnostic> {
         .iter()
         .map(|d| {
             Override::parse(d).map_err(|msg| {
-                Diagnostic::error(Code::BadOverride, msg).help("write it as -D NAME=VALUE, e.g. -D depth=7")
+                Diagnostic::error(Code::BadOverride, msg)
+                    .help("write it as -D NAME=VALUE, e.g. -D depth=7")
             })
         })
         .collect()

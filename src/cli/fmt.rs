@@ -36,7 +36,10 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         diags.extend(parsed.diagnostics);
         if diags.iter().any(|d| d.is_error()) {
             reporter.emit(&diags, &src.name, &src.text);
-            reporter.say(&format!("{}: not formatted, it has syntax errors", src.name));
+            reporter.say(&format!(
+                "{}: not formatted, it has syntax errors",
+                src.name
+            ));
             status = 1;
             continue;
         }

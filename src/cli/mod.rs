@@ -51,10 +51,14 @@ pub enum ErrorFormat {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Check a program and report every problem found (nothing is run).
-    #[command(after_help = "Examples:\n  lsyc check plant.lsy\n  lsyc check plant.lsy -D angle=25\n  lsyc check plant.lsy --error-format json")]
+    #[command(
+        after_help = "Examples:\n  lsyc check plant.lsy\n  lsyc check plant.lsy -D angle=25\n  lsyc check plant.lsy --error-format json"
+    )]
     Check(check::Args),
     /// Print a program in canonical form (comments kept).
-    #[command(after_help = "Examples:\n  lsyc fmt plant.lsy > tidy.lsy\n  lsyc fmt --write plant.lsy\n  lsyc fmt --check lang-examples/*.lsy")]
+    #[command(
+        after_help = "Examples:\n  lsyc fmt plant.lsy > tidy.lsy\n  lsyc fmt --write plant.lsy\n  lsyc fmt --check lang-examples/*.lsy"
+    )]
     Fmt(fmt::Args),
 }
 

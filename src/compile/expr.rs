@@ -104,7 +104,8 @@ impl<'a> ExprCompiler<'a> {
                     let decided = if is_and { v == 0.0 } else { v != 0.0 };
                     self.truncate(start);
                     if decided {
-                        self.chunk.push(Op::Const(f64::from(u8::from(!is_and))), e.span);
+                        self.chunk
+                            .push(Op::Const(f64::from(u8::from(!is_and))), e.span);
                     } else {
                         self.expr(b);
                         self.emit_folded(Op::Truth, 1, e.span);
@@ -116,7 +117,11 @@ impl<'a> ExprCompiler<'a> {
                 self.expr(b);
                 self.chunk.push(Op::Truth, b.span);
                 let end = self.chunk.len();
-                self.chunk.code[jump as usize] = if is_and { Op::AndJump(end) } else { Op::OrJump(end) };
+                self.chunk.code[jump as usize] = if is_and {
+                    Op::AndJump(end)
+                } else {
+                    Op::OrJump(end)
+                };
             }
             ExprKind::Binary(op, a, b) => {
                 self.expr(a);
@@ -154,7 +159,10 @@ impl<'a> ExprCompiler<'a> {
                         self.chunk.push(Op::Normal, span);
                     }
                     name => {
-                        let idx = builtins::BUILTINS.iter().position(|b| b.name == name).unwrap_or(0);
+                        let idx = builtins::BUILTINS
+                            .iter()
+                            .position(|b| b.name == name)
+                            .unwrap_or(0);
                         self.emit_folded(Op::Call(idx as u8), args.len(), span);
                     }
                 }
@@ -173,7 +181,9 @@ impl<'a> ExprCompiler<'a> {
     fn emit_folded(&mut self, op: Op, inputs: usize, span: Span) {
         let n = self.chunk.code.len();
         if n >= inputs
-            && self.chunk.code[n - inputs..].iter().all(|o| matches!(o, Op::Const(_)))
+            && self.chunk.code[n - inputs..]
+                .iter()
+                .all(|o| matches!(o, Op::Const(_)))
         {
             let start = (n - inputs) as u32;
             let at = self.chunk.push(op, span);

@@ -161,10 +161,17 @@ pub fn compile(file: &File, checked: &Checked, name: Option<&str>) -> Result<Pro
         })
         .collect();
     let ls = match name {
-        Some(n) => systems.iter().find(|l| l.name.name == n).copied().ok_or_else(|| {
-            let names: Vec<&str> = systems.iter().map(|l| l.name.name.as_str()).collect();
-            format!("there is no lsystem `{n}`; the file has: {}", names.join(", "))
-        })?,
+        Some(n) => systems
+            .iter()
+            .find(|l| l.name.name == n)
+            .copied()
+            .ok_or_else(|| {
+                let names: Vec<&str> = systems.iter().map(|l| l.name.name.as_str()).collect();
+                format!(
+                    "there is no lsystem `{n}`; the file has: {}",
+                    names.join(", ")
+                )
+            })?,
         None => *systems.first().ok_or("the file has no lsystem to run")?,
     };
     Compiler::new(file, checked).lsystem(ls)
@@ -228,7 +235,9 @@ impl<'a> Compiler<'a> {
                     match (&p.node.key.name[..], &p.node.value) {
                         ("path", crate::ast::PropValue::Str(s, _)) => def.path = s.clone(),
                         ("fill", crate::ast::PropValue::Str(s, _)) => def.fill = Some(s.clone()),
-                        ("stroke", crate::ast::PropValue::Str(s, _)) => def.stroke = Some(s.clone()),
+                        ("stroke", crate::ast::PropValue::Str(s, _)) => {
+                            def.stroke = Some(s.clone())
+                        }
                         ("width", crate::ast::PropValue::Expr(x)) => {
                             def.width = ExprCompiler::fold_const(x, checked)
                         }
@@ -256,7 +265,8 @@ impl<'a> Compiler<'a> {
             ModName::Cut => ModName::Symbol('%'),
             n => n.clone(),
         };
-        let a = u8::try_from(arity).map_err(|_| format!("`{}` has more than 255 parameters", name.text()))?;
+        let a = u8::try_from(arity)
+            .map_err(|_| format!("`{}` has more than 255 parameters", name.text()))?;
         if let Some(&s) = self.symbols.map.get(&(name.clone(), a)) {
             return Ok(s);
         }
@@ -280,14 +290,16 @@ impl<'a> Compiler<'a> {
     /// Full arity of a module written in a successor or axiom (queries gain their outputs).
     fn written_arity(m: &Module) -> usize {
         match &m.name {
-            ModName::Query(q) => {
-                crate::query::lookup(q).map_or(0, |q| q.outputs.len()) + m.arity()
-            }
+            ModName::Query(q) => crate::query::lookup(q).map_or(0, |q| q.outputs.len()) + m.arity(),
             _ => m.arity(),
         }
     }
 
-    fn emit_list(&mut self, ms: &[Module], env: &HashMap<String, u16>) -> Result<Vec<Emit>, String> {
+    fn emit_list(
+        &mut self,
+        ms: &[Module],
+        env: &HashMap<String, u16>,
+    ) -> Result<Vec<Emit>, String> {
         let mut out = Vec::with_capacity(ms.len());
         for m in ms {
             let sym = self.intern(&m.name, Self::written_arity(m))?;
@@ -297,11 +309,16 @@ impl<'a> Compiler<'a> {
                 for _ in 0..k {
                     let start = self.chunk.len();
                     self.chunk.push(Op::Const(0.0), m.span);
-                    args.push(Code { start, end: start + 1 });
+                    args.push(Code {
+                        start,
+                        end: start + 1,
+                    });
                 }
             }
             for a in m.args.iter().flatten() {
-                args.push(ExprCompiler::new(&mut self.chunk, self.file, self.checked, env).compile(a));
+                args.push(
+                    ExprCompiler::new(&mut self.chunk, self.file, self.checked, env).compile(a),
+                );
             }
             out.push(Emit { sym, args });
         }
@@ -314,10 +331,10 @@ impl<'a> Compiler<'a> {
         let mut bind = |m: &Module, env: &mut HashMap<String, u16>| -> u16 {
             let first = slot;
             for a in m.args.iter().flatten() {
-                if let crate::ast::ExprKind::Var(n) = &a.kind {
-                    if n != "_" {
-                        env.insert(n.clone(), slot);
-                    }
+                if let crate::ast::ExprKind::Var(n) = &a.kind
+                    && n != "_"
+                {
+                    env.insert(n.clone(), slot);
                 }
                 slot += 1;
             }
@@ -337,11 +354,17 @@ impl<'a> Compiler<'a> {
         let pred = self.intern(&r.pred.name, r.pred.arity())?;
         let mut lp = Vec::new();
         for (m, s) in left {
-            lp.push(Pattern { sym: self.intern(&m.name, m.arity())?, slot: s });
+            lp.push(Pattern {
+                sym: self.intern(&m.name, m.arity())?,
+                slot: s,
+            });
         }
         let mut rp = Vec::new();
         for (m, s) in right {
-            rp.push(Pattern { sym: self.intern(&m.name, m.arity())?, slot: s });
+            rp.push(Pattern {
+                sym: self.intern(&m.name, m.arity())?,
+                slot: s,
+            });
         }
         let cond = r
             .cond
@@ -362,7 +385,10 @@ impl<'a> Compiler<'a> {
                 group: 0,
                 succ,
                 slots: slot,
-                span: r.pred.span.to(r.succ.last().map_or(r.pred.span, |m| m.span)),
+                span: r
+                    .pred
+                    .span
+                    .to(r.succ.last().map_or(r.pred.span, |m| m.span)),
             },
         ))
     }
@@ -375,7 +401,9 @@ impl<'a> Compiler<'a> {
         let mut ignore_mods: Vec<&Module> = Vec::new();
         for s in &ls.body.stmts {
             match &s.node {
-                Stmt::Angle(e) => angle = ExprCompiler::fold_const(e, self.checked).unwrap_or(angle),
+                Stmt::Angle(e) => {
+                    angle = ExprCompiler::fold_const(e, self.checked).unwrap_or(angle)
+                }
                 Stmt::Step(e) => step = ExprCompiler::fold_const(e, self.checked).unwrap_or(step),
                 Stmt::Derive(e) => {
                     derive = ExprCompiler::fold_const(e, self.checked).map_or(derive, |v| v as u32)
@@ -422,7 +450,9 @@ impl<'a> Compiler<'a> {
         let mut ignore = vec![false; n];
         for m in ignore_mods {
             for (i, info) in self.symbols.info.iter().enumerate() {
-                if info.name == m.name || (m.name == ModName::Cut && info.name == ModName::Symbol('%')) {
+                if info.name == m.name
+                    || (m.name == ModName::Cut && info.name == ModName::Symbol('%'))
+                {
                     ignore[i] = true;
                 }
             }
@@ -463,7 +493,11 @@ impl<'a> Compiler<'a> {
 
 /// A D0L program: every symbol has no parameters, and every rule is
 /// unconditional, context-free and not stochastic (the first rule wins).
-fn d0l_table(symbols: &Symbols, rules: &[Vec<CompiledRule>], _chunk: &Chunk) -> Option<Vec<Vec<Sym>>> {
+fn d0l_table(
+    symbols: &Symbols,
+    rules: &[Vec<CompiledRule>],
+    _chunk: &Chunk,
+) -> Option<Vec<Vec<Sym>>> {
     if symbols.info.iter().any(|i| i.arity != 0) {
         return None;
     }
@@ -472,7 +506,11 @@ fn d0l_table(symbols: &Symbols, rules: &[Vec<CompiledRule>], _chunk: &Chunk) -> 
         match rs.first() {
             None => table.push(vec![s as Sym]),
             Some(r) => {
-                if r.cond.is_some() || r.weight.is_some() || !r.left.is_empty() || !r.right.is_empty() {
+                if r.cond.is_some()
+                    || r.weight.is_some()
+                    || !r.left.is_empty()
+                    || !r.right.is_empty()
+                {
                     return None;
                 }
                 table.push(r.succ.iter().map(|e| e.sym).collect());

@@ -59,9 +59,17 @@ impl Default for Limits {
 #[derive(Clone, Debug, PartialEq)]
 pub enum DeriveError {
     /// Step `step` would produce `modules` modules, over the limit.
-    TooManyModules { step: u32, modules: usize, limit: usize },
+    TooManyModules {
+        step: u32,
+        modules: usize,
+        limit: usize,
+    },
     /// Step `step` would need about `bytes` bytes, over the limit.
-    TooMuchMemory { step: u32, bytes: usize, limit: usize },
+    TooMuchMemory {
+        step: u32,
+        bytes: usize,
+        limit: usize,
+    },
     /// An expression failed while deriving step `step` (0: the axiom).
     Vm { step: u32, error: VmError },
 }
@@ -116,10 +124,19 @@ pub fn step(
         Some(table) => d0l_step(table, s, step, limits)?,
         None => parametric_step(prog, s, step, seed, limits)?,
     };
-    Ok(if prog.has_cut { apply_cut(prog, out) } else { out })
+    Ok(if prog.has_cut {
+        apply_cut(prog, out)
+    } else {
+        out
+    })
 }
 
-fn check_limits(step: u32, modules: usize, params: usize, limits: Limits) -> Result<(), DeriveError> {
+fn check_limits(
+    step: u32,
+    modules: usize,
+    params: usize,
+    limits: Limits,
+) -> Result<(), DeriveError> {
     if modules > limits.max_modules {
         return Err(DeriveError::TooManyModules {
             step,
@@ -127,7 +144,9 @@ fn check_limits(step: u32, modules: usize, params: usize, limits: Limits) -> Res
             limit: limits.max_modules,
         });
     }
-    let bytes = modules.saturating_mul(std::mem::size_of::<Sym>()).saturating_add(params.saturating_mul(8));
+    let bytes = modules
+        .saturating_mul(std::mem::size_of::<Sym>())
+        .saturating_add(params.saturating_mul(8));
     if bytes > limits.max_bytes {
         return Err(DeriveError::TooMuchMemory {
             step,
@@ -139,14 +158,22 @@ fn check_limits(step: u32, modules: usize, params: usize, limits: Limits) -> Res
 }
 
 /// D0L: every symbol has one fixed successor. Count, check, then fill in place.
-fn d0l_step(table: &[Vec<Sym>], s: &ModString, step: u32, limits: Limits) -> Result<ModString, DeriveError> {
+fn d0l_step(
+    table: &[Vec<Sym>],
+    s: &ModString,
+    step: u32,
+    limits: Limits,
+) -> Result<ModString, DeriveError> {
     let lens: Vec<usize> = table.iter().map(Vec::len).collect();
     let counts: Vec<usize> = s
         .syms
         .par_chunks(CHUNK)
         .map(|c| c.iter().map(|&x| lens[x as usize]).sum())
         .collect();
-    let total = counts.iter().try_fold(0usize, |a, &c| a.checked_add(c)).unwrap_or(usize::MAX);
+    let total = counts
+        .iter()
+        .try_fold(0usize, |a, &c| a.checked_add(c))
+        .unwrap_or(usize::MAX);
     check_limits(step, total, 0, limits)?;
     let mut out = vec![0 as Sym; total];
     let mut slices = Vec::with_capacity(counts.len());
@@ -255,7 +282,16 @@ fn parametric_step(
         .par_chunks(CHUNK)
         .enumerate()
         .map(|(ci, chunk)| {
-            rewrite_chunk(&view, ci * CHUNK, chunk, starts[ci], step, seed, limits, &produced)
+            rewrite_chunk(
+                &view,
+                ci * CHUNK,
+                chunk,
+                starts[ci],
+                step,
+                seed,
+                limits,
+                &produced,
+            )
         })
         .collect();
     let mut outs = Vec::with_capacity(parts.len());
@@ -309,14 +345,26 @@ fn rewrite_chunk(
         }
         let mut rng = Random::new(seed, step, i as u64);
         let vm = |error| DeriveError::Vm { step, error };
-        let chosen = choose(view, rules, i, params, &mut slots, &mut stack, &mut rng, &mut weights)
-            .map_err(vm)?;
+        let chosen = choose(
+            view,
+            rules,
+            i,
+            params,
+            &mut slots,
+            &mut stack,
+            &mut rng,
+            &mut weights,
+        )
+        .map_err(vm)?;
         match chosen {
             Some(r) => {
                 for e in &r.succ {
                     out.syms.push(e.sym);
                     for code in &e.args {
-                        let v = prog.chunk.eval(*code, &slots, &mut rng, &mut stack).map_err(vm)?;
+                        let v = prog
+                            .chunk
+                            .eval(*code, &slots, &mut rng, &mut stack)
+                            .map_err(vm)?;
                         out.params.push(v);
                     }
                 }
@@ -376,7 +424,7 @@ fn choose<'r>(
                 }
             }
             if sum > 0.0 {
-                let mut x = rng.next() * sum;
+                let mut x = rng.uniform() * sum;
                 let mut pick = weights[weights.len() - 1].0;
                 for &(idx, w) in weights.iter() {
                     if x < w {
@@ -426,7 +474,11 @@ fn holds(
 /// Erases, after each `cut`, the rest of its branch (up to the `]` that closes it).
 fn apply_cut(prog: &Program, s: ModString) -> ModString {
     let info = &prog.symbols.info;
-    if !s.syms.iter().any(|&x| info[x as usize].action == Action::Cut) {
+    if !s
+        .syms
+        .iter()
+        .any(|&x| info[x as usize].action == Action::Cut)
+    {
         return s;
     }
     let mut out = ModString {

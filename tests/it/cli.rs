@@ -32,16 +32,33 @@ fn check_bytes(name: &str, bytes: &[u8]) -> Run {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join(name);
     std::fs::write(&path, bytes).expect("write input");
-    let r = run(&["check", path.to_str().expect("utf-8 path"), "--color", "never"]);
-    assert!(!r.stderr.contains("panicked"), "{name}: lsyc panicked:\n{}", r.stderr);
+    let r = run(&[
+        "check",
+        path.to_str().expect("utf-8 path"),
+        "--color",
+        "never",
+    ]);
+    assert!(
+        !r.stderr.contains("panicked"),
+        "{name}: lsyc panicked:\n{}",
+        r.stderr
+    );
     r
 }
 
 /// An input error: exit 1, an error code, and the file named with line and column.
 fn assert_input_error(name: &str, r: &Run, code: &str) {
     assert_eq!(r.status, 1, "{name}: exit status\n{}", r.stderr);
-    assert!(r.stderr.contains(&format!("error[{code}]")), "{name}: expected {code}:\n{}", r.stderr);
-    assert!(r.stderr.contains(name), "{name}: the file is not named:\n{}", r.stderr);
+    assert!(
+        r.stderr.contains(&format!("error[{code}]")),
+        "{name}: expected {code}:\n{}",
+        r.stderr
+    );
+    assert!(
+        r.stderr.contains(name),
+        "{name}: the file is not named:\n{}",
+        r.stderr
+    );
 }
 
 #[test]
@@ -67,7 +84,10 @@ fn random_bytes() {
 
 #[test]
 fn invalid_utf8() {
-    let r = check_bytes("latin1.lsy", b"lsystem A {\n    axiom F;\n    // caf\xe9\n}\n");
+    let r = check_bytes(
+        "latin1.lsy",
+        b"lsystem A {\n    axiom F;\n    // caf\xe9\n}\n",
+    );
     assert_input_error("latin1.lsy", &r, "E0101");
     assert!(r.stderr.contains("latin1.lsy:3:"), "{}", r.stderr);
 }
@@ -114,7 +134,10 @@ fn a_one_megabyte_line() {
 
 #[test]
 fn unterminated_comment() {
-    let r = check_bytes("comment.lsy", b"lsystem A {\n    axiom F; /* never closed\n}\n");
+    let r = check_bytes(
+        "comment.lsy",
+        b"lsystem A {\n    axiom F; /* never closed\n}\n",
+    );
     assert_input_error("comment.lsy", &r, "E0104");
     assert!(r.stderr.contains("comment.lsy:2:14"), "{}", r.stderr);
 }
@@ -129,7 +152,11 @@ fn huge_number() {
 fn missing_file() {
     let r = run(&["check", "no/such/file.lsy"]);
     assert_eq!(r.status, 1);
-    assert!(r.stderr.contains("error[E0001]") && r.stderr.contains("no/such/file.lsy"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("error[E0001]") && r.stderr.contains("no/such/file.lsy"),
+        "{}",
+        r.stderr
+    );
     assert!(r.stderr.contains("no such file"), "{}", r.stderr);
 }
 
@@ -139,7 +166,11 @@ fn a_directory() {
     let p = dir.path().to_str().expect("utf-8");
     let r = run(&["check", p]);
     assert_eq!(r.status, 1);
-    assert!(r.stderr.contains("error[E0001]") && r.stderr.contains("is a directory"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("error[E0001]") && r.stderr.contains("is a directory"),
+        "{}",
+        r.stderr
+    );
 }
 
 #[test]
@@ -147,10 +178,15 @@ fn too_large_file() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("big.lsy");
     let f = std::fs::File::create(&path).expect("create");
-    f.set_len(lsyc::source::MAX_SOURCE_BYTES + 1).expect("sparse file");
+    f.set_len(lsyc::source::MAX_SOURCE_BYTES + 1)
+        .expect("sparse file");
     let r = run(&["check", path.to_str().expect("utf-8")]);
     assert_eq!(r.status, 1);
-    assert!(r.stderr.contains("error[E0002]") && r.stderr.contains("big.lsy"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("error[E0002]") && r.stderr.contains("big.lsy"),
+        "{}",
+        r.stderr
+    );
 }
 
 #[test]
@@ -167,9 +203,17 @@ fn usage_errors_exit_2() {
 fn help_has_examples() {
     let r = run(&["--help"]);
     assert_eq!(r.status, 0);
-    assert!(r.stdout.contains("Examples:") && r.stdout.contains("lsyc check"), "{}", r.stdout);
+    assert!(
+        r.stdout.contains("Examples:") && r.stdout.contains("lsyc check"),
+        "{}",
+        r.stdout
+    );
     let r = run(&["fmt", "--help"]);
-    assert!(r.stdout.contains("--write") && r.stdout.contains("Examples:"), "{}", r.stdout);
+    assert!(
+        r.stdout.contains("--write") && r.stdout.contains("Examples:"),
+        "{}",
+        r.stdout
+    );
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
@@ -181,23 +225,38 @@ fn write(dir: &Path, name: &str, text: &str) -> String {
 #[test]
 fn overrides_must_name_constants() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let f = write(dir.path(), "c.lsy", "const depth = 5;\nlsystem A {\n    derive depth;\n    axiom F;\n}\n");
+    let f = write(
+        dir.path(),
+        "c.lsy",
+        "const depth = 5;\nlsystem A {\n    derive depth;\n    axiom F;\n}\n",
+    );
     assert_eq!(run(&["check", &f, "-D", "depth=7"]).status, 0);
     let r = run(&["check", &f, "-D", "dept=7"]);
     assert_eq!(r.status, 1);
-    assert!(r.stderr.contains("E0506") && r.stderr.contains("did you mean `depth`"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("E0506") && r.stderr.contains("did you mean `depth`"),
+        "{}",
+        r.stderr
+    );
     let r = run(&["check", &f, "-D", "depth=seven"]);
     assert_eq!(r.status, 1);
     assert!(r.stderr.contains("E0506"), "{}", r.stderr);
     let r = run(&["check", &f, "-D", "depth=2.5"]);
-    assert_eq!(r.status, 1, "an override is checked like the constant: derive must be whole");
+    assert_eq!(
+        r.status, 1,
+        "an override is checked like the constant: derive must be whole"
+    );
     assert!(r.stderr.contains("E0505"), "{}", r.stderr);
 }
 
 #[test]
 fn json_diagnostics() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let f = write(dir.path(), "j.lsy", "lsystem A {\n    axiom F;\n    F -> G2;\n}\n");
+    let f = write(
+        dir.path(),
+        "j.lsy",
+        "lsystem A {\n    axiom F;\n    F -> G2;\n}\n",
+    );
     let r = run(&["check", &f, "--error-format", "json"]);
     assert_eq!(r.status, 1);
     let line = r.stderr.lines().next().expect("one diagnostic");
@@ -228,7 +287,11 @@ fn fmt_check_write_and_stdout() {
     let r = run(&["fmt", &f]);
     assert_eq!(r.status, 0, "{}", r.stderr);
     insta::assert_snapshot!("fmt_stdout", r.stdout);
-    assert_eq!(std::fs::read_to_string(&f).expect("read"), messy, "fmt without --write must not touch the file");
+    assert_eq!(
+        std::fs::read_to_string(&f).expect("read"),
+        messy,
+        "fmt without --write must not touch the file"
+    );
     assert_eq!(run(&["fmt", "--check", &f]).status, 1);
     assert_eq!(run(&["fmt", "--write", &f]).status, 0);
     assert_eq!(std::fs::read_to_string(&f).expect("read"), r.stdout);
@@ -237,7 +300,14 @@ fn fmt_check_write_and_stdout() {
     let bad = write(dir.path(), "bad.lsy", "lsystem A { axiom F F -> ; }\n");
     let r = run(&["fmt", "--write", &bad]);
     assert_eq!(r.status, 1);
-    assert_eq!(std::fs::read_to_string(&bad).expect("read"), "lsystem A { axiom F F -> ; }\n");
-    let leftovers: Vec<_> = std::fs::read_dir(dir.path()).expect("dir").flatten().filter(|e| e.file_name().to_string_lossy().contains(".tmp")).collect();
+    assert_eq!(
+        std::fs::read_to_string(&bad).expect("read"),
+        "lsystem A { axiom F F -> ; }\n"
+    );
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("dir")
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+        .collect();
     assert!(leftovers.is_empty(), "temporary files left behind");
 }

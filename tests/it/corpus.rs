@@ -11,8 +11,15 @@ fn check_spans(file: &File, len: u32, name: &str) {
     fn block<T>(b: &Block<T>, len: u32, name: &str, inner: &dyn Fn(&T)) {
         let mut last = 0;
         for Node { node, span, .. } in &b.stmts {
-            assert!(span.start <= span.end && span.end <= len, "{name}: span {span:?} outside the source");
-            assert!(span.start >= last, "{name}: statement at {} starts before its predecessor ends ({last})", span.start);
+            assert!(
+                span.start <= span.end && span.end <= len,
+                "{name}: span {span:?} outside the source"
+            );
+            assert!(
+                span.start >= last,
+                "{name}: statement at {} starts before its predecessor ends ({last})",
+                span.start
+            );
             last = span.end;
             inner(node);
         }
@@ -34,14 +41,28 @@ fn ast_snapshots() {
     let mut settings = insta::Settings::clone_current();
     settings.set_prepend_module_to_snapshot(false);
     settings.bind(|| {
-        insta::glob!("../..", "{lang-examples,tests/data/parse/ok}/*.lsy", |path| {
-            let text = read_text(path);
-            let parsed = parser::parse(&text);
-            let errors: Vec<_> = parsed.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
-            assert!(errors.is_empty(), "{} does not parse:\n{}", rel(path), render_plain(&errors, &rel(path), &text));
-            check_spans(&parsed.file, text.len() as u32, &rel(path));
-            insta::assert_snapshot!("ast", dump(&parsed.file, true));
-        });
+        insta::glob!(
+            "../..",
+            "{lang-examples,tests/data/parse/ok}/*.lsy",
+            |path| {
+                let text = read_text(path);
+                let parsed = parser::parse(&text);
+                let errors: Vec<_> = parsed
+                    .diagnostics
+                    .iter()
+                    .filter(|d| d.is_error())
+                    .cloned()
+                    .collect();
+                assert!(
+                    errors.is_empty(),
+                    "{} does not parse:\n{}",
+                    rel(path),
+                    render_plain(&errors, &rel(path), &text)
+                );
+                check_spans(&parsed.file, text.len() as u32, &rel(path));
+                insta::assert_snapshot!("ast", dump(&parsed.file, true));
+            }
+        );
     });
 }
 
@@ -59,9 +80,24 @@ fn formatter_round_trip_and_idempotence() {
         }
         let once = fmt::format_file(&parsed.file);
         let reparsed = parser::parse(&once);
-        let errs: Vec<_> = reparsed.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
-        assert!(errs.is_empty(), "{}: the formatted text does not parse:\n{}\n{once}", rel(&path), render_plain(&errs, "formatted", &once));
-        similar_asserts_eq(&dump(&parsed.file, false), &dump(&reparsed.file, false), &rel(&path), "AST changed by formatting");
+        let errs: Vec<_> = reparsed
+            .diagnostics
+            .iter()
+            .filter(|d| d.is_error())
+            .cloned()
+            .collect();
+        assert!(
+            errs.is_empty(),
+            "{}: the formatted text does not parse:\n{}\n{once}",
+            rel(&path),
+            render_plain(&errs, "formatted", &once)
+        );
+        similar_asserts_eq(
+            &dump(&parsed.file, false),
+            &dump(&reparsed.file, false),
+            &rel(&path),
+            "AST changed by formatting",
+        );
         let twice = fmt::format_file(&reparsed.file);
         similar_asserts_eq(&once, &twice, &rel(&path), "formatting is not idempotent");
         checked += 1;
@@ -71,9 +107,24 @@ fn formatter_round_trip_and_idempotence() {
 
 fn similar_asserts_eq(a: &str, b: &str, file: &str, what: &str) {
     if a != b {
-        let line = a.lines().zip(b.lines()).position(|(x, y)| x != y).unwrap_or(0);
-        let show = |s: &str| s.lines().skip(line.saturating_sub(2)).take(6).collect::<Vec<_>>().join("\n");
-        panic!("{file}: {what}; first difference at line {}:\n--- before\n{}\n--- after\n{}", line + 1, show(a), show(b));
+        let line = a
+            .lines()
+            .zip(b.lines())
+            .position(|(x, y)| x != y)
+            .unwrap_or(0);
+        let show = |s: &str| {
+            s.lines()
+                .skip(line.saturating_sub(2))
+                .take(6)
+                .collect::<Vec<_>>()
+                .join("\n")
+        };
+        panic!(
+            "{file}: {what}; first difference at line {}:\n--- before\n{}\n--- after\n{}",
+            line + 1,
+            show(a),
+            show(b)
+        );
     }
 }
 
@@ -90,7 +141,10 @@ fn gallery_is_clean_and_canonical() {
             problems.push_str(&render_plain(&fe.diagnostics, &rel(&path), &text));
         }
         if !fe.has_errors() && fmt::format_file(&fe.file) != text {
-            problems.push_str(&format!("{}: not in canonical form (lsyc fmt --write it)\n", rel(&path)));
+            problems.push_str(&format!(
+                "{}: not in canonical form (lsyc fmt --write it)\n",
+                rel(&path)
+            ));
         }
     }
     assert!(problems.is_empty(), "{problems}");
@@ -102,6 +156,10 @@ fn clean_programs_have_no_diagnostics() {
     for path in lsy_files(&["tests/data/check/ok"]) {
         let text = read_text(&path);
         let fe = frontend::run(&text, Vec::new(), &[]);
-        assert!(fe.diagnostics.is_empty(), "{}", render_plain(&fe.diagnostics, &rel(&path), &text));
+        assert!(
+            fe.diagnostics.is_empty(),
+            "{}",
+            render_plain(&fe.diagnostics, &rel(&path), &text)
+        );
     }
 }

@@ -27,14 +27,20 @@ fn error_programs_produce_their_codes() {
             let text = read_text(path);
             let name = rel(path);
             let want = expected_codes(&text);
-            assert!(!want.is_empty(), "{name}: the first line must be `// expect: CODE…`");
+            assert!(
+                !want.is_empty(),
+                "{name}: the first line must be `// expect: CODE…`"
+            );
             let bytes = std::fs::read(path).unwrap_or_default();
             let src = lsyc::source::from_bytes(name.clone(), &bytes);
             let fe = frontend::run(&src.text, src.diagnostics, &[]);
             let got: BTreeSet<&str> = fe.diagnostics.iter().map(|d| d.code.as_str()).collect();
             let rendered = render_plain(&fe.diagnostics, &name, &src.text);
             for w in &want {
-                assert!(got.contains(w.as_str()), "{name}: expected {w}, got {got:?}\n{rendered}");
+                assert!(
+                    got.contains(w.as_str()),
+                    "{name}: expected {w}, got {got:?}\n{rendered}"
+                );
             }
             insta::assert_snapshot!("diagnostics", rendered);
         });
@@ -52,5 +58,8 @@ fn every_code_has_an_error_program() {
         .filter(|c| !CLI_ONLY.contains(c) && !covered.contains(c.as_str()))
         .map(|c| c.as_str())
         .collect();
-    assert!(missing.is_empty(), "codes without a program in tests/data/check/err: {missing:?}");
+    assert!(
+        missing.is_empty(),
+        "codes without a program in tests/data/check/err: {missing:?}"
+    );
 }
