@@ -20,4 +20,5 @@ pub mod resolve;
 pub mod source;
 pub mod span;
 pub mod trivia;
+pub mod turtle;
 pub mod vm;

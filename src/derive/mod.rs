@@ -70,8 +70,11 @@ pub enum DeriveError {
         bytes: usize,
         limit: usize,
     },
-    /// An expression failed while deriving step `step` (0: the axiom).
+    /// An expression failed while deriving step `step` (0: the axiom;
+    /// `u32::MAX`: while interpreting).
     Vm { step: u32, error: VmError },
+    /// Interpretation rules expanded into each other `depth` times.
+    InterpretTooDeep { module: String, depth: usize },
 }
 
 /// Evaluates the axiom with the lsystem's parameters.

@@ -1,0 +1,316 @@
+//! The turtle: a derived module string to geometry, sent to a `Sink`.
+//!
+//! Owns: the turtle conventions of the contract (start at the origin heading +y;
+//! `+` turns left, counter-clockwise seen from +z; `&` pitches H toward −U; `\`
+//! rolls L toward U; `|` is 180° about U; `$` rolls L horizontal), scale `*`,
+//! width `!`, colour `'`, polygons `{ . }`, element printing, and interpretation
+//! (homomorphism) rules. Every rotation is right-handed about its axis
+//! (+ about U, & about L, \ about H), so 2D and 3D programs agree.
+//! Must not know output formats: it only calls the sink.
+
+use crate::compile::{Action, Program, Sym};
+use crate::derive::{DeriveError, ModString};
+use crate::vm::{Random, VmError};
+use glam::DVec3;
+
+/// How deep interpretation rules may expand into each other.
+pub const MAX_INTERPRET_DEPTH: usize = 64;
+
+/// Where the geometry goes.
+pub trait Sink {
+    /// A drawn segment from `a` to `b`. `width` 0 is a hairline.
+    fn segment(&mut self, a: DVec3, b: DVec3, width: f64, color: u32);
+    /// A filled polygon.
+    fn polygon(&mut self, points: &[DVec3], color: u32);
+    /// Element `index` printed at `at`, its local +y along `h`, its local −x along
+    /// `l` (so local +x is −l), scaled by `scale`.
+    fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32);
+}
+
+/// The turtle's state, saved by `[` and restored by `]`.
+#[derive(Clone, Copy, Debug)]
+pub struct State {
+    pub pos: DVec3,
+    pub h: DVec3,
+    pub l: DVec3,
+    pub u: DVec3,
+    pub scale: f64,
+    pub width: f64,
+    pub color: u32,
+}
+
+impl Default for State {
+    fn default() -> State {
+        State {
+            pos: DVec3::ZERO,
+            h: DVec3::Y,
+            l: DVec3::NEG_X,
+            u: DVec3::Z,
+            scale: 1.0,
+            width: 0.0,
+            color: 0,
+        }
+    }
+}
+
+/// Rotates `a` toward `b` by `deg` degrees in their plane (a, b orthonormal).
+fn turn(a: DVec3, b: DVec3, deg: f64) -> (DVec3, DVec3) {
+    let (s, c) = deg.to_radians().sin_cos();
+    (a * c + b * s, b * c - a * s)
+}
+
+impl State {
+    fn apply(&mut self, action: Action, arg: Option<f64>, angle: f64, step: f64) {
+        let a = arg.unwrap_or(angle);
+        match action {
+            // Right-handed about U: H toward L (counter-clockwise seen from +z).
+            Action::TurnLeft => (self.h, self.l) = turn(self.h, self.l, a),
+            Action::TurnRight => (self.h, self.l) = turn(self.h, self.l, -a),
+            // Right-handed about L: H toward −U.
+            Action::PitchDown => (self.h, self.u) = turn(self.h, self.u, -a),
+            Action::PitchUp => (self.h, self.u) = turn(self.h, self.u, a),
+            // Right-handed about H: L toward U.
+            Action::RollLeft => (self.l, self.u) = turn(self.l, self.u, a),
+            Action::RollRight => (self.l, self.u) = turn(self.l, self.u, -a),
+            Action::TurnAround => {
+                self.h = -self.h;
+                self.l = -self.l;
+            }
+            Action::RollHorizontal => {
+                // L perpendicular to "up" (+y, against gravity) and to H.
+                let l = DVec3::Y.cross(self.h);
+                if l.length_squared() > 1e-18 {
+                    self.l = l.normalize();
+                    self.u = self.h.cross(self.l);
+                }
+            }
+            Action::Scale => self.scale *= arg.unwrap_or(1.0),
+            Action::Width => {
+                self.width = match arg {
+                    Some(w) => w.max(0.0),
+                    None => self.width * 0.7,
+                }
+            }
+            Action::Color => {
+                self.color = match arg {
+                    Some(c) => c.max(0.0) as u32,
+                    None => self.color + 1,
+                }
+            }
+            Action::Draw | Action::Move => {
+                self.pos += self.h * (arg.unwrap_or(step) * self.scale);
+            }
+            _ => {}
+        }
+    }
+}
+
+/// What was drawn.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Drawn {
+    pub segments: u64,
+    pub elements: u64,
+    pub polygons: u64,
+    /// [min x, min y, max x, max y] of drawn geometry (segments, polygon points,
+    /// element origins); `None` when nothing was drawn.
+    pub bbox: Option<[f64; 4]>,
+}
+
+impl Drawn {
+    fn grow(&mut self, p: DVec3) {
+        let b = self.bbox.get_or_insert([p.x, p.y, p.x, p.y]);
+        b[0] = b[0].min(p.x);
+        b[1] = b[1].min(p.y);
+        b[2] = b[2].max(p.x);
+        b[3] = b[3].max(p.y);
+    }
+}
+
+/// Interprets a derived string. Interpretation rules are applied as the turtle
+/// meets their modules (random choices keyed by `seed` and position).
+pub fn interpret(
+    prog: &Program,
+    s: &ModString,
+    seed: u64,
+    sink: &mut dyn Sink,
+) -> Result<Drawn, DeriveError> {
+    let mut t = Turtle {
+        prog,
+        sink,
+        state: State::default(),
+        stack: Vec::new(),
+        polygons: Vec::new(),
+        drawn: Drawn::default(),
+        seed,
+        stack_vm: Vec::new(),
+    };
+    let has_interp = prog.interpret.iter().any(|r| !r.is_empty());
+    let mut p = 0usize;
+    for (i, &sym) in s.syms.iter().enumerate() {
+        let n = prog.symbols.arity(sym);
+        let params = &s.params[p..p + n];
+        p += n;
+        if has_interp && !prog.interpret[sym as usize].is_empty() {
+            t.expand(sym, params, i as u64, 0)?;
+        } else {
+            t.module(sym, params);
+        }
+    }
+    Ok(t.drawn)
+}
+
+struct Turtle<'a> {
+    prog: &'a Program,
+    sink: &'a mut dyn Sink,
+    state: State,
+    stack: Vec<State>,
+    polygons: Vec<Vec<DVec3>>,
+    drawn: Drawn,
+    seed: u64,
+    stack_vm: Vec<f64>,
+}
+
+impl Turtle<'_> {
+    /// Applies the first matching interpretation rule of `sym` and interprets its
+    /// successor in place of the module.
+    fn expand(&mut self, sym: Sym, params: &[f64], position: u64, depth: usize) -> Result<(), DeriveError> {
+        if depth >= MAX_INTERPRET_DEPTH {
+            return Err(DeriveError::InterpretTooDeep {
+                module: self.prog.symbols.info[sym as usize].name.text().into_owned(),
+                depth,
+            });
+        }
+        let prog = self.prog;
+        let vm = |error: VmError| DeriveError::Vm { step: u32::MAX, error };
+        let mut rng = Random::new(self.seed ^ 0x1e7e_3b1d, u32::MAX - depth as u32, position);
+        let mut chosen = None;
+        let rules = &prog.interpret[sym as usize];
+        let mut k = 0;
+        // Interpretation rules have no context: conditions and weights only.
+        while k < rules.len() && chosen.is_none() {
+            let group = rules[k].group;
+            let end = k + rules[k..].iter().take_while(|r| r.group == group).count();
+            let mut cands: Vec<(usize, f64)> = Vec::new();
+            for (idx, r) in rules[k..end].iter().enumerate() {
+                let ok = match r.cond {
+                    Some(c) => prog.chunk.eval(c, params, &mut rng, &mut self.stack_vm).map_err(vm)? != 0.0,
+                    None => true,
+                };
+                if !ok {
+                    continue;
+                }
+                let w = match r.weight {
+                    Some(c) => prog.chunk.eval(c, params, &mut rng, &mut self.stack_vm).map_err(vm)?,
+                    None => 1.0,
+                };
+                if r.weight.is_none() {
+                    cands.push((k + idx, 1.0));
+                    break;
+                }
+                if w > 0.0 {
+                    cands.push((k + idx, w));
+                }
+            }
+            let sum: f64 = cands.iter().map(|c| c.1).sum();
+            if sum > 0.0 {
+                let mut x = rng.uniform() * sum;
+                let mut pick = cands[cands.len() - 1].0;
+                for &(idx, w) in &cands {
+                    if x < w {
+                        pick = idx;
+                        break;
+                    }
+                    x -= w;
+                }
+                chosen = Some(&rules[pick]);
+            }
+            k = end;
+        }
+        let Some(rule) = chosen else {
+            self.module(sym, params);
+            return Ok(());
+        };
+        for e in &rule.succ {
+            let mut args = Vec::with_capacity(e.args.len());
+            for code in &e.args {
+                args.push(prog.chunk.eval(*code, params, &mut rng, &mut self.stack_vm).map_err(vm)?);
+            }
+            if prog.interpret[e.sym as usize].is_empty() {
+                self.module(e.sym, &args);
+            } else {
+                self.expand(e.sym, &args, position, depth + 1)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn module(&mut self, sym: Sym, params: &[f64]) {
+        let prog = self.prog;
+        let action = prog.symbols.info[sym as usize].action;
+        let arg = params.first().copied();
+        match action {
+            Action::Draw | Action::Move => {
+                let from = self.state.pos;
+                self.state.apply(action, arg, prog.angle, prog.step);
+                let to = self.state.pos;
+                if let Some(poly) = self.polygons.last_mut() {
+                    if poly.is_empty() {
+                        poly.push(from);
+                    }
+                    poly.push(to);
+                } else if action == Action::Draw {
+                    self.drawn.segments += 1;
+                    self.drawn.grow(from);
+                    self.drawn.grow(to);
+                    self.sink.segment(from, to, self.state.width, self.state.color);
+                }
+            }
+            Action::Push => self.stack.push(self.state),
+            Action::Pop => {
+                if let Some(s) = self.stack.pop() {
+                    self.state = s;
+                }
+            }
+            Action::PolygonStart => self.polygons.push(Vec::new()),
+            Action::Vertex => {
+                let p = self.state.pos;
+                if let Some(poly) = self.polygons.last_mut() {
+                    if poly.last() != Some(&p) {
+                        poly.push(p);
+                    }
+                }
+            }
+            Action::PolygonEnd => {
+                if let Some(mut poly) = self.polygons.pop() {
+                    if poly.len() > 1 && poly.first() == poly.last() {
+                        poly.pop();
+                    }
+                    if poly.len() >= 3 {
+                        self.drawn.polygons += 1;
+                        for &p in &poly {
+                            self.drawn.grow(p);
+                        }
+                        self.sink.polygon(&poly, self.state.color);
+                    }
+                }
+            }
+            Action::Element(i) => {
+                self.drawn.elements += 1;
+                self.drawn.grow(self.state.pos);
+                let st = self.state;
+                self.sink.element(i, st.pos, st.h, st.l, st.scale, st.color);
+            }
+            Action::None | Action::Cut => {}
+            other => self.state.apply(other, arg, prog.angle, prog.step),
+        }
+    }
+}
+
+/// A sink that only counts (for `--stats` without output, and tests).
+pub struct Discard;
+
+impl Sink for Discard {
+    fn segment(&mut self, _: DVec3, _: DVec3, _: f64, _: u32) {}
+    fn polygon(&mut self, _: &[DVec3], _: u32) {}
+    fn element(&mut self, _: u16, _: DVec3, _: DVec3, _: DVec3, _: f64, _: u32) {}
+}
