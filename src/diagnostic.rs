@@ -44,6 +44,7 @@ macro_rules! codes {
 codes! {
     ReadFile = "E0001", "the input file cannot be read";
     FileTooLarge = "E0002", "the input file is too large";
+    WriteOutput = "E0003", "an output file that cannot be written";
     InvalidUtf8 = "E0101", "the source is not valid UTF-8";
     NulByte = "E0102", "the source contains a NUL byte";
     UnexpectedChar = "E0103", "a character that cannot start any token";
@@ -86,6 +87,11 @@ codes! {
     EdgeOutOfRange = "E0802", "an edge index beyond the polygon's edges";
     GuideIncomplete = "E0803", "a guide without a polygon or without a system";
     SeedArguments = "E0804", "a seed passing a different number of arguments than its lsystem takes";
+    DivisionByZero = "E0901", "a division by zero while running";
+    NotFinite = "E0902", "an expression whose value is not a finite number while running";
+    TooManyModules = "E0903", "a derivation step that would exceed the module limit";
+    TooMuchMemory = "E0904", "a derivation step that would exceed the memory limit";
+    InterpretTooDeep = "E0905", "interpretation rules that expand into each other too deeply";
     Unused = "W0101", "a declaration that nothing uses";
     UnusedParameter = "W0102", "a rule parameter that nothing uses";
     NeverProduced = "W0201", "a rule whose predecessor never appears";

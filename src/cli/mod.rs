@@ -5,6 +5,7 @@
 
 mod check;
 mod fmt;
+mod run;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use lsyc::diagnostic::{self, Diagnostic, Format};
@@ -13,6 +14,8 @@ use std::process::ExitCode;
 
 const EXAMPLES: &str = "\
 Examples:
+  lsyc run lang-examples/koch-island.lsy -o koch.svg
+  lsyc run lang-examples/plant-e.lsy -o plant.png --stats
   lsyc check lang-examples/koch-island.lsy
   lsyc check tree.lsy -D depth=9 --error-format json
   lsyc fmt tree.lsy                 # print the canonical form
@@ -52,9 +55,12 @@ pub enum ErrorFormat {
 pub enum Command {
     /// Check a program and report every problem found (nothing is run).
     #[command(
-        after_help = "Examples:\n  lsyc check plant.lsy\n  lsyc check plant.lsy -D angle=25\n  lsyc check plant.lsy --error-format json"
+        after_help = "Examples:\n  lsyc check plant.lsy\n  lsyc check plant.lsy -D delta=25\n  lsyc check plant.lsy --error-format json"
     )]
     Check(check::Args),
+    /// Derive and draw a program: SVG, PNG, OBJ or text by the output's extension.
+    #[command(after_help = "Examples:\n  lsyc run lang-examples/koch-island.lsy -o koch.svg\n  lsyc run lang-examples/plant-e.lsy -n 6 -o plant.png --size 800\n  lsyc run lang-examples/monopodial-tree.lsy -D r2=0.7 --stats\n  lsyc run lang-examples/hilbert-3d.lsy -o hilbert.obj\n  lsyc run lang-examples/stochastic-plant.lsy --seed 7 -o plant.svg")]
+    Run(run::Args),
     /// Print a program in canonical form (comments kept).
     #[command(
         after_help = "Examples:\n  lsyc fmt plant.lsy > tidy.lsy\n  lsyc fmt --write plant.lsy\n  lsyc fmt --check lang-examples/*.lsy"
@@ -122,6 +128,7 @@ pub fn main() -> ExitCode {
     let status = match &cli.command {
         Command::Check(args) => check::run(args, &reporter),
         Command::Fmt(args) => fmt::run(args, &reporter),
+        Command::Run(args) => run::run(args, &reporter),
     };
     ExitCode::from(status)
 }

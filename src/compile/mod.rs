@@ -126,6 +126,7 @@ pub struct ElementDef {
 #[derive(Clone, Debug)]
 pub struct Program {
     pub name: String,
+    pub name_span: Span,
     pub symbols: Symbols,
     pub chunk: Chunk,
     /// The axiom, evaluated once (it may use the lsystem's parameters).
@@ -472,6 +473,7 @@ impl<'a> Compiler<'a> {
         let d0l = d0l_table(&self.symbols, &by_sym, &self.chunk);
         Ok(Program {
             name: ls.name.name.clone(),
+            name_span: ls.name.span,
             symbols: self.symbols,
             chunk: self.chunk,
             axiom,
@@ -518,4 +520,58 @@ fn d0l_table(
         }
     }
     Some(table)
+}
+
+impl Program {
+    /// A listing of every compiled expression: the axiom's parameters, then each
+    /// rule's condition, weight and successor parameters, with source spans.
+    pub fn disassemble(&self) -> String {
+        use std::fmt::Write;
+        let mut out = String::new();
+        let name = |s: Sym| {
+            let i = &self.symbols.info[s as usize];
+            if i.arity == 0 {
+                i.name.text().into_owned()
+            } else {
+                format!("{}/{}", i.name.text(), i.arity)
+            }
+        };
+        let _ = writeln!(out, "lsystem {}: {} symbols, {} instructions", self.name, self.symbols.len(), self.chunk.len());
+        for (k, e) in self.axiom.iter().enumerate() {
+            for (a, code) in e.args.iter().enumerate() {
+                let _ = writeln!(out, "axiom module {k} {} parameter {a}:", name(e.sym));
+                self.chunk.disassemble(*code, &mut out);
+            }
+        }
+        for (kind, table) in [("rule", &self.rules), ("interpret", &self.interpret)] {
+            for (s, rules) in table.iter().enumerate() {
+                for (k, r) in rules.iter().enumerate() {
+                    let _ = writeln!(
+                        out,
+                        "{kind} {} #{k} (group {}, {} slots) @{}..{}",
+                        name(s as Sym),
+                        r.group,
+                        r.slots,
+                        r.span.start,
+                        r.span.end
+                    );
+                    if let Some(c) = r.cond {
+                        let _ = writeln!(out, "  condition:");
+                        self.chunk.disassemble(c, &mut out);
+                    }
+                    if let Some(w) = r.weight {
+                        let _ = writeln!(out, "  weight:");
+                        self.chunk.disassemble(w, &mut out);
+                    }
+                    for (m, e) in r.succ.iter().enumerate() {
+                        for (a, code) in e.args.iter().enumerate() {
+                            let _ = writeln!(out, "  successor {m} {} parameter {a}:", name(e.sym));
+                            self.chunk.disassemble(*code, &mut out);
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
 }

@@ -1,0 +1,249 @@
+//! `lsyc run FILE`: derive, draw, and write SVG, PNG, OBJ or text.
+
+use super::{Reporter, check::overrides};
+use lsyc::derive::Limits;
+use lsyc::diagnostic::{Code, Diagnostic};
+use lsyc::run::{self, Format, Options, OutputError, Picture, Stats};
+use lsyc::{frontend, source};
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The .lsy program to run.
+    pub file: PathBuf,
+
+    /// Derivation steps (default: the program's `derive`).
+    #[arg(short = 'n', long = "steps", value_name = "STEPS")]
+    pub steps: Option<u32>,
+
+    /// Output file; its extension picks the format: .svg .png .obj .txt
+    #[arg(short = 'o', long = "output", value_name = "OUT")]
+    pub output: Option<PathBuf>,
+
+    /// Print statistics as one JSON object on stdout.
+    #[arg(long)]
+    pub stats: bool,
+
+    /// Override a constant: -D NAME=VALUE (repeatable).
+    #[arg(short = 'D', value_name = "NAME=VALUE")]
+    pub define: Vec<String>,
+
+    /// Seed of the random choices (same seed, same output).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+
+    /// Which lsystem of the file to run (default: the first).
+    #[arg(long, value_name = "NAME")]
+    pub system: Option<String>,
+
+    /// PNG size in pixels (the longer side).
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=16384))]
+    pub size: u32,
+
+    /// PNG background: a colour name, #rrggbb, or `none` for transparent.
+    #[arg(long, default_value = "white")]
+    pub background: String,
+
+    /// Stop with an error before a step would hold more modules than this.
+    #[arg(long, default_value_t = Limits::default().max_modules)]
+    pub max_modules: usize,
+
+    /// Stop with an error before a step would need more memory than this (MiB).
+    #[arg(long, value_name = "MIB", default_value_t = Limits::default().max_bytes >> 20)]
+    pub max_memory: usize,
+
+    /// Worker threads for derivation (default: all cores). Output does not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+
+    /// Print the compiled bytecode of every rule and exit.
+    #[arg(long)]
+    pub disasm: bool,
+}
+
+pub fn run(args: &Args, reporter: &Reporter) -> u8 {
+    let ovr = match overrides(&args.define) {
+        Ok(o) => o,
+        Err(d) => {
+            reporter.emit(&[d], "<command line>", "");
+            return 2;
+        }
+    };
+    let format = match &args.output {
+        Some(p) => match Format::from_path(p) {
+            Some(f) => Some(f),
+            None => {
+                reporter.say(&format!(
+                    "error: cannot tell the output format of `{}`: use a file ending in .svg, .png, .obj or .txt",
+                    p.display()
+                ));
+                return 2;
+            }
+        },
+        None => None,
+    };
+    let background = if args.background == "none" {
+        [0, 0, 0, 0]
+    } else {
+        match lsyc::render::png::parse_color(&args.background) {
+            Some([r, g, b]) => [r, g, b, 255],
+            None => {
+                reporter.say(&format!("error: `{}` is not a colour", args.background));
+                return 2;
+            }
+        }
+    };
+    if let Some(n) = args.threads {
+        // Only the first call in a process can set the global pool; later calls are harmless.
+        let _ = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global();
+    }
+    let src = match source::read(&args.file) {
+        Ok(s) => s,
+        Err(d) => {
+            reporter.emit(&[d], &args.file.display().to_string(), "");
+            return 1;
+        }
+    };
+    if let Some(out) = &args.output {
+        if same_file(out, &args.file) {
+            reporter.say(&format!(
+                "error: the output `{}` is the input program; choose another file",
+                out.display()
+            ));
+            return 2;
+        }
+    }
+    let fe = frontend::run(&src.text, src.diagnostics, &ovr);
+    reporter.emit(&fe.diagnostics, &src.name, &src.text);
+    let Some(checked) = fe.checked.as_ref().filter(|_| !fe.has_errors()) else {
+        return 1;
+    };
+    let opts = Options {
+        steps: args.steps,
+        seed: args.seed,
+        limits: Limits {
+            max_modules: args.max_modules,
+            max_bytes: args.max_memory.saturating_mul(1 << 20),
+        },
+        system: args.system.clone(),
+    };
+    if args.disasm {
+        return match lsyc::compile::compile(&fe.file, checked, opts.system.as_deref()) {
+            Ok(p) => {
+                print!("{}", p.disassemble());
+                0
+            }
+            Err(m) => {
+                reporter.emit(&[Diagnostic::error(Code::UnknownSystem, m)], &src.name, &src.text);
+                1
+            }
+        };
+    }
+    let steps_hint = args.steps;
+    let bar = progress_bar(steps_hint);
+    let on_step = |step: u32, modules: usize| {
+        if let Some(b) = &bar {
+            b.set_position(step as u64);
+            b.set_message(format!("{modules} modules"));
+        }
+    };
+    let derived = run::derive(&fe.file, checked, &opts, &on_step);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let derived = match derived {
+        Ok(d) => d,
+        Err(d) => {
+            reporter.emit(&[d], &src.name, &src.text);
+            return 1;
+        }
+    };
+    let start = Instant::now();
+    let drawn = match (format, &args.output) {
+        (Some(format), Some(path)) => {
+            let picture = Picture {
+                size: args.size,
+                background,
+            };
+            let mut drawn = None;
+            let written = source::write_atomic_with(path, |w| {
+                match run::write_output(&derived, format, picture, args.seed, w) {
+                    Ok(d) => {
+                        drawn = Some(d);
+                        Ok(())
+                    }
+                    Err(OutputError::Io(e)) => Err(e),
+                    Err(OutputError::Diagnostic(d)) => {
+                        reporter.emit(&[d], &src.name, &src.text);
+                        Err(std::io::Error::other("stopped by an error"))
+                    }
+                }
+            });
+            match (written, drawn) {
+                (Ok(()), Some(d)) => d,
+                (Err(e), None) if e.to_string() == "stopped by an error" => return 1,
+                (Err(e), _) => {
+                    reporter.emit(
+                        &[Diagnostic::error(
+                            Code::WriteOutput,
+                            format!("cannot write `{}`: {e}", path.display()),
+                        )],
+                        &src.name,
+                        &src.text,
+                    );
+                    return 1;
+                }
+                (Ok(()), None) => return 1,
+            }
+        }
+        _ => match run::measure(&derived, args.seed) {
+            Ok((d, _)) => d,
+            Err(d) => {
+                reporter.emit(&[d], &src.name, &src.text);
+                return 1;
+            }
+        },
+    };
+    let stats = Stats::new(&derived, &drawn, start.elapsed().as_secs_f64() * 1000.0);
+    if args.stats {
+        if let Ok(s) = serde_json::to_string(&stats) {
+            println!("{s}");
+        }
+    }
+    let wrote = args
+        .output
+        .as_ref()
+        .map_or(String::new(), |p| format!(", wrote {}", p.display()));
+    reporter.say(&format!(
+        "{}: {} modules, {} segments, {} elements after {} steps (derive {:.0} ms, draw {:.0} ms){wrote}",
+        stats.system,
+        stats.modules,
+        stats.segments,
+        stats.elements,
+        stats.steps,
+        stats.derive_ms,
+        stats.interpret_ms
+    ));
+    let _ = std::io::stdout().flush();
+    0
+}
+
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
+fn progress_bar(steps: Option<u32>) -> Option<indicatif::ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(u64::from(steps.unwrap_or(0)));
+    if let Ok(style) = indicatif::ProgressStyle::with_template("deriving {bar:30} step {pos}/{len} {msg}") {
+        bar.set_style(style);
+    }
+    Some(bar)
+}

@@ -1,0 +1,172 @@
+//! Output formats, chosen by the file extension: SVG, PNG, OBJ and text.
+//!
+//! Owns: the view (2D programs are drawn in the x–y plane; 3D programs are
+//! projected from a fixed oblique view), the colour palette of `'(c)`, and the
+//! fitting of drawings into a viewport. Each format is a `turtle::Sink` or a
+//! writer of the module string; none of them derives.
+
+pub mod obj;
+pub mod png;
+pub mod svg;
+pub mod txt;
+
+use crate::turtle::Sink;
+use glam::{DMat3, DVec2, DVec3};
+
+/// The colours of `'(0)`, `'(1)`, …; indices wrap around.
+pub const PALETTE: &[&str] = &[
+    "#263238", "#6d4c2f", "#2e7d32", "#7cb342", "#c62828", "#f9a825", "#1565c0", "#6a1b9a",
+    "#00838f", "#ad1457",
+];
+
+pub fn palette(i: u32) -> &'static str {
+    PALETTE[i as usize % PALETTE.len()]
+}
+
+/// RGB of a palette entry.
+pub fn palette_rgb(i: u32) -> [u8; 3] {
+    parse_hex(palette(i)).unwrap_or([0, 0, 0])
+}
+
+/// `#rrggbb` to RGB.
+pub fn parse_hex(s: &str) -> Option<[u8; 3]> {
+    let h = s.strip_prefix('#')?;
+    if h.len() != 6 {
+        return None;
+    }
+    let v = u32::from_str_radix(h, 16).ok()?;
+    Some([(v >> 16) as u8, (v >> 8) as u8, v as u8])
+}
+
+/// How 3D points become 2D drawing coordinates (+y up).
+#[derive(Clone, Copy, Debug)]
+pub struct View {
+    m: DMat3,
+}
+
+impl View {
+    /// The x–y plane for 2D programs; for 3D programs an oblique view (turned
+    /// 30° about the vertical, tilted 20°) so that depth shows.
+    pub fn new(is_3d: bool) -> View {
+        if is_3d {
+            let yaw = DMat3::from_rotation_y(30f64.to_radians());
+            let tilt = DMat3::from_rotation_x(20f64.to_radians());
+            View { m: tilt * yaw }
+        } else {
+            View { m: DMat3::IDENTITY }
+        }
+    }
+
+    pub fn project(&self, p: DVec3) -> DVec2 {
+        let q = self.m * p;
+        DVec2::new(q.x, q.y)
+    }
+
+    pub fn project_dir(&self, v: DVec3) -> DVec2 {
+        self.project(v)
+    }
+}
+
+/// Bounds of drawn geometry as seen by a view.
+#[derive(Clone, Copy, Debug)]
+pub struct Bounds {
+    pub min: DVec2,
+    pub max: DVec2,
+    pub any: bool,
+}
+
+impl Default for Bounds {
+    fn default() -> Bounds {
+        Bounds {
+            min: DVec2::splat(f64::INFINITY),
+            max: DVec2::splat(f64::NEG_INFINITY),
+            any: false,
+        }
+    }
+}
+
+impl Bounds {
+    pub fn add(&mut self, p: DVec2) {
+        if p.is_finite() {
+            self.min = self.min.min(p);
+            self.max = self.max.max(p);
+            self.any = true;
+        }
+    }
+
+    /// A non-degenerate box with a margin, or a unit box around the origin.
+    pub fn framed(&self, margin: f64) -> (DVec2, DVec2) {
+        if !self.any {
+            return (DVec2::splat(-1.0), DVec2::splat(1.0));
+        }
+        let size = (self.max - self.min).max(DVec2::splat(1e-9));
+        let extent = size.x.max(size.y);
+        let pad = DVec2::splat(extent * margin);
+        let mut min = self.min - pad;
+        let mut max = self.max + pad;
+        // Lines of zero extent in one direction still get some room.
+        for k in 0..2 {
+            if max[k] - min[k] < extent * 0.02 {
+                min[k] -= extent * 0.01;
+                max[k] += extent * 0.01;
+            }
+        }
+        (min, max)
+    }
+}
+
+/// Collects the projected bounds of everything drawn, elements included.
+pub struct BoundsSink<'a> {
+    pub view: View,
+    pub bounds: Bounds,
+    /// Local outline bounds of each element: [minx, miny, maxx, maxy].
+    pub element_boxes: &'a [[f64; 4]],
+}
+
+impl Sink for BoundsSink<'_> {
+    fn segment(&mut self, a: DVec3, b: DVec3, _: f64, _: u32) {
+        self.bounds.add(self.view.project(a));
+        self.bounds.add(self.view.project(b));
+    }
+
+    fn polygon(&mut self, points: &[DVec3], _: u32) {
+        for &p in points {
+            self.bounds.add(self.view.project(p));
+        }
+    }
+
+    fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, _: u32) {
+        let Some(b) = self.element_boxes.get(index as usize) else {
+            self.bounds.add(self.view.project(at));
+            return;
+        };
+        for (x, y) in [(b[0], b[1]), (b[2], b[1]), (b[0], b[3]), (b[2], b[3])] {
+            let p = at + (-l * x + h * y) * scale;
+            self.bounds.add(self.view.project(p));
+        }
+    }
+}
+
+/// The bounding box of SVG path data in its own coordinates, if it has points.
+pub fn path_bounds(d: &str) -> Option<[f64; 4]> {
+    let mut b = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+    let mut any = false;
+    for seg in svgtypes::SimplifyingPathParser::from(d) {
+        let Ok(seg) = seg else { return None };
+        use svgtypes::SimplePathSegment as S;
+        let pts: Vec<(f64, f64)> = match seg {
+            S::MoveTo { x, y } | S::LineTo { x, y } => vec![(x, y)],
+            S::CurveTo { x1, y1, x2, y2, x, y } => vec![(x1, y1), (x2, y2), (x, y)],
+            S::Quadratic { x1, y1, x, y } => vec![(x1, y1), (x, y)],
+            S::ClosePath => vec![],
+        };
+        for (x, y) in pts {
+            any = true;
+            b[0] = b[0].min(x);
+            b[1] = b[1].min(y);
+            b[2] = b[2].max(x);
+            b[3] = b[3].max(y);
+        }
+    }
+    any.then_some(b)
+}

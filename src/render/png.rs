@@ -1,0 +1,201 @@
+//! PNG output through tiny-skia: anti-aliased strokes, filled polygons and
+//! elements, fitted into a square-ish image of `--size` pixels.
+
+use super::{Bounds, View, palette_rgb, parse_hex};
+use crate::compile::ElementDef;
+use crate::turtle::Sink;
+use glam::{DVec2, DVec3};
+use tiny_skia::{
+    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, Transform,
+};
+
+/// Segments batched into one path before it is stroked.
+const BATCH: usize = 4096;
+
+pub struct PngWriter {
+    pixmap: Pixmap,
+    view: View,
+    min: DVec2,
+    max: DVec2,
+    k: f64,
+    off: DVec2,
+    elements: Vec<Option<(tiny_skia::Path, [u8; 3], Option<[u8; 3]>)>>,
+    batch: PathBuilder,
+    batch_len: usize,
+    style: (f64, u32),
+    last: Option<DVec2>,
+}
+
+/// A colour name or `#rrggbb`.
+pub fn parse_color(s: &str) -> Option<[u8; 3]> {
+    if let Some(rgb) = parse_hex(s) {
+        return Some(rgb);
+    }
+    s.parse::<svgtypes::Color>().ok().map(|c| [c.red, c.green, c.blue])
+}
+
+fn element_path(d: &str) -> Option<tiny_skia::Path> {
+    let mut pb = PathBuilder::new();
+    for seg in svgtypes::SimplifyingPathParser::from(d) {
+        use svgtypes::SimplePathSegment as S;
+        match seg.ok()? {
+            S::MoveTo { x, y } => pb.move_to(x as f32, y as f32),
+            S::LineTo { x, y } => pb.line_to(x as f32, y as f32),
+            S::CurveTo { x1, y1, x2, y2, x, y } => {
+                pb.cubic_to(x1 as f32, y1 as f32, x2 as f32, y2 as f32, x as f32, y as f32)
+            }
+            S::Quadratic { x1, y1, x, y } => pb.quad_to(x1 as f32, y1 as f32, x as f32, y as f32),
+            S::ClosePath => pb.close(),
+        }
+    }
+    pb.finish()
+}
+
+impl PngWriter {
+    /// An image of at most `size` pixels on its longer side.
+    pub fn new(size: u32, background: [u8; 4], view: View, bounds: &Bounds, elements: &[ElementDef]) -> Option<PngWriter> {
+        let (min, max) = bounds.framed(0.03);
+        let ext = max - min;
+        let (w, h) = if ext.x >= ext.y {
+            (size, ((size as f64) * ext.y / ext.x).ceil().max(1.0) as u32)
+        } else {
+            (((size as f64) * ext.x / ext.y).ceil().max(1.0) as u32, size)
+        };
+        let mut pixmap = Pixmap::new(w.max(1), h.max(1))?;
+        pixmap.fill(Color::from_rgba8(background[0], background[1], background[2], background[3]));
+        let k = (w as f64 / ext.x).min(h as f64 / ext.y);
+        let off = DVec2::new((w as f64 - ext.x * k) / 2.0, (h as f64 - ext.y * k) / 2.0);
+        let elements = elements
+            .iter()
+            .map(|e| {
+                let fill = e.fill.as_deref().and_then(parse_color).unwrap_or([63, 127, 58]);
+                let stroke = e.stroke.as_deref().and_then(parse_color);
+                element_path(&e.path).map(|p| (p, fill, stroke))
+            })
+            .collect();
+        Some(PngWriter {
+            pixmap,
+            view,
+            min,
+            max,
+            k,
+            off,
+            elements,
+            batch: PathBuilder::new(),
+            batch_len: 0,
+            style: (0.0, 0),
+            last: None,
+        })
+    }
+
+    fn px(&self, p: DVec3) -> (f32, f32) {
+        let q = self.view.project(p);
+        (
+            ((q.x - self.min.x) * self.k + self.off.x) as f32,
+            ((self.max.y - q.y) * self.k + self.off.y) as f32,
+        )
+    }
+
+    fn flush(&mut self) {
+        if self.batch_len == 0 {
+            return;
+        }
+        let pb = std::mem::replace(&mut self.batch, PathBuilder::new());
+        self.batch_len = 0;
+        self.last = None;
+        let Some(path) = pb.finish() else { return };
+        let (width, color) = self.style;
+        let rgb = palette_rgb(color);
+        let mut paint = Paint::default();
+        paint.set_color_rgba8(rgb[0], rgb[1], rgb[2], 255);
+        paint.anti_alias = true;
+        let stroke = Stroke {
+            width: if width > 0.0 { (width * self.k).max(0.6) as f32 } else { 1.2 },
+            line_cap: LineCap::Round,
+            line_join: LineJoin::Round,
+            ..Stroke::default()
+        };
+        self.pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+    }
+
+    /// Finishes drawing and encodes the image.
+    pub fn finish(mut self) -> Result<Vec<u8>, String> {
+        self.flush();
+        self.pixmap.encode_png().map_err(|e| e.to_string())
+    }
+}
+
+impl Sink for PngWriter {
+    fn segment(&mut self, a: DVec3, b: DVec3, width: f64, color: u32) {
+        if self.style != (width, color) || self.batch_len >= BATCH {
+            self.flush();
+            self.style = (width, color);
+        }
+        let (ax, ay) = self.px(a);
+        let (bx, by) = self.px(b);
+        let start = DVec2::new(ax as f64, ay as f64);
+        if self.last != Some(start) {
+            self.batch.move_to(ax, ay);
+        }
+        self.batch.line_to(bx, by);
+        self.last = Some(DVec2::new(bx as f64, by as f64));
+        self.batch_len += 1;
+    }
+
+    fn polygon(&mut self, points: &[DVec3], color: u32) {
+        self.flush();
+        let mut pb = PathBuilder::new();
+        for (i, &p) in points.iter().enumerate() {
+            let (x, y) = self.px(p);
+            if i == 0 {
+                pb.move_to(x, y);
+            } else {
+                pb.line_to(x, y);
+            }
+        }
+        pb.close();
+        if let Some(path) = pb.finish() {
+            let rgb = palette_rgb(color);
+            let mut paint = Paint::default();
+            paint.set_color_rgba8(rgb[0], rgb[1], rgb[2], 255);
+            paint.anti_alias = true;
+            self.pixmap.fill_path(&path, &paint, FillRule::EvenOdd, Transform::identity(), None);
+        }
+    }
+
+    fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, _: u32) {
+        self.flush();
+        let Some(Some((path, fill, stroke))) = self.elements.get(index as usize) else {
+            return;
+        };
+        // Local (x, y) → world at + scale (−l x + h y) → pixels (y down).
+        let o = self.view.project(at);
+        let ex = self.view.project_dir(-l * scale);
+        let ey = self.view.project_dir(h * scale);
+        let k = self.k;
+        let t = Transform::from_row(
+            (ex.x * k) as f32,
+            (-ex.y * k) as f32,
+            (ey.x * k) as f32,
+            (-ey.y * k) as f32,
+            ((o.x - self.min.x) * k + self.off.x) as f32,
+            ((self.max.y - o.y) * k + self.off.y) as f32,
+        );
+        let mut paint = Paint::default();
+        paint.set_color_rgba8(fill[0], fill[1], fill[2], 255);
+        paint.anti_alias = true;
+        let path = path.clone();
+        self.pixmap.fill_path(&path, &paint, FillRule::Winding, t, None);
+        if let Some(s) = stroke {
+            paint.set_color_rgba8(s[0], s[1], s[2], 255);
+            let stroke = Stroke {
+                width: 1.0,
+                ..Stroke::default()
+            };
+            // A hairline in pixels: stroke the transformed path.
+            if let Some(p) = path.transform(t) {
+                self.pixmap.stroke_path(&p, &paint, &stroke, Transform::identity(), None);
+            }
+        }
+    }
+}

@@ -1,0 +1,256 @@
+//! SVG output, streamed: consecutive segments of one style become one `<path>`,
+//! elements are `<use>`s of shared `<defs>`, +y points up, and the viewBox is
+//! fitted to the drawing (found by a first, drawing-free pass of the turtle).
+
+use super::{Bounds, View, palette};
+use crate::compile::ElementDef;
+use crate::turtle::Sink;
+use glam::{DVec2, DVec3};
+use std::io::{self, Write};
+
+/// Writes SVG to `out` as the turtle draws.
+pub struct SvgWriter<W: Write> {
+    out: W,
+    view: View,
+    /// Decimal places for coordinates, from the drawing's size.
+    decimals: usize,
+    /// The open `<path>`: its style and where its last segment ended.
+    open: Option<(f64, u32, DVec2)>,
+    buf: Vec<u8>,
+    error: Option<io::Error>,
+}
+
+impl<W: Write> SvgWriter<W> {
+    /// Starts the document; `bounds` are the projected bounds of the drawing.
+    pub fn new(mut out: W, view: View, bounds: &Bounds, elements: &[ElementDef], used: &[bool]) -> io::Result<SvgWriter<W>> {
+        let (min, max) = bounds.framed(0.02);
+        let size = max - min;
+        let extent = size.x.max(size.y);
+        let decimals = (3.0 - extent.log10().floor()).clamp(0.0, 9.0) as usize;
+        let hairline = extent / 700.0;
+        let (w, h) = if size.x >= size.y {
+            (800.0, 800.0 * size.y / size.x)
+        } else {
+            (800.0 * size.x / size.y, 800.0)
+        };
+        let num = |v: f64| {
+            let mut b = Vec::new();
+            write_num(&mut b, v, decimals);
+            String::from_utf8(b).unwrap_or_default()
+        };
+        let mut head = String::new();
+        head.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+        head.push_str(&format!(
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:xlink=\"http://www.w3.org/1999/xlink\" viewBox=\"{} {} {} {}\" width=\"{:.0}\" height=\"{:.0}\">\n",
+            num(min.x),
+            num(-max.y),
+            num(size.x),
+            num(size.y),
+            w.max(1.0),
+            h.max(1.0)
+        ));
+        head.push_str(&format!(
+            "<g fill=\"none\" stroke-linecap=\"round\" stroke-linejoin=\"round\" stroke-width=\"{}\">\n",
+            num(hairline)
+        ));
+        if used.iter().any(|u| *u) {
+            head.push_str("<defs>\n");
+            for (i, e) in elements.iter().enumerate() {
+                if !used.get(i).copied().unwrap_or(false) {
+                    continue;
+                }
+                let fill = e.fill.as_deref().unwrap_or("#3f7f3a");
+                let stroke = e.stroke.as_deref().unwrap_or("none");
+                head.push_str(&format!(
+                    "<path id=\"e{i}\" class=\"element\" data-element=\"{}\" d=\"{}\" fill=\"{}\" stroke=\"{}\"{}/>\n",
+                    xml(&e.name),
+                    xml(&e.path),
+                    xml(fill),
+                    xml(stroke),
+                    e.width.map_or(String::new(), |w| format!(" stroke-width=\"{w}\" vector-effect=\"non-scaling-stroke\""))
+                ));
+            }
+            head.push_str("</defs>\n");
+        }
+        out.write_all(head.as_bytes())?;
+        Ok(SvgWriter {
+            out,
+            view,
+            decimals,
+            open: None,
+            buf: Vec::with_capacity(64),
+            error: None,
+        })
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        if self.error.is_none() {
+            if let Err(e) = self.out.write_all(bytes) {
+                self.error = Some(e);
+            }
+        }
+    }
+
+    fn close_path(&mut self) {
+        if self.open.take().is_some() {
+            self.write(b"\"/>\n");
+        }
+    }
+
+    /// Ends the document and returns the writer.
+    pub fn finish(mut self) -> io::Result<W> {
+        self.close_path();
+        self.write(b"</g>\n</svg>\n");
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        self.out.flush()?;
+        Ok(self.out)
+    }
+}
+
+impl<W: Write> Sink for SvgWriter<W> {
+    fn segment(&mut self, a: DVec3, b: DVec3, width: f64, color: u32) {
+        let pa = self.view.project(a);
+        let pb = self.view.project(b);
+        let mut buf = std::mem::take(&mut self.buf);
+        buf.clear();
+        match self.open {
+            Some((w, c, end)) if w == width && c == color && end == pa => {
+                buf.extend_from_slice(b"l");
+            }
+            _ => {
+                self.close_path();
+                buf.extend_from_slice(b"<path");
+                buf.extend_from_slice(b" stroke=\"");
+                buf.extend_from_slice(palette(color).as_bytes());
+                buf.push(b'"');
+                if width > 0.0 {
+                    buf.extend_from_slice(b" stroke-width=\"");
+                    write_num(&mut buf, width, self.decimals + 1);
+                    buf.push(b'"');
+                }
+                buf.extend_from_slice(b" d=\"M");
+                write_num(&mut buf, pa.x, self.decimals);
+                buf.push(b' ');
+                write_num(&mut buf, -pa.y, self.decimals);
+                buf.extend_from_slice(b"l");
+            }
+        }
+        write_num(&mut buf, pb.x - pa.x, self.decimals);
+        buf.push(b' ');
+        write_num(&mut buf, -(pb.y - pa.y), self.decimals);
+        self.write(&buf);
+        self.buf = buf;
+        self.open = Some((width, color, pb));
+    }
+
+    fn polygon(&mut self, points: &[DVec3], color: u32) {
+        self.close_path();
+        let mut buf = Vec::new();
+        buf.extend_from_slice(b"<polygon fill=\"");
+        buf.extend_from_slice(palette(color).as_bytes());
+        buf.extend_from_slice(b"\" stroke=\"none\" points=\"");
+        for (i, &p) in points.iter().enumerate() {
+            if i > 0 {
+                buf.push(b' ');
+            }
+            let q = self.view.project(p);
+            write_num(&mut buf, q.x, self.decimals);
+            buf.push(b',');
+            write_num(&mut buf, -q.y, self.decimals);
+        }
+        buf.extend_from_slice(b"\"/>\n");
+        self.write(&buf);
+    }
+
+    fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, _: u32) {
+        self.close_path();
+        // Local (x, y) → world at + scale (−l x + h y), then flip y for SVG.
+        let o = self.view.project(at);
+        let ex = self.view.project_dir(-l * scale);
+        let ey = self.view.project_dir(h * scale);
+        let d = self.decimals + 3;
+        let mut buf = Vec::new();
+        buf.extend_from_slice(format!("<use href=\"#e{index}\" xlink:href=\"#e{index}\" transform=\"matrix(").as_bytes());
+        for (k, v) in [ex.x, -ex.y, ey.x, -ey.y, o.x, -o.y].into_iter().enumerate() {
+            if k > 0 {
+                buf.push(b' ');
+            }
+            write_num(&mut buf, v, if k < 4 { d } else { self.decimals });
+        }
+        buf.extend_from_slice(b")\"/>\n");
+        self.write(&buf);
+    }
+}
+
+/// Escapes text for an XML attribute.
+pub fn xml(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('"', "&quot;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// Writes `v` with at most `decimals` decimals, trailing zeros dropped.
+pub fn write_num(buf: &mut Vec<u8>, v: f64, decimals: usize) {
+    if !v.is_finite() {
+        buf.push(b'0');
+        return;
+    }
+    let scale = 10f64.powi(decimals as i32);
+    let r = (v * scale).round();
+    if r.abs() >= 9.0e15 {
+        buf.extend_from_slice(format!("{v}").as_bytes());
+        return;
+    }
+    let mut n = r as i64;
+    if n == 0 {
+        buf.push(b'0');
+        return;
+    }
+    if n < 0 {
+        buf.push(b'-');
+        n = -n;
+    }
+    let n = n as u64;
+    let p = 10u64.pow(decimals as u32);
+    let (int, mut frac) = (n / p, n % p);
+    buf.extend_from_slice(int.to_string().as_bytes());
+    if frac != 0 {
+        let mut digits = decimals;
+        while frac % 10 == 0 {
+            frac /= 10;
+            digits -= 1;
+        }
+        buf.push(b'.');
+        let s = frac.to_string();
+        for _ in s.len()..digits {
+            buf.push(b'0');
+        }
+        buf.extend_from_slice(s.as_bytes());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::write_num;
+
+    fn n(v: f64, d: usize) -> String {
+        let mut b = Vec::new();
+        write_num(&mut b, v, d);
+        String::from_utf8(b).unwrap_or_default()
+    }
+
+    #[test]
+    fn numbers_are_short_and_exact_enough() {
+        assert_eq!(n(0.0, 3), "0");
+        assert_eq!(n(1.5, 3), "1.5");
+        assert_eq!(n(-1.25, 3), "-1.25");
+        assert_eq!(n(0.0004, 3), "0");
+        assert_eq!(n(0.0405, 3), "0.041");
+        assert_eq!(n(12.0, 0), "12");
+        assert_eq!(n(-0.001, 3), "-0.001");
+        assert_eq!(n(3.14159, 2), "3.14");
+    }
+}

@@ -1,0 +1,265 @@
+//! Running a checked program: compile, derive, interpret, write an output.
+//!
+//! Owns: the order of the execution phases, their timings for `--stats`, and the
+//! diagnostics of runtime failures (each with the step and the source span of
+//! the expression that failed). The CLI and the tests call this; it does no
+//! argument parsing and writes only to the writers it is given.
+
+use crate::ast::File;
+use crate::check::Checked;
+use crate::compile::{self, Action, Program};
+use crate::derive::{self, DeriveError, Limits, ModString};
+use crate::diagnostic::{Code, Diagnostic};
+use crate::render::{self, Bounds, BoundsSink, View};
+use crate::turtle::{self, Drawn};
+use crate::vm::Fault;
+use serde::Serialize;
+use std::io::Write;
+use std::time::Instant;
+
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// Derivation steps; the program's `derive` when `None`.
+    pub steps: Option<u32>,
+    pub seed: u64,
+    pub limits: Limits,
+    /// The lsystem to run; the first one when `None`.
+    pub system: Option<String>,
+}
+
+/// A derived program.
+pub struct Derived {
+    pub prog: Program,
+    pub string: ModString,
+    pub steps: u32,
+    pub derive_ms: f64,
+}
+
+/// Compiles and derives. `progress(step, modules)` is called after each step.
+pub fn derive(
+    file: &File,
+    checked: &Checked,
+    opts: &Options,
+    progress: &(dyn Fn(u32, usize) + Sync),
+) -> Result<Derived, Diagnostic> {
+    let prog = compile::compile(file, checked, opts.system.as_deref())
+        .map_err(|m| Diagnostic::error(Code::UnknownSystem, m))?;
+    let steps = opts.steps.unwrap_or(prog.derive);
+    let start = Instant::now();
+    let args = vec![0.0; prog.params.len()];
+    let result = derive::axiom(&prog, &args, opts.seed)
+        .and_then(|a| derive::derive(&prog, a, steps, opts.seed, opts.limits, progress));
+    let string = result.map_err(|e| runtime_diagnostic(&e, &prog))?;
+    Ok(Derived {
+        prog,
+        string,
+        steps,
+        derive_ms: start.elapsed().as_secs_f64() * 1000.0,
+    })
+}
+
+/// A runtime failure as a diagnostic pointing into the program.
+pub fn runtime_diagnostic(e: &DeriveError, prog: &Program) -> Diagnostic {
+    let when = |step: u32| match step {
+        0 => "while evaluating the axiom".to_string(),
+        u32::MAX => "while drawing (in an interpretation rule)".to_string(),
+        s => format!("in derivation step {s}"),
+    };
+    match e {
+        DeriveError::Vm { step, error } => match error.fault {
+            Fault::DivisionByZero => Diagnostic::error(
+                Code::DivisionByZero,
+                format!("division by zero {}", when(*step)),
+            )
+            .primary(error.span, "this divides by zero")
+            .help("guard the rule with a condition, e.g. `A(x) : x != 0 -> …`"),
+            Fault::NotFinite => Diagnostic::error(
+                Code::NotFinite,
+                format!("an expression is not a finite number {}", when(*step)),
+            )
+            .primary(error.span, "this gives infinity or NaN")
+            .help("check the operands: a square root or logarithm of a negative number, or a value that overflows"),
+        },
+        DeriveError::TooManyModules { step, modules, limit } => Diagnostic::error(
+            Code::TooManyModules,
+            format!("derivation step {step} would produce {modules} modules, more than the limit of {limit}"),
+        )
+        .primary(prog.name_span, "this lsystem grows too fast")
+        .help("derive fewer steps with -n, or raise the limit with --max-modules"),
+        DeriveError::TooMuchMemory { step, bytes, limit } => Diagnostic::error(
+            Code::TooMuchMemory,
+            format!(
+                "derivation step {step} would need about {} MiB, more than the limit of {} MiB",
+                bytes >> 20,
+                limit >> 20
+            ),
+        )
+        .primary(prog.name_span, "this lsystem grows too fast")
+        .help("derive fewer steps with -n, or raise the limit with --max-memory"),
+        DeriveError::InterpretTooDeep { module, depth } => Diagnostic::error(
+            Code::InterpretTooDeep,
+            format!("interpretation rules expand `{module}` more than {depth} levels deep"),
+        )
+        .primary(prog.name_span, "an `interpret` rule produces a module that is interpreted again, endlessly")
+        .help("interpretation rules must end in modules that draw; a rule like `interpret A -> B; interpret B -> A;` never does"),
+    }
+}
+
+/// The output formats, by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    Svg,
+    Png,
+    Obj,
+    Txt,
+}
+
+impl Format {
+    pub fn from_path(path: &std::path::Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match ext.as_str() {
+            "svg" => Format::Svg,
+            "png" => Format::Png,
+            "obj" => Format::Obj,
+            "txt" => Format::Txt,
+            _ => return None,
+        })
+    }
+}
+
+/// Settings of the picture formats.
+#[derive(Clone, Copy, Debug)]
+pub struct Picture {
+    pub size: u32,
+    pub background: [u8; 4],
+}
+
+impl Default for Picture {
+    fn default() -> Picture {
+        Picture {
+            size: 1024,
+            background: [255, 255, 255, 255],
+        }
+    }
+}
+
+/// Local bounding boxes of the program's elements (for fitting the view).
+fn element_boxes(prog: &Program) -> Vec<[f64; 4]> {
+    prog.elements
+        .iter()
+        .map(|e| render::path_bounds(&e.path).unwrap_or([0.0, 0.0, 0.0, 0.0]))
+        .collect()
+}
+
+/// Draws without output: the counts and bounding box.
+pub fn measure(d: &Derived, seed: u64) -> Result<(Drawn, Bounds), Diagnostic> {
+    let boxes = element_boxes(&d.prog);
+    let mut sink = BoundsSink {
+        view: View::new(d.prog.is_3d),
+        bounds: Bounds::default(),
+        element_boxes: &boxes,
+    };
+    let drawn = turtle::interpret(&d.prog, &d.string, seed, &mut sink)
+        .map_err(|e| runtime_diagnostic(&e, &d.prog))?;
+    Ok((drawn, sink.bounds))
+}
+
+/// Why writing an output failed.
+pub enum OutputError {
+    Diagnostic(Diagnostic),
+    Io(std::io::Error),
+}
+
+impl From<std::io::Error> for OutputError {
+    fn from(e: std::io::Error) -> Self {
+        OutputError::Io(e)
+    }
+}
+
+/// Writes `d` in `format` to `out`; returns what was drawn.
+pub fn write_output(
+    d: &Derived,
+    format: Format,
+    picture: Picture,
+    seed: u64,
+    out: &mut dyn Write,
+) -> Result<Drawn, OutputError> {
+    let diag = |e: DeriveError| OutputError::Diagnostic(runtime_diagnostic(&e, &d.prog));
+    match format {
+        Format::Txt => {
+            render::txt::write(out, &d.prog, &d.string)?;
+            let (drawn, _) = measure(d, seed).map_err(OutputError::Diagnostic)?;
+            Ok(drawn)
+        }
+        Format::Svg => {
+            let (_, bounds) = measure(d, seed).map_err(OutputError::Diagnostic)?;
+            let used: Vec<bool> = (0..d.prog.elements.len())
+                .map(|i| {
+                    d.prog
+                        .symbols
+                        .info
+                        .iter()
+                        .any(|s| s.action == Action::Element(i as u16))
+                })
+                .collect();
+            let view = View::new(d.prog.is_3d);
+            let mut w = render::svg::SvgWriter::new(out, view, &bounds, &d.prog.elements, &used)?;
+            let drawn = turtle::interpret(&d.prog, &d.string, seed, &mut w).map_err(diag)?;
+            w.finish()?;
+            Ok(drawn)
+        }
+        Format::Png => {
+            let (_, bounds) = measure(d, seed).map_err(OutputError::Diagnostic)?;
+            let view = View::new(d.prog.is_3d);
+            let mut w = render::png::PngWriter::new(
+                picture.size,
+                picture.background,
+                view,
+                &bounds,
+                &d.prog.elements,
+            )
+            .ok_or_else(|| std::io::Error::other("the image size is not possible"))?;
+            let drawn = turtle::interpret(&d.prog, &d.string, seed, &mut w).map_err(diag)?;
+            let bytes = w.finish().map_err(std::io::Error::other)?;
+            out.write_all(&bytes)?;
+            Ok(drawn)
+        }
+        Format::Obj => Err(OutputError::Io(std::io::Error::other(
+            "OBJ output is not available in this build",
+        ))),
+    }
+}
+
+/// The `--stats` object of the contract.
+#[derive(Serialize)]
+pub struct Stats {
+    pub system: String,
+    pub modules: usize,
+    pub segments: u64,
+    pub elements: u64,
+    pub polygons: u64,
+    pub bbox: Option<[f64; 4]>,
+    pub steps: u32,
+    pub derive_ms: f64,
+    pub interpret_ms: f64,
+    pub bytes_per_module: f64,
+}
+
+impl Stats {
+    pub fn new(d: &Derived, drawn: &Drawn, interpret_ms: f64) -> Stats {
+        // `+ 0.0` turns -0 into 0.
+        let round = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
+        Stats {
+            system: d.prog.name.clone(),
+            modules: d.string.len(),
+            segments: drawn.segments,
+            elements: drawn.elements,
+            polygons: drawn.polygons,
+            bbox: drawn.bbox.map(|b| b.map(round)),
+            steps: d.steps,
+            derive_ms: round(d.derive_ms),
+            interpret_ms: round(interpret_ms),
+            bytes_per_module: round(d.string.bytes() as f64 / d.string.len().max(1) as f64),
+        }
+    }
+}
