@@ -533,7 +533,7 @@ impl Program {
             if i.arity == 0 {
                 i.name.text().into_owned()
             } else {
-                format!("{}/{}", i.name.text(), i.arity)
+                format!("{}:{}", i.name.text(), i.arity)
             }
         };
         let _ = writeln!(out, "lsystem {}: {} symbols, {} instructions", self.name, self.symbols.len(), self.chunk.len());

@@ -107,12 +107,49 @@ pub fn derive(
     limits: Limits,
     progress: &(dyn Fn(u32, usize) + Sync),
 ) -> Result<ModString, DeriveError> {
+    if let Some(table) = &prog.d0l {
+        if !prog.has_cut {
+            d0l_forecast(table, &start, steps, limits)?;
+        }
+    }
     let mut s = start;
     for k in 1..=steps {
         s = step(prog, &s, k, seed, limits)?;
         progress(k, s.len());
     }
     Ok(s)
+}
+
+/// A D0L string's length is known before deriving it: the symbol counts of the
+/// next step are a linear function of the current ones. An explosion is found
+/// here, before any step allocates.
+fn d0l_forecast(table: &[Vec<Sym>], start: &ModString, steps: u32, limits: Limits) -> Result<(), DeriveError> {
+    let n = table.len();
+    let mut counts = vec![0u128; n];
+    for &x in &start.syms {
+        counts[x as usize] += 1;
+    }
+    let mut next = vec![0u128; n];
+    for step in 1..=steps {
+        next.iter_mut().for_each(|c| *c = 0);
+        for (s, succ) in table.iter().enumerate() {
+            if counts[s] == 0 {
+                continue;
+            }
+            for &t in succ {
+                next[t as usize] = next[t as usize].saturating_add(counts[s]);
+            }
+        }
+        std::mem::swap(&mut counts, &mut next);
+        let total = counts.iter().fold(0u128, |a, &c| a.saturating_add(c));
+        let total = usize::try_from(total).unwrap_or(usize::MAX);
+        check_limits(step, total, 0, limits)?;
+        // Once every count is 0 or fixed, later steps cannot grow: stop early.
+        if counts == next {
+            break;
+        }
+    }
+    Ok(())
 }
 
 /// One parallel rewriting step (step numbers start at 1).

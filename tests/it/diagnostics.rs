@@ -8,7 +8,18 @@ use lsyc::frontend;
 use std::collections::BTreeSet;
 
 /// Codes tested from the command line instead (tests/it/cli.rs).
-const CLI_ONLY: &[Code] = &[Code::ReadFile, Code::FileTooLarge, Code::BadOverride];
+const CLI_ONLY: &[Code] = &[
+    Code::ReadFile,
+    Code::FileTooLarge,
+    Code::WriteOutput,
+    Code::BadOverride,
+    // Runtime errors: tests/it/run.rs.
+    Code::DivisionByZero,
+    Code::NotFinite,
+    Code::TooManyModules,
+    Code::TooMuchMemory,
+    Code::InterpretTooDeep,
+];
 
 fn expected_codes(text: &str) -> Vec<String> {
     text.lines()

@@ -1,0 +1,302 @@
+//! Running programs: derived strings, counts, pictures, determinism, runtime errors.
+
+use crate::support::{lsy_files, read_text, rel, render_plain, root};
+use glam::DVec3;
+use lsyc::run::{self, Derived, Format, Options, Picture};
+use lsyc::turtle::{self, Sink};
+use lsyc::{frontend, run::Stats};
+use std::process::Command;
+
+fn derive_text(text: &str, steps: Option<u32>) -> Result<Derived, String> {
+    let fe = frontend::run(text, Vec::new(), &[]);
+    let checked = fe
+        .checked
+        .as_ref()
+        .filter(|_| !fe.has_errors())
+        .ok_or_else(|| render_plain(&fe.diagnostics, "test.lsy", text))?;
+    let opts = Options {
+        steps,
+        ..Options::default()
+    };
+    run::derive(&fe.file, checked, &opts, &|_, _| {}).map_err(|d| render_plain(&[d], "test.lsy", text))
+}
+
+fn txt(d: &Derived) -> String {
+    let mut out = Vec::new();
+    run::write_output(d, Format::Txt, Picture::default(), 0, &mut out).ok();
+    String::from_utf8(out).unwrap_or_default().trim_end().to_string()
+}
+
+#[test]
+fn d0l_strings_match_hand_derivations() {
+    // The slides' Fibonacci example: b, a, ab, aba, abaab, abaababa.
+    let fib = "lsystem Fib { axiom b; a -> ab; b -> a; }";
+    let want = ["b", "a", "ab", "aba", "abaab", "abaababa"];
+    for (n, w) in want.iter().enumerate() {
+        let d = derive_text(fib, Some(n as u32)).expect("derives");
+        assert_eq!(txt(&d), *w, "step {n}");
+    }
+    let koch = "lsystem K { axiom F-F-F-F; F -> F-F+F+FF-F-F+F; }";
+    let d = derive_text(koch, Some(1)).expect("derives");
+    assert_eq!(txt(&d), "F-F+F+FF-F-F+F-F-F+F+FF-F-F+F-F-F+F+FF-F-F+F-F-F+F+FF-F-F+F");
+    // Erasure, brackets and the identity of modules without rules.
+    let d = derive_text("lsystem E { axiom A[B]C; A -> ; B -> BB; }", Some(2)).expect("derives");
+    assert_eq!(txt(&d), "[BBBB]C");
+}
+
+#[test]
+fn parametric_conditions_context_and_cut() {
+    let src = "lsystem P { axiom A(0); A(x) : x < 3 -> F(x) A(x + 1); A(x) -> B(x * 2); }";
+    assert_eq!(txt(&derive_text(src, Some(4)).expect("derives")), "F(0) F(1) F(2) B(6)");
+    // Context: a signal moving right, skipping the branch and the ignored `+`.
+    let src = "lsystem S { ignore +; axiom b a [a] + a a; b < a -> b; b -> a; }";
+    assert_eq!(txt(&derive_text(src, Some(1)).expect("derives")), "ab[a]+aa");
+    assert_eq!(txt(&derive_text(src, Some(2)).expect("derives")), "aa[b]+ba");
+    // Right context across a branch.
+    let src = "lsystem R { axiom A[X]B; A > B -> C; }";
+    assert_eq!(txt(&derive_text(src, Some(1)).expect("derives")), "C[X]B");
+    // cut erases the rest of its branch.
+    let src = "lsystem C { axiom F[A F F]F; A -> cut; }";
+    assert_eq!(txt(&derive_text(src, Some(1)).expect("derives")), "F[]F");
+}
+
+#[test]
+fn stochastic_choices_follow_the_weights_and_the_seed() {
+    let src = "lsystem S { axiom A; A ->(1) A X; A ->(3) A Y; }";
+    let fe = frontend::run(src, Vec::new(), &[]);
+    let checked = fe.checked.as_ref().expect("checks");
+    let count = |seed: u64| {
+        let opts = Options {
+            steps: Some(4000),
+            seed,
+            ..Options::default()
+        };
+        let d = run::derive(&fe.file, checked, &opts, &|_, _| {}).expect("derives");
+        let s = txt(&d);
+        (s.matches('X').count(), s.matches('Y').count(), s)
+    };
+    let (x, y, a) = count(1);
+    assert_eq!(x + y, 4000);
+    let share = y as f64 / 4000.0;
+    assert!((share - 0.75).abs() < 0.04, "Y share {share}");
+    assert_eq!(a, count(1).2, "same seed, same string");
+    assert_ne!(a, count(2).2, "another seed, another string");
+}
+
+/// Records segment end points.
+#[derive(Default)]
+struct Points(Vec<(DVec3, DVec3)>);
+
+impl Sink for Points {
+    fn segment(&mut self, a: DVec3, b: DVec3, _: f64, _: u32) {
+        self.0.push((a, b));
+    }
+    fn polygon(&mut self, _: &[DVec3], _: u32) {}
+    fn element(&mut self, _: u16, _: DVec3, _: DVec3, _: DVec3, _: f64, _: u32) {}
+}
+
+#[test]
+fn the_3d_hilbert_curve_visits_every_cell_once() {
+    let text = read_text(&root().join("lang-examples/hilbert-3d.lsy"));
+    for n in 1..=3u32 {
+        let d = derive_text(&text, Some(n)).expect("derives");
+        let mut pts = Points::default();
+        turtle::interpret(&d.prog, &d.string, 0, &mut pts).expect("draws");
+        let cells = 8usize.pow(n);
+        assert_eq!(pts.0.len(), cells - 1, "n = {n}");
+        let mut seen = std::collections::HashSet::new();
+        let key = |p: DVec3| (p.x.round() as i64, p.y.round() as i64, p.z.round() as i64);
+        seen.insert(key(pts.0[0].0));
+        for (k, &(a, b)) in pts.0.iter().enumerate() {
+            assert!(((b - a).length() - 1.0).abs() < 1e-9, "unit steps");
+            if k > 0 {
+                assert!((a - pts.0[k - 1].1).length() < 1e-9, "one connected curve");
+            }
+            seen.insert(key(b));
+        }
+        assert_eq!(seen.len(), cells, "n = {n}: every cell of the cube once");
+        let side = 2i64.pow(n) - 1;
+        assert!(seen.iter().all(|&(x, y, z)| [x, y, z].iter().all(|c| c.abs() <= side)));
+    }
+}
+
+#[test]
+fn turtle_conventions() {
+    // `+` turns left (counter-clockwise): from heading +y to -x.
+    let d = derive_text("lsystem T { angle 90; axiom F+F; }", None).expect("derives");
+    let mut pts = Points::default();
+    turtle::interpret(&d.prog, &d.string, 0, &mut pts).expect("draws");
+    assert!((pts.0[1].1 - DVec3::new(-1.0, 1.0, 0.0)).length() < 1e-12, "{:?}", pts.0);
+    // `&` pitches down: the heading goes toward -U = -z.
+    let d = derive_text("lsystem T { angle 90; axiom &F; }", None).expect("derives");
+    let mut pts = Points::default();
+    turtle::interpret(&d.prog, &d.string, 0, &mut pts).expect("draws");
+    assert!((pts.0[0].1 - DVec3::new(0.0, 0.0, -1.0)).length() < 1e-12, "{:?}", pts.0);
+    // `*` scales, `[ ]` restore, `|` turns around.
+    let d = derive_text("lsystem T { axiom F[*(2)F]|F; }", None).expect("draws");
+    let mut pts = Points::default();
+    turtle::interpret(&d.prog, &d.string, 0, &mut pts).expect("draws");
+    assert!((pts.0[1].1 - DVec3::new(0.0, 3.0, 0.0)).length() < 1e-12);
+    assert!((pts.0[2].1 - DVec3::ZERO).length() < 1e-12);
+}
+
+fn stats_of(d: &Derived) -> serde_json::Value {
+    let (drawn, _) = run::measure(d, 0).expect("draws");
+    let mut v = serde_json::to_value(Stats::new(d, &drawn, 0.0)).expect("json");
+    if let Some(o) = v.as_object_mut() {
+        o.remove("derive_ms");
+        o.remove("interpret_ms");
+    }
+    v
+}
+
+#[test]
+fn gallery_stats() {
+    let mut settings = insta::Settings::clone_current();
+    settings.set_prepend_module_to_snapshot(false);
+    settings.bind(|| {
+        insta::glob!("../..", "lang-examples/*.lsy", |path| {
+            let text = read_text(path);
+            if text.contains("\nscene ") {
+                return; // scenes run with their environment
+            }
+            let d = derive_text(&text, None).unwrap_or_else(|e| panic!("{}: {e}", rel(path)));
+            let v = stats_of(&d);
+            insta::assert_snapshot!("stats", serde_json::to_string_pretty(&v).unwrap_or_default());
+        });
+    });
+}
+
+#[test]
+fn koch_island_counts_and_bounds() {
+    let text = read_text(&root().join("lang-examples/koch-island.lsy"));
+    let d = derive_text(&text, Some(1)).expect("derives");
+    let v = stats_of(&d);
+    assert_eq!(v["segments"], 32);
+    assert_eq!(v["modules"], 4 * 14 + 3);
+    // After one step a side is 4 units long with bumps of 1 on either side.
+    let b = &v["bbox"];
+    let w = b[2].as_f64().unwrap_or(0.0) - b[0].as_f64().unwrap_or(0.0);
+    assert!((w - 6.0).abs() < 1e-9, "{v}");
+}
+
+fn lsyc(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_lsyc"))
+        .args(args)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("lsyc runs")
+}
+
+#[test]
+fn outputs_are_deterministic_across_runs_and_threads() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for prog in ["stochastic-plant", "monopodial-tree", "hogeweg-plant"] {
+        let input = root().join(format!("lang-examples/{prog}.lsy"));
+        let input = input.to_str().expect("utf-8");
+        let mut outs = Vec::new();
+        for (k, threads) in ["1", "2", "1"].iter().enumerate() {
+            let out = dir.path().join(format!("{prog}-{k}.svg"));
+            let o = lsyc(&["run", input, "-o", out.to_str().expect("utf-8"), "--seed", "7", "--threads", threads]);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            outs.push(std::fs::read(&out).expect("written"));
+        }
+        assert!(outs[0] == outs[1] && outs[1] == outs[2], "{prog}: outputs differ");
+    }
+}
+
+#[test]
+fn svg_rereads_with_usvg_and_png_decodes() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for prog in ["plant-e", "helix", "bush-3d", "dragon-curve"] {
+        let input = root().join(format!("lang-examples/{prog}.lsy"));
+        let svg = dir.path().join(format!("{prog}.svg"));
+        let png = dir.path().join(format!("{prog}.png"));
+        for out in [&svg, &png] {
+            let o = lsyc(&["run", input.to_str().expect("utf-8"), "-o", out.to_str().expect("utf-8"), "--size", "300"]);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        }
+        let data = std::fs::read(&svg).expect("svg");
+        let tree = usvg::Tree::from_data(&data, &usvg::Options::default())
+            .unwrap_or_else(|e| panic!("{prog}: usvg cannot read our SVG: {e}"));
+        assert!(tree.root().has_children(), "{prog}: empty SVG");
+        let bytes = std::fs::read(&png).expect("png");
+        let pixmap = tiny_skia::Pixmap::decode_png(&bytes).expect("a PNG");
+        assert_eq!(pixmap.width().max(pixmap.height()), 300);
+        let ink = pixmap.pixels().iter().filter(|p| p.red() < 200 || p.green() < 200).count();
+        assert!(ink > 100, "{prog}: the picture is blank");
+    }
+}
+
+#[test]
+fn text_output_parses_back_as_an_axiom() {
+    // The .txt output is in the language's syntax: it can be an axiom again.
+    for path in lsy_files(&["lang-examples"]) {
+        let text = read_text(&path);
+        if text.contains("\nscene ") {
+            continue;
+        }
+        let Ok(d) = derive_text(&text, Some(2)) else { continue };
+        let s = txt(&d);
+        if s.len() > 20_000 {
+            continue;
+        }
+        let program = format!("lsystem Again {{ axiom {s}; }}");
+        let parsed = lsyc::parser::parse(&program);
+        let errs: Vec<_> = parsed.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
+        assert!(errs.is_empty(), "{}: {}", rel(&path), render_plain(&errs, "again", &program));
+    }
+}
+
+#[test]
+fn runtime_errors_point_at_the_expression() {
+    let src = "lsystem Z {\n    axiom A(3);\n    A(x) -> A(x - 1) F(10 / x);\n}\n";
+    let err = derive_text(src, Some(5)).err().expect("fails");
+    assert!(err.contains("error[E0901]") && err.contains("step 4"), "{err}");
+    assert!(err.contains("test.lsy:3:24"), "{err}");
+    let src = "lsystem N {\n    axiom A(-1);\n    A(x) -> F(sqrt(x));\n}\n";
+    let err = derive_text(src, Some(1)).err().expect("fails");
+    assert!(err.contains("error[E0902]") && err.contains("test.lsy:3:15"), "{err}");
+    // && does not evaluate its right side when the left is false.
+    let src = "lsystem G { axiom A(0); A(x) : x != 0 && 1 / x > 2 -> B; }";
+    assert!(derive_text(src, Some(1)).is_ok());
+}
+
+#[test]
+fn an_explosion_stops_quickly_with_a_clear_error() {
+    let src = "lsystem Boom { axiom F; F -> FFFFFFFFFF; }";
+    let start = std::time::Instant::now();
+    let err = derive_text(src, Some(40)).err().expect("stops");
+    assert!(start.elapsed().as_secs_f64() < 1.0, "took {:?}", start.elapsed());
+    assert!(err.contains("error[E0903]") && err.contains("modules"), "{err}");
+}
+
+#[test]
+fn endless_interpretation_is_an_error() {
+    let src = "lsystem I { axiom A; interpret A -> B; interpret B -> A F; }";
+    let d = derive_text(src, Some(0)).expect("derives");
+    let err = run::measure(&d, 0).err().expect("fails");
+    assert_eq!(err.code, lsyc::diagnostic::Code::InterpretTooDeep);
+}
+
+#[test]
+fn disassembly_snapshots() {
+    for prog in ["monopodial-tree", "stochastic-plant", "hogeweg-plant"] {
+        let out = lsyc(&["run", root().join(format!("lang-examples/{prog}.lsy")).to_str().expect("utf-8"), "--disasm"]);
+        assert!(out.status.success());
+        insta::assert_snapshot!(format!("disasm_{prog}"), String::from_utf8_lossy(&out.stdout));
+    }
+}
+
+#[test]
+fn run_refuses_to_overwrite_its_input_and_unknown_formats() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = dir.path().join("a.lsy");
+    std::fs::write(&p, "lsystem A { axiom F; }\n").expect("write");
+    let ps = p.to_str().expect("utf-8");
+    let o = lsyc(&["run", ps, "-o", ps]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(std::fs::read_to_string(&p).expect("read"), "lsystem A { axiom F; }\n");
+    let o = lsyc(&["run", ps, "-o", "x.pdf"]);
+    assert_eq!(o.status.code(), Some(2));
+}
