@@ -94,7 +94,8 @@ impl State {
             Action::Color => {
                 self.color = match arg {
                     Some(c) => c.max(0.0) as u32,
-                    None => self.color + 1,
+                    // The wood-to-leaf ramp of the palette ends at 7.
+                    None => (self.color + 1).min(7),
                 }
             }
             Action::Draw | Action::Move => {

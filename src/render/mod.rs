@@ -13,10 +13,12 @@ pub mod txt;
 use crate::turtle::Sink;
 use glam::{DMat3, DVec2, DVec3};
 
-/// The colours of `'(0)`, `'(1)`, …; indices wrap around.
+/// The colours of `'(0)`, `'(1)`, …; indices wrap around. Index 0 is ink; 1–7
+/// go from bark through darker to lighter greens, so that a bare `'` (the next
+/// colour) moves a plant from wood to leaf as in ABOP; 8–11 are flower colours.
 pub const PALETTE: &[&str] = &[
-    "#263238", "#6d4c2f", "#2e7d32", "#7cb342", "#c62828", "#f9a825", "#1565c0", "#6a1b9a",
-    "#00838f", "#ad1457",
+    "#263238", "#4e342e", "#6d4c41", "#33691e", "#558b2f", "#689f38", "#7cb342", "#9ccc65",
+    "#c62828", "#f9a825", "#1565c0", "#6a1b9a",
 ];
 
 pub fn palette(i: u32) -> &'static str {
