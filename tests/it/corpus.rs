@@ -163,3 +163,13 @@ fn clean_programs_have_no_diagnostics() {
         );
     }
 }
+
+/// The language reference lists every diagnostic code with its title.
+#[test]
+fn the_reference_lists_every_code() {
+    let doc = read_text(&crate::support::root().join("docs/language.md"));
+    for code in lsyc::diagnostic::Code::ALL {
+        let row = format!("| `{}` | {} |", code.as_str(), code.title());
+        assert!(doc.contains(&row), "docs/language.md lacks the row {row}");
+    }
+}
