@@ -45,10 +45,7 @@ impl<'a> ExprCompiler<'a> {
     pub fn compile(&mut self, e: &Expr) -> Code {
         let start = self.chunk.len();
         self.expr(e);
-        Code {
-            start,
-            end: self.chunk.len(),
-        }
+        Code::new(self.chunk, start, self.chunk.len())
     }
 
     fn const_decl(&self, name: &str) -> Option<&'a ConstDecl> {
@@ -187,7 +184,11 @@ impl<'a> ExprCompiler<'a> {
         {
             let start = (n - inputs) as u32;
             let at = self.chunk.push(op, span);
-            let code = Code { start, end: at + 1 };
+            let code = Code {
+                start,
+                end: at + 1,
+                fast: crate::vm::Fast::None,
+            };
             let mut rng = Random::new(0, 0, 0);
             let mut stack = Vec::new();
             if let Ok(v) = self.chunk.eval(code, &[], &mut rng, &mut stack) {

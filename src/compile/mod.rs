@@ -310,10 +310,7 @@ impl<'a> Compiler<'a> {
                 for _ in 0..k {
                     let start = self.chunk.len();
                     self.chunk.push(Op::Const(0.0), m.span);
-                    args.push(Code {
-                        start,
-                        end: start + 1,
-                    });
+                    args.push(Code::new(&self.chunk, start, start + 1));
                 }
             }
             for a in m.args.iter().flatten() {
@@ -536,7 +533,13 @@ impl Program {
                 format!("{}:{}", i.name.text(), i.arity)
             }
         };
-        let _ = writeln!(out, "lsystem {}: {} symbols, {} instructions", self.name, self.symbols.len(), self.chunk.len());
+        let _ = writeln!(
+            out,
+            "lsystem {}: {} symbols, {} instructions",
+            self.name,
+            self.symbols.len(),
+            self.chunk.len()
+        );
         for (k, e) in self.axiom.iter().enumerate() {
             for (a, code) in e.args.iter().enumerate() {
                 let _ = writeln!(out, "axiom module {k} {} parameter {a}:", name(e.sym));

@@ -17,6 +17,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// Modules per parallel work unit.
 const CHUNK: usize = 1 << 15;
 
+/// The widest D0L successor copied as a fixed-size block.
+const PAD: usize = 16;
+
 /// A derived string: `syms[i]` is module i; its parameters follow those of the
 /// modules before it in `params` (each symbol has a fixed arity).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -123,7 +126,12 @@ pub fn derive(
 /// A D0L string's length is known before deriving it: the symbol counts of the
 /// next step are a linear function of the current ones. An explosion is found
 /// here, before any step allocates.
-fn d0l_forecast(table: &[Vec<Sym>], start: &ModString, steps: u32, limits: Limits) -> Result<(), DeriveError> {
+fn d0l_forecast(
+    table: &[Vec<Sym>],
+    start: &ModString,
+    steps: u32,
+    limits: Limits,
+) -> Result<(), DeriveError> {
     let n = table.len();
     let mut counts = vec![0u128; n];
     for &x in &start.syms {
@@ -223,24 +231,31 @@ fn d0l_step(
         slices.push(a);
         rest = b;
     }
+    // Successors padded to a fixed width are copied as one fixed-size block (no
+    // call to memcpy per module); the block may run past the module's share and
+    // is overwritten by the next one, except at the end of a slice.
+    let padded: Option<Vec<[Sym; PAD]>> = table
+        .iter()
+        .map(|succ| {
+            let mut block = [0 as Sym; PAD];
+            block.get_mut(..succ.len())?.copy_from_slice(succ);
+            Some(block)
+        })
+        .collect();
     s.syms
         .par_chunks(CHUNK)
         .zip(slices.into_par_iter())
         .for_each(|(inp, outp)| {
             let mut k = 0;
             for &x in inp {
-                let succ = &table[x as usize];
-                match succ.len() {
-                    0 => {}
-                    1 => {
-                        outp[k] = succ[0];
-                        k += 1;
+                let n = lens[x as usize];
+                match &padded {
+                    Some(blocks) if k + PAD <= outp.len() => {
+                        outp[k..k + PAD].copy_from_slice(&blocks[x as usize]);
                     }
-                    n => {
-                        outp[k..k + n].copy_from_slice(succ);
-                        k += n;
-                    }
+                    _ => outp[k..k + n].copy_from_slice(&table[x as usize]),
                 }
+                k += n;
             }
         });
     Ok(ModString {
@@ -288,6 +303,26 @@ pub(crate) struct View<'a> {
     pub s: &'a ModString,
     /// Parameter offset of every module (only for context-sensitive programs).
     pub offsets: Vec<u32>,
+    /// Per symbol, the most modules and parameters one rewrite of it produces, so
+    /// that output buffers are allocated once.
+    pub growth: Vec<(usize, usize)>,
+}
+
+/// The most modules and parameters any rule of each symbol produces (the symbol
+/// itself when it has no rule).
+fn growth(prog: &Program) -> Vec<(usize, usize)> {
+    prog.rules
+        .iter()
+        .enumerate()
+        .map(|(s, rules)| {
+            let own = (1, prog.symbols.arity(s as Sym));
+            rules.iter().fold(own, |(m, p), r| {
+                let rm = r.succ.len();
+                let rp = r.succ.iter().map(|e| e.args.len()).sum();
+                (m.max(rm), p.max(rp))
+            })
+        })
+        .collect()
 }
 
 impl View<'_> {
@@ -315,7 +350,12 @@ fn parametric_step(
     limits: Limits,
 ) -> Result<ModString, DeriveError> {
     let (starts, offsets) = param_offsets(prog, s, prog.has_context);
-    let view = View { prog, s, offsets };
+    let view = View {
+        prog,
+        s,
+        offsets,
+        growth: growth(prog),
+    };
     let produced = AtomicUsize::new(0);
     let parts: Vec<Result<ChunkOut, DeriveError>> = s
         .syms
@@ -341,12 +381,26 @@ fn parametric_step(
     let total: usize = outs.iter().map(|o| o.syms.len()).sum();
     let total_params: usize = outs.iter().map(|o| o.params.len()).sum();
     check_limits(step, total, total_params, limits)?;
-    let mut syms = Vec::with_capacity(total);
-    let mut params = Vec::with_capacity(total_params);
-    for o in outs {
-        syms.extend_from_slice(&o.syms);
-        params.extend_from_slice(&o.params);
+    // Join the chunks' outputs in parallel, each into its own slice.
+    let mut syms = vec![0 as Sym; total];
+    let mut params = vec![0.0; total_params];
+    let mut sym_slices = Vec::with_capacity(outs.len());
+    let mut param_slices = Vec::with_capacity(outs.len());
+    let (mut rs, mut rp): (&mut [Sym], &mut [f64]) = (&mut syms, &mut params);
+    for o in &outs {
+        let (a, b) = rs.split_at_mut(o.syms.len());
+        sym_slices.push(a);
+        rs = b;
+        let (a, b) = rp.split_at_mut(o.params.len());
+        param_slices.push(a);
+        rp = b;
     }
+    outs.par_iter()
+        .zip(sym_slices.into_par_iter().zip(param_slices.into_par_iter()))
+        .for_each(|(o, (ss, ps))| {
+            ss.copy_from_slice(&o.syms);
+            ps.copy_from_slice(&o.params);
+        });
     Ok(ModString { syms, params })
 }
 
@@ -364,8 +418,8 @@ fn rewrite_chunk(
     let prog = view.prog;
     let s = view.s;
     let mut out = ChunkOut {
-        syms: Vec::with_capacity(chunk.len() * 2),
-        params: Vec::with_capacity((s.params.len() / s.len().max(1) + 1) * chunk.len()),
+        syms: Vec::with_capacity(chunk.iter().map(|&x| view.growth[x as usize].0).sum()),
+        params: Vec::with_capacity(chunk.iter().map(|&x| view.growth[x as usize].1).sum()),
     };
     let mut p = param_start;
     let mut slots: Vec<f64> = Vec::new();
@@ -385,33 +439,53 @@ fn rewrite_chunk(
         }
         let mut rng = Random::new(seed, step, i as u64);
         let vm = |error| DeriveError::Vm { step, error };
-        let chosen = choose(
-            view,
-            rules,
-            i,
-            params,
-            &mut slots,
-            &mut stack,
-            &mut rng,
-            &mut weights,
-        )
-        .map_err(vm)?;
-        match chosen {
-            Some(r) => {
-                for e in &r.succ {
-                    out.syms.push(e.sym);
-                    for code in &e.args {
-                        let v = prog
-                            .chunk
-                            .eval(*code, &slots, &mut rng, &mut stack)
-                            .map_err(vm)?;
-                        out.params.push(v);
-                    }
+        // The common case: one rule that always applies and binds only the
+        // predecessor's parameters, which are then the slots themselves.
+        if let [r] = rules.as_slice()
+            && r.cond.is_none()
+            && r.weight.is_none()
+            && r.left.is_empty()
+            && r.right.is_empty()
+        {
+            for e in &r.succ {
+                out.syms.push(e.sym);
+                for code in &e.args {
+                    let v = prog
+                        .chunk
+                        .eval(*code, params, &mut rng, &mut stack)
+                        .map_err(vm)?;
+                    out.params.push(v);
                 }
             }
-            None => {
-                out.syms.push(sym);
-                out.params.extend_from_slice(params);
+        } else {
+            let chosen = choose(
+                view,
+                rules,
+                i,
+                params,
+                &mut slots,
+                &mut stack,
+                &mut rng,
+                &mut weights,
+            )
+            .map_err(vm)?;
+            match chosen {
+                Some(r) => {
+                    for e in &r.succ {
+                        out.syms.push(e.sym);
+                        for code in &e.args {
+                            let v = prog
+                                .chunk
+                                .eval(*code, &slots, &mut rng, &mut stack)
+                                .map_err(vm)?;
+                            out.params.push(v);
+                        }
+                    }
+                }
+                None => {
+                    out.syms.push(sym);
+                    out.params.extend_from_slice(params);
+                }
             }
         }
         // Share progress so a runaway step stops early, not after filling memory.
