@@ -213,7 +213,10 @@ fn verify_and_report(
     let per = |b: usize| b as f64 / n as f64;
     let rate = |d: Duration| n as f64 / d.as_secs_f64() / 1e6;
     eprintln!();
-    eprintln!("{title}, depth {depth}: {n} modules, {} parameters", ours.params.len());
+    eprintln!(
+        "{title}, depth {depth}: {n} modules, {} parameters",
+        ours.params.len()
+    );
     assert_eq!(ours.params.len(), their_params);
     eprintln!(
         "  lsyc    {:>6.1} M modules/s (one run)  live {:>6.2} B/module  peak heap {:>6.2} B/module",
@@ -246,13 +249,16 @@ fn compare(c: &mut Criterion, name: &str, file: &str, depth: u32, make: fn() -> 
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(8))
         .throughput(Throughput::Elements(n as u64));
-    g.bench_function(format!("lsyc/{}-threads", rayon::current_num_threads()), |b| {
-        b.iter_batched(
-            || (),
-            |()| lsyc_derive(&prog, black_box(depth)),
-            BatchSize::PerIteration,
-        )
-    });
+    g.bench_function(
+        format!("lsyc/{}-threads", rayon::current_num_threads()),
+        |b| {
+            b.iter_batched(
+                || (),
+                |()| lsyc_derive(&prog, black_box(depth)),
+                BatchSize::PerIteration,
+            )
+        },
+    );
     g.bench_function("lsyc/1-thread", |b| {
         b.iter_batched(
             || (),

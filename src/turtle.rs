@@ -174,15 +174,27 @@ struct Turtle<'a> {
 impl Turtle<'_> {
     /// Applies the first matching interpretation rule of `sym` and interprets its
     /// successor in place of the module.
-    fn expand(&mut self, sym: Sym, params: &[f64], position: u64, depth: usize) -> Result<(), DeriveError> {
+    fn expand(
+        &mut self,
+        sym: Sym,
+        params: &[f64],
+        position: u64,
+        depth: usize,
+    ) -> Result<(), DeriveError> {
         if depth >= MAX_INTERPRET_DEPTH {
             return Err(DeriveError::InterpretTooDeep {
-                module: self.prog.symbols.info[sym as usize].name.text().into_owned(),
+                module: self.prog.symbols.info[sym as usize]
+                    .name
+                    .text()
+                    .into_owned(),
                 depth,
             });
         }
         let prog = self.prog;
-        let vm = |error: VmError| DeriveError::Vm { step: u32::MAX, error };
+        let vm = |error: VmError| DeriveError::Vm {
+            step: u32::MAX,
+            error,
+        };
         let mut rng = Random::new(self.seed ^ 0x1e7e_3b1d, u32::MAX - depth as u32, position);
         let mut chosen = None;
         let rules = &prog.interpret[sym as usize];
@@ -194,14 +206,22 @@ impl Turtle<'_> {
             let mut cands: Vec<(usize, f64)> = Vec::new();
             for (idx, r) in rules[k..end].iter().enumerate() {
                 let ok = match r.cond {
-                    Some(c) => prog.chunk.eval(c, params, &mut rng, &mut self.stack_vm).map_err(vm)? != 0.0,
+                    Some(c) => {
+                        prog.chunk
+                            .eval(c, params, &mut rng, &mut self.stack_vm)
+                            .map_err(vm)?
+                            != 0.0
+                    }
                     None => true,
                 };
                 if !ok {
                     continue;
                 }
                 let w = match r.weight {
-                    Some(c) => prog.chunk.eval(c, params, &mut rng, &mut self.stack_vm).map_err(vm)?,
+                    Some(c) => prog
+                        .chunk
+                        .eval(c, params, &mut rng, &mut self.stack_vm)
+                        .map_err(vm)?,
                     None => 1.0,
                 };
                 if r.weight.is_none() {
@@ -234,7 +254,11 @@ impl Turtle<'_> {
         for e in &rule.succ {
             let mut args = Vec::with_capacity(e.args.len());
             for code in &e.args {
-                args.push(prog.chunk.eval(*code, params, &mut rng, &mut self.stack_vm).map_err(vm)?);
+                args.push(
+                    prog.chunk
+                        .eval(*code, params, &mut rng, &mut self.stack_vm)
+                        .map_err(vm)?,
+                );
             }
             if prog.interpret[e.sym as usize].is_empty() {
                 self.module(e.sym, &args);
@@ -263,7 +287,8 @@ impl Turtle<'_> {
                     self.drawn.segments += 1;
                     self.drawn.grow(from);
                     self.drawn.grow(to);
-                    self.sink.segment(from, to, self.state.width, self.state.color);
+                    self.sink
+                        .segment(from, to, self.state.width, self.state.color);
                 }
             }
             Action::Push => self.stack.push(self.state),
@@ -275,10 +300,10 @@ impl Turtle<'_> {
             Action::PolygonStart => self.polygons.push(Vec::new()),
             Action::Vertex => {
                 let p = self.state.pos;
-                if let Some(poly) = self.polygons.last_mut() {
-                    if poly.last() != Some(&p) {
-                        poly.push(p);
-                    }
+                if let Some(poly) = self.polygons.last_mut()
+                    && poly.last() != Some(&p)
+                {
+                    poly.push(p);
                 }
             }
             Action::PolygonEnd => {

@@ -59,7 +59,9 @@ pub enum Command {
     )]
     Check(check::Args),
     /// Derive and draw a program: SVG, PNG, OBJ or text by the output's extension.
-    #[command(after_help = "Examples:\n  lsyc run lang-examples/koch-island.lsy -o koch.svg\n  lsyc run lang-examples/plant-e.lsy -n 6 -o plant.png --size 800\n  lsyc run lang-examples/monopodial-tree.lsy -D r2=0.7 --stats\n  lsyc run lang-examples/hilbert-3d.lsy -o hilbert.obj\n  lsyc run lang-examples/stochastic-plant.lsy --seed 7 -o plant.svg")]
+    #[command(
+        after_help = "Examples:\n  lsyc run lang-examples/koch-island.lsy -o koch.svg\n  lsyc run lang-examples/plant-e.lsy -n 6 -o plant.png --size 800\n  lsyc run lang-examples/monopodial-tree.lsy -D r2=0.7 --stats\n  lsyc run lang-examples/hilbert-3d.lsy -o hilbert.obj\n  lsyc run lang-examples/stochastic-plant.lsy --seed 7 -o plant.svg"
+    )]
     Run(run::Args),
     /// Print a program in canonical form (comments kept).
     #[command(

@@ -97,7 +97,9 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     };
     if let Some(n) = args.threads {
         // Only the first call in a process can set the global pool; later calls are harmless.
-        let _ = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global();
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build_global();
     }
     let src = match source::read(&args.file) {
         Ok(s) => s,
@@ -106,14 +108,14 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
             return 1;
         }
     };
-    if let Some(out) = &args.output {
-        if same_file(out, &args.file) {
-            reporter.say(&format!(
-                "error: the output `{}` is the input program; choose another file",
-                out.display()
-            ));
-            return 2;
-        }
+    if let Some(out) = &args.output
+        && same_file(out, &args.file)
+    {
+        reporter.say(&format!(
+            "error: the output `{}` is the input program; choose another file",
+            out.display()
+        ));
+        return 2;
     }
     let fe = frontend::run(&src.text, src.diagnostics, &ovr);
     reporter.emit(&fe.diagnostics, &src.name, &src.text);
@@ -136,7 +138,11 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
                 0
             }
             Err(m) => {
-                reporter.emit(&[Diagnostic::error(Code::UnknownSystem, m)], &src.name, &src.text);
+                reporter.emit(
+                    &[Diagnostic::error(Code::UnknownSystem, m)],
+                    &src.name,
+                    &src.text,
+                );
                 1
             }
         };
@@ -207,10 +213,10 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         },
     };
     let stats = Stats::new(&derived, &drawn, start.elapsed().as_secs_f64() * 1000.0);
-    if args.stats {
-        if let Ok(s) = serde_json::to_string(&stats) {
-            println!("{s}");
-        }
+    if args.stats
+        && let Ok(s) = serde_json::to_string(&stats)
+    {
+        println!("{s}");
     }
     let wrote = args
         .output
@@ -242,7 +248,9 @@ fn progress_bar(steps: Option<u32>) -> Option<indicatif::ProgressBar> {
         return None;
     }
     let bar = indicatif::ProgressBar::new(u64::from(steps.unwrap_or(0)));
-    if let Ok(style) = indicatif::ProgressStyle::with_template("deriving {bar:30} step {pos}/{len} {msg}") {
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("deriving {bar:30} step {pos}/{len} {msg}")
+    {
         bar.set_style(style);
     }
     Some(bar)

@@ -110,10 +110,10 @@ pub fn derive(
     limits: Limits,
     progress: &(dyn Fn(u32, usize) + Sync),
 ) -> Result<ModString, DeriveError> {
-    if let Some(table) = &prog.d0l {
-        if !prog.has_cut {
-            d0l_forecast(table, &start, steps, limits)?;
-        }
+    if let Some(table) = &prog.d0l
+        && !prog.has_cut
+    {
+        d0l_forecast(table, &start, steps, limits)?;
     }
     let mut s = start;
     for k in 1..=steps {

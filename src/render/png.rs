@@ -12,6 +12,9 @@ use tiny_skia::{
 /// Segments batched into one path before it is stroked.
 const BATCH: usize = 4096;
 
+/// An element ready to paint: its outline, fill and optional stroke colour.
+type Painted = (tiny_skia::Path, [u8; 3], Option<[u8; 3]>);
+
 pub struct PngWriter {
     pixmap: Pixmap,
     view: View,
@@ -19,7 +22,7 @@ pub struct PngWriter {
     max: DVec2,
     k: f64,
     off: DVec2,
-    elements: Vec<Option<(tiny_skia::Path, [u8; 3], Option<[u8; 3]>)>>,
+    elements: Vec<Option<Painted>>,
     batch: PathBuilder,
     batch_len: usize,
     style: (f64, u32),
@@ -31,7 +34,9 @@ pub fn parse_color(s: &str) -> Option<[u8; 3]> {
     if let Some(rgb) = parse_hex(s) {
         return Some(rgb);
     }
-    s.parse::<svgtypes::Color>().ok().map(|c| [c.red, c.green, c.blue])
+    s.parse::<svgtypes::Color>()
+        .ok()
+        .map(|c| [c.red, c.green, c.blue])
 }
 
 fn element_path(d: &str) -> Option<tiny_skia::Path> {
@@ -41,9 +46,16 @@ fn element_path(d: &str) -> Option<tiny_skia::Path> {
         match seg.ok()? {
             S::MoveTo { x, y } => pb.move_to(x as f32, y as f32),
             S::LineTo { x, y } => pb.line_to(x as f32, y as f32),
-            S::CurveTo { x1, y1, x2, y2, x, y } => {
-                pb.cubic_to(x1 as f32, y1 as f32, x2 as f32, y2 as f32, x as f32, y as f32)
-            }
+            S::CurveTo {
+                x1,
+                y1,
+                x2,
+                y2,
+                x,
+                y,
+            } => pb.cubic_to(
+                x1 as f32, y1 as f32, x2 as f32, y2 as f32, x as f32, y as f32,
+            ),
             S::Quadratic { x1, y1, x, y } => pb.quad_to(x1 as f32, y1 as f32, x as f32, y as f32),
             S::ClosePath => pb.close(),
         }
@@ -53,7 +65,13 @@ fn element_path(d: &str) -> Option<tiny_skia::Path> {
 
 impl PngWriter {
     /// An image of at most `size` pixels on its longer side.
-    pub fn new(size: u32, background: [u8; 4], view: View, bounds: &Bounds, elements: &[ElementDef]) -> Option<PngWriter> {
+    pub fn new(
+        size: u32,
+        background: [u8; 4],
+        view: View,
+        bounds: &Bounds,
+        elements: &[ElementDef],
+    ) -> Option<PngWriter> {
         let (min, max) = bounds.framed(0.03);
         let ext = max - min;
         let (w, h) = if ext.x >= ext.y {
@@ -62,13 +80,22 @@ impl PngWriter {
             (((size as f64) * ext.x / ext.y).ceil().max(1.0) as u32, size)
         };
         let mut pixmap = Pixmap::new(w.max(1), h.max(1))?;
-        pixmap.fill(Color::from_rgba8(background[0], background[1], background[2], background[3]));
+        pixmap.fill(Color::from_rgba8(
+            background[0],
+            background[1],
+            background[2],
+            background[3],
+        ));
         let k = (w as f64 / ext.x).min(h as f64 / ext.y);
         let off = DVec2::new((w as f64 - ext.x * k) / 2.0, (h as f64 - ext.y * k) / 2.0);
         let elements = elements
             .iter()
             .map(|e| {
-                let fill = e.fill.as_deref().and_then(parse_color).unwrap_or([63, 127, 58]);
+                let fill = e
+                    .fill
+                    .as_deref()
+                    .and_then(parse_color)
+                    .unwrap_or([63, 127, 58]);
                 let stroke = e.stroke.as_deref().and_then(parse_color);
                 element_path(&e.path).map(|p| (p, fill, stroke))
             })
@@ -110,12 +137,17 @@ impl PngWriter {
         paint.set_color_rgba8(rgb[0], rgb[1], rgb[2], 255);
         paint.anti_alias = true;
         let stroke = Stroke {
-            width: if width > 0.0 { (width * self.k).max(0.6) as f32 } else { 1.2 },
+            width: if width > 0.0 {
+                (width * self.k).max(0.6) as f32
+            } else {
+                1.2
+            },
             line_cap: LineCap::Round,
             line_join: LineJoin::Round,
             ..Stroke::default()
         };
-        self.pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+        self.pixmap
+            .stroke_path(&path, &paint, &stroke, Transform::identity(), None);
     }
 
     /// Finishes drawing and encodes the image.
@@ -159,7 +191,13 @@ impl Sink for PngWriter {
             let mut paint = Paint::default();
             paint.set_color_rgba8(rgb[0], rgb[1], rgb[2], 255);
             paint.anti_alias = true;
-            self.pixmap.fill_path(&path, &paint, FillRule::EvenOdd, Transform::identity(), None);
+            self.pixmap.fill_path(
+                &path,
+                &paint,
+                FillRule::EvenOdd,
+                Transform::identity(),
+                None,
+            );
         }
     }
 
@@ -185,7 +223,8 @@ impl Sink for PngWriter {
         paint.set_color_rgba8(fill[0], fill[1], fill[2], 255);
         paint.anti_alias = true;
         let path = path.clone();
-        self.pixmap.fill_path(&path, &paint, FillRule::Winding, t, None);
+        self.pixmap
+            .fill_path(&path, &paint, FillRule::Winding, t, None);
         if let Some(s) = stroke {
             paint.set_color_rgba8(s[0], s[1], s[2], 255);
             let stroke = Stroke {
@@ -194,7 +233,8 @@ impl Sink for PngWriter {
             };
             // A hairline in pixels: stroke the transformed path.
             if let Some(p) = path.transform(t) {
-                self.pixmap.stroke_path(&p, &paint, &stroke, Transform::identity(), None);
+                self.pixmap
+                    .stroke_path(&p, &paint, &stroke, Transform::identity(), None);
             }
         }
     }

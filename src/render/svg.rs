@@ -22,7 +22,13 @@ pub struct SvgWriter<W: Write> {
 
 impl<W: Write> SvgWriter<W> {
     /// Starts the document; `bounds` are the projected bounds of the drawing.
-    pub fn new(mut out: W, view: View, bounds: &Bounds, elements: &[ElementDef], used: &[bool]) -> io::Result<SvgWriter<W>> {
+    pub fn new(
+        mut out: W,
+        view: View,
+        bounds: &Bounds,
+        elements: &[ElementDef],
+        used: &[bool],
+    ) -> io::Result<SvgWriter<W>> {
         let (min, max) = bounds.framed(0.02);
         let size = max - min;
         let extent = size.x.max(size.y);
@@ -84,10 +90,10 @@ impl<W: Write> SvgWriter<W> {
     }
 
     fn write(&mut self, bytes: &[u8]) {
-        if self.error.is_none() {
-            if let Err(e) = self.out.write_all(bytes) {
-                self.error = Some(e);
-            }
+        if self.error.is_none()
+            && let Err(e) = self.out.write_all(bytes)
+        {
+            self.error = Some(e);
         }
     }
 
@@ -172,8 +178,14 @@ impl<W: Write> Sink for SvgWriter<W> {
         let ey = self.view.project_dir(h * scale);
         let d = self.decimals + 3;
         let mut buf = Vec::new();
-        buf.extend_from_slice(format!("<use href=\"#e{index}\" xlink:href=\"#e{index}\" transform=\"matrix(").as_bytes());
-        for (k, v) in [ex.x, -ex.y, ey.x, -ey.y, o.x, -o.y].into_iter().enumerate() {
+        buf.extend_from_slice(
+            format!("<use href=\"#e{index}\" xlink:href=\"#e{index}\" transform=\"matrix(")
+                .as_bytes(),
+        );
+        for (k, v) in [ex.x, -ex.y, ey.x, -ey.y, o.x, -o.y]
+            .into_iter()
+            .enumerate()
+        {
             if k > 0 {
                 buf.push(b' ');
             }
@@ -251,6 +263,6 @@ mod tests {
         assert_eq!(n(0.0405, 3), "0.041");
         assert_eq!(n(12.0, 0), "12");
         assert_eq!(n(-0.001, 3), "-0.001");
-        assert_eq!(n(3.14159, 2), "3.14");
+        assert_eq!(n(1.23456, 2), "1.23");
     }
 }

@@ -18,13 +18,17 @@ fn derive_text(text: &str, steps: Option<u32>) -> Result<Derived, String> {
         steps,
         ..Options::default()
     };
-    run::derive(&fe.file, checked, &opts, &|_, _| {}).map_err(|d| render_plain(&[d], "test.lsy", text))
+    run::derive(&fe.file, checked, &opts, &|_, _| {})
+        .map_err(|d| render_plain(&[d], "test.lsy", text))
 }
 
 fn txt(d: &Derived) -> String {
     let mut out = Vec::new();
     run::write_output(d, Format::Txt, Picture::default(), 0, &mut out).ok();
-    String::from_utf8(out).unwrap_or_default().trim_end().to_string()
+    String::from_utf8(out)
+        .unwrap_or_default()
+        .trim_end()
+        .to_string()
 }
 
 #[test]
@@ -38,7 +42,10 @@ fn d0l_strings_match_hand_derivations() {
     }
     let koch = "lsystem K { axiom F-F-F-F; F -> F-F+F+FF-F-F+F; }";
     let d = derive_text(koch, Some(1)).expect("derives");
-    assert_eq!(txt(&d), "F-F+F+FF-F-F+F-F-F+F+FF-F-F+F-F-F+F+FF-F-F+F-F-F+F+FF-F-F+F");
+    assert_eq!(
+        txt(&d),
+        "F-F+F+FF-F-F+F-F-F+F+FF-F-F+F-F-F+F+FF-F-F+F-F-F+F+FF-F-F+F"
+    );
     // Erasure, brackets and the identity of modules without rules.
     let d = derive_text("lsystem E { axiom A[B]C; A -> ; B -> BB; }", Some(2)).expect("derives");
     assert_eq!(txt(&d), "[BBBB]C");
@@ -47,11 +54,20 @@ fn d0l_strings_match_hand_derivations() {
 #[test]
 fn parametric_conditions_context_and_cut() {
     let src = "lsystem P { axiom A(0); A(x) : x < 3 -> F(x) A(x + 1); A(x) -> B(x * 2); }";
-    assert_eq!(txt(&derive_text(src, Some(4)).expect("derives")), "F(0) F(1) F(2) B(6)");
+    assert_eq!(
+        txt(&derive_text(src, Some(4)).expect("derives")),
+        "F(0) F(1) F(2) B(6)"
+    );
     // Context: a signal moving right, skipping the branch and the ignored `+`.
     let src = "lsystem S { ignore +; axiom b a [a] + a a; b < a -> b; b -> a; }";
-    assert_eq!(txt(&derive_text(src, Some(1)).expect("derives")), "ab[a]+aa");
-    assert_eq!(txt(&derive_text(src, Some(2)).expect("derives")), "aa[b]+ba");
+    assert_eq!(
+        txt(&derive_text(src, Some(1)).expect("derives")),
+        "ab[a]+aa"
+    );
+    assert_eq!(
+        txt(&derive_text(src, Some(2)).expect("derives")),
+        "aa[b]+ba"
+    );
     // Right context across a branch.
     let src = "lsystem R { axiom A[X]B; A > B -> C; }";
     assert_eq!(txt(&derive_text(src, Some(1)).expect("derives")), "C[X]B");
@@ -116,7 +132,10 @@ fn the_3d_hilbert_curve_visits_every_cell_once() {
         }
         assert_eq!(seen.len(), cells, "n = {n}: every cell of the cube once");
         let side = 2i64.pow(n) - 1;
-        assert!(seen.iter().all(|&(x, y, z)| [x, y, z].iter().all(|c| c.abs() <= side)));
+        assert!(
+            seen.iter()
+                .all(|&(x, y, z)| [x, y, z].iter().all(|c| c.abs() <= side))
+        );
     }
 }
 
@@ -126,12 +145,20 @@ fn turtle_conventions() {
     let d = derive_text("lsystem T { angle 90; axiom F+F; }", None).expect("derives");
     let mut pts = Points::default();
     turtle::interpret(&d.prog, &d.string, 0, &mut pts).expect("draws");
-    assert!((pts.0[1].1 - DVec3::new(-1.0, 1.0, 0.0)).length() < 1e-12, "{:?}", pts.0);
+    assert!(
+        (pts.0[1].1 - DVec3::new(-1.0, 1.0, 0.0)).length() < 1e-12,
+        "{:?}",
+        pts.0
+    );
     // `&` pitches down: the heading goes toward -U = -z.
     let d = derive_text("lsystem T { angle 90; axiom &F; }", None).expect("derives");
     let mut pts = Points::default();
     turtle::interpret(&d.prog, &d.string, 0, &mut pts).expect("draws");
-    assert!((pts.0[0].1 - DVec3::new(0.0, 0.0, -1.0)).length() < 1e-12, "{:?}", pts.0);
+    assert!(
+        (pts.0[0].1 - DVec3::new(0.0, 0.0, -1.0)).length() < 1e-12,
+        "{:?}",
+        pts.0
+    );
     // `*` scales, `[ ]` restore, `|` turns around.
     let d = derive_text("lsystem T { axiom F[*(2)F]|F; }", None).expect("draws");
     let mut pts = Points::default();
@@ -162,7 +189,10 @@ fn gallery_stats() {
             }
             let d = derive_text(&text, None).unwrap_or_else(|e| panic!("{}: {e}", rel(path)));
             let v = stats_of(&d);
-            insta::assert_snapshot!("stats", serde_json::to_string_pretty(&v).unwrap_or_default());
+            insta::assert_snapshot!(
+                "stats",
+                serde_json::to_string_pretty(&v).unwrap_or_default()
+            );
         });
     });
 }
@@ -197,11 +227,23 @@ fn outputs_are_deterministic_across_runs_and_threads() {
         let mut outs = Vec::new();
         for (k, threads) in ["1", "2", "1"].iter().enumerate() {
             let out = dir.path().join(format!("{prog}-{k}.svg"));
-            let o = lsyc(&["run", input, "-o", out.to_str().expect("utf-8"), "--seed", "7", "--threads", threads]);
+            let o = lsyc(&[
+                "run",
+                input,
+                "-o",
+                out.to_str().expect("utf-8"),
+                "--seed",
+                "7",
+                "--threads",
+                threads,
+            ]);
             assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
             outs.push(std::fs::read(&out).expect("written"));
         }
-        assert!(outs[0] == outs[1] && outs[1] == outs[2], "{prog}: outputs differ");
+        assert!(
+            outs[0] == outs[1] && outs[1] == outs[2],
+            "{prog}: outputs differ"
+        );
     }
 }
 
@@ -213,7 +255,14 @@ fn svg_rereads_with_usvg_and_png_decodes() {
         let svg = dir.path().join(format!("{prog}.svg"));
         let png = dir.path().join(format!("{prog}.png"));
         for out in [&svg, &png] {
-            let o = lsyc(&["run", input.to_str().expect("utf-8"), "-o", out.to_str().expect("utf-8"), "--size", "300"]);
+            let o = lsyc(&[
+                "run",
+                input.to_str().expect("utf-8"),
+                "-o",
+                out.to_str().expect("utf-8"),
+                "--size",
+                "300",
+            ]);
             assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         }
         let data = std::fs::read(&svg).expect("svg");
@@ -223,7 +272,11 @@ fn svg_rereads_with_usvg_and_png_decodes() {
         let bytes = std::fs::read(&png).expect("png");
         let pixmap = tiny_skia::Pixmap::decode_png(&bytes).expect("a PNG");
         assert_eq!(pixmap.width().max(pixmap.height()), 300);
-        let ink = pixmap.pixels().iter().filter(|p| p.red() < 200 || p.green() < 200).count();
+        let ink = pixmap
+            .pixels()
+            .iter()
+            .filter(|p| p.red() < 200 || p.green() < 200)
+            .count();
         assert!(ink > 100, "{prog}: the picture is blank");
     }
 }
@@ -236,27 +289,49 @@ fn text_output_parses_back_as_an_axiom() {
         if text.contains("\nscene ") {
             continue;
         }
-        let Ok(d) = derive_text(&text, Some(2)) else { continue };
+        let Ok(d) = derive_text(&text, Some(2)) else {
+            continue;
+        };
         let s = txt(&d);
         if s.len() > 20_000 {
             continue;
         }
         let program = format!("lsystem Again {{ axiom {s}; }}");
         let parsed = lsyc::parser::parse(&program);
-        let errs: Vec<_> = parsed.diagnostics.iter().filter(|d| d.is_error()).cloned().collect();
-        assert!(errs.is_empty(), "{}: {}", rel(&path), render_plain(&errs, "again", &program));
+        let errs: Vec<_> = parsed
+            .diagnostics
+            .iter()
+            .filter(|d| d.is_error())
+            .cloned()
+            .collect();
+        assert!(
+            errs.is_empty(),
+            "{}: {}",
+            rel(&path),
+            render_plain(&errs, "again", &program)
+        );
     }
 }
 
 #[test]
 fn runtime_errors_point_at_the_expression() {
     let src = "lsystem Z {\n    axiom A(3);\n    A(x) -> A(x - 1) F(10 / x);\n}\n";
-    let err = derive_text(src, Some(5)).err().expect("fails");
-    assert!(err.contains("error[E0901]") && err.contains("step 4"), "{err}");
+    let Err(err) = derive_text(src, Some(5)) else {
+        panic!("expected an error");
+    };
+    assert!(
+        err.contains("error[E0901]") && err.contains("step 4"),
+        "{err}"
+    );
     assert!(err.contains("test.lsy:3:24"), "{err}");
     let src = "lsystem N {\n    axiom A(-1);\n    A(x) -> F(sqrt(x));\n}\n";
-    let err = derive_text(src, Some(1)).err().expect("fails");
-    assert!(err.contains("error[E0902]") && err.contains("test.lsy:3:15"), "{err}");
+    let Err(err) = derive_text(src, Some(1)) else {
+        panic!("expected an error");
+    };
+    assert!(
+        err.contains("error[E0902]") && err.contains("test.lsy:3:15"),
+        "{err}"
+    );
     // && does not evaluate its right side when the left is false.
     let src = "lsystem G { axiom A(0); A(x) : x != 0 && 1 / x > 2 -> B; }";
     assert!(derive_text(src, Some(1)).is_ok());
@@ -266,25 +341,44 @@ fn runtime_errors_point_at_the_expression() {
 fn an_explosion_stops_quickly_with_a_clear_error() {
     let src = "lsystem Boom { axiom F; F -> FFFFFFFFFF; }";
     let start = std::time::Instant::now();
-    let err = derive_text(src, Some(40)).err().expect("stops");
-    assert!(start.elapsed().as_secs_f64() < 1.0, "took {:?}", start.elapsed());
-    assert!(err.contains("error[E0903]") && err.contains("modules"), "{err}");
+    let Err(err) = derive_text(src, Some(40)) else {
+        panic!("expected an error");
+    };
+    assert!(
+        start.elapsed().as_secs_f64() < 1.0,
+        "took {:?}",
+        start.elapsed()
+    );
+    assert!(
+        err.contains("error[E0903]") && err.contains("modules"),
+        "{err}"
+    );
 }
 
 #[test]
 fn endless_interpretation_is_an_error() {
     let src = "lsystem I { axiom A; interpret A -> B; interpret B -> A F; }";
     let d = derive_text(src, Some(0)).expect("derives");
-    let err = run::measure(&d, 0).err().expect("fails");
+    let err = run::measure(&d, 0).expect_err("fails");
     assert_eq!(err.code, lsyc::diagnostic::Code::InterpretTooDeep);
 }
 
 #[test]
 fn disassembly_snapshots() {
     for prog in ["monopodial-tree", "stochastic-plant", "hogeweg-plant"] {
-        let out = lsyc(&["run", root().join(format!("lang-examples/{prog}.lsy")).to_str().expect("utf-8"), "--disasm"]);
+        let out = lsyc(&[
+            "run",
+            root()
+                .join(format!("lang-examples/{prog}.lsy"))
+                .to_str()
+                .expect("utf-8"),
+            "--disasm",
+        ]);
         assert!(out.status.success());
-        insta::assert_snapshot!(format!("disasm_{prog}"), String::from_utf8_lossy(&out.stdout));
+        insta::assert_snapshot!(
+            format!("disasm_{prog}"),
+            String::from_utf8_lossy(&out.stdout)
+        );
     }
 }
 
@@ -296,7 +390,10 @@ fn run_refuses_to_overwrite_its_input_and_unknown_formats() {
     let ps = p.to_str().expect("utf-8");
     let o = lsyc(&["run", ps, "-o", ps]);
     assert_eq!(o.status.code(), Some(2));
-    assert_eq!(std::fs::read_to_string(&p).expect("read"), "lsystem A { axiom F; }\n");
+    assert_eq!(
+        std::fs::read_to_string(&p).expect("read"),
+        "lsystem A { axiom F; }\n"
+    );
     let o = lsyc(&["run", ps, "-o", "x.pdf"]);
     assert_eq!(o.status.code(), Some(2));
 }
