@@ -18,8 +18,7 @@ use crate::compile::Program;
 use crate::turtle::Sink;
 use glam::{DQuat, DVec3};
 use std::collections::{HashMap, VecDeque};
-use std::fmt;
-use std::io::{self, BufWriter, Write};
+use std::io::{self, Write};
 
 /// Chains whose end may still be continued (after a `]`); older ones are closed.
 pub const MAX_OPEN_CHAINS: usize = 64;
@@ -30,8 +29,15 @@ pub const MAX_JOINTS: usize = 1 << 16;
 const MITRE_MIN_COS: f64 = -0.173_648_177_666_930_3;
 /// A mitre may reach back at most this fraction of either segment's length.
 const MITRE_MAX_REACH: f64 = 0.45;
+/// The most vertices per ring.
+pub const MAX_SIDES: usize = 256;
 /// Line pieces per curve when flattening element paths.
 const CURVE_STEPS: usize = 8;
+/// Relative resolution of written coordinates (7 significant digits), with
+/// a margin: shorter segments and thinner tubes would collapse.
+const RESOLUTION: f64 = 1e-5;
+/// Output is assembled in a buffer of this size before it is written.
+const BUFFER: usize = 1 << 16;
 
 /// A flattened closed outline in an element's local frame (x right, y forward).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -42,7 +48,7 @@ pub struct ElementOutline {
 /// How the mesh is built.
 #[derive(Clone, Debug)]
 pub struct ObjOptions {
-    /// Vertices per tube ring (at least 3).
+    /// Vertices per tube ring (clamped to 3..=`MAX_SIDES`).
     pub sides: usize,
     /// Tube radius for hairlines (width 0).
     pub default_radius: f64,
@@ -221,7 +227,10 @@ struct Counts {
 /// A streaming OBJ writer. Call [`ObjWriter::finish`] to close the open tubes
 /// and flush; dropping it without `finish` leaves the output incomplete.
 pub struct ObjWriter<W: Write> {
-    out: BufWriter<W>,
+    out: W,
+    /// Text not yet written to `out`.
+    buf: Vec<u8>,
+    /// The first write error; nothing is written after it.
     error: Option<io::Error>,
     sides: usize,
     /// cos, sin of the ring angles.
@@ -242,7 +251,7 @@ pub struct ObjWriter<W: Write> {
 
 impl<W: Write> ObjWriter<W> {
     pub fn new(out: W, options: ObjOptions) -> Self {
-        let sides = options.sides.max(3);
+        let sides = options.sides.clamp(3, MAX_SIDES);
         let ring_angles = (0..sides)
             .map(|i| {
                 let t = std::f64::consts::TAU * i as f64 / sides as f64;
@@ -259,14 +268,19 @@ impl<W: Write> ObjWriter<W> {
             .into_iter()
             .map(|e| {
                 let mut pts = clean_outline(e.points);
-                if signed_area(&pts) < 0.0 {
+                let area = signed_area(&pts);
+                if area < 0.0 {
                     pts.reverse();
+                }
+                if pts.len() < 3 || area == 0.0 {
+                    pts.clear();
                 }
                 pts
             })
             .collect();
         let mut w = ObjWriter {
-            out: BufWriter::with_capacity(1 << 16, out),
+            out,
+            buf: Vec::with_capacity(BUFFER + 256),
             error: None,
             sides,
             ring_angles,
@@ -280,7 +294,7 @@ impl<W: Write> ObjWriter<W> {
             material: 0,
             counts: Counts::default(),
         };
-        w.write(format_args!(
+        w.text(&format!(
             "# lsyc OBJ: segments as closed tubes ({sides} sides), polygons and elements as faces\n"
         ));
         w
@@ -293,51 +307,86 @@ impl<W: Write> ObjWriter<W> {
             self.close(chain);
         }
         let (c, v) = (self.counts, self.v);
-        self.write(format_args!(
+        self.text(&format!(
             "# {} tubes, {} spheres, {} polygons, {} elements; {v} vertices, {} faces\n",
             c.tubes, c.spheres, c.polygons, c.elements, c.faces
         ));
+        self.drain();
         if let Some(e) = self.error.take() {
             return Err(e);
         }
-        let mut w = self.out.into_inner().map_err(|e| e.into_error())?;
-        w.flush()?;
-        Ok(w)
+        self.out.flush()?;
+        Ok(self.out)
     }
 
-    fn write(&mut self, args: fmt::Arguments) {
-        if self.error.is_none() {
-            if let Err(e) = self.out.write_fmt(args) {
-                self.error = Some(e);
-            }
+    /// Writes the buffer out (or drops it after an error).
+    fn drain(&mut self) {
+        if self.error.is_none()
+            && let Err(e) = self.out.write_all(&self.buf)
+        {
+            self.error = Some(e);
+        }
+        self.buf.clear();
+    }
+
+    /// Ends a line; writes the buffer out when it is full.
+    fn end_line(&mut self) {
+        self.buf.push(b'\n');
+        if self.buf.len() >= BUFFER {
+            self.drain();
         }
     }
 
+    fn text(&mut self, t: &str) {
+        self.buf.extend_from_slice(t.as_bytes());
+        if self.buf.len() >= BUFFER {
+            self.drain();
+        }
+    }
+
+    fn triple(&mut self, tag: &[u8], p: DVec3) {
+        self.buf.extend_from_slice(tag);
+        for x in [p.x, p.y, p.z] {
+            self.buf.push(b' ');
+            push_number(&mut self.buf, x);
+        }
+        self.end_line();
+    }
+
     fn vertex(&mut self, p: DVec3) -> u64 {
-        self.write(format_args!("v {} {} {}\n", f(p.x), f(p.y), f(p.z)));
+        self.triple(b"v", p);
         self.v += 1;
         self.v
     }
 
     fn normal(&mut self, n: DVec3) -> u64 {
-        self.write(format_args!("vn {} {} {}\n", f(n.x), f(n.y), f(n.z)));
+        self.triple(b"vn", n);
         self.vn += 1;
         self.vn
     }
 
+    /// A corner ` v//vn` of a face line.
+    fn corner(&mut self, (v, n): (u64, u64)) {
+        self.buf.push(b' ');
+        push_int(&mut self.buf, v);
+        put(&mut self.buf, b"//");
+        push_int(&mut self.buf, n);
+    }
+
     /// A triangle of (vertex, normal) pairs, counter-clockwise seen from outside.
     fn tri(&mut self, a: (u64, u64), b: (u64, u64), c: (u64, u64)) {
-        self.write(format_args!(
-            "f {}//{} {}//{} {}//{}\n",
-            a.0, a.1, b.0, b.1, c.0, c.1
-        ));
+        self.buf.push(b'f');
+        self.corner(a);
+        self.corner(b);
+        self.corner(c);
+        self.end_line();
         self.counts.faces += 1;
     }
 
     fn material(&mut self, color: u32) {
         if color != self.material {
             self.material = color;
-            self.write(format_args!("usemtl lsyc_color{color}\n"));
+            self.text(&format!("usemtl lsyc_color{color}\n"));
         }
     }
 
@@ -351,7 +400,13 @@ impl<W: Write> ObjWriter<W> {
     }
 
     /// Writes a ring: vertex i at `point(i)`, normal i `normal(i)`.
-    fn ring(&mut self, point: impl Fn(DVec3) -> DVec3, normal: impl Fn(DVec3) -> DVec3, n: DVec3, dir: DVec3) -> Ring {
+    fn ring(
+        &mut self,
+        point: impl Fn(DVec3) -> DVec3,
+        normal: impl Fn(DVec3) -> DVec3,
+        n: DVec3,
+        dir: DVec3,
+    ) -> Ring {
         let b = dir.cross(n);
         let first_v = self.v + 1;
         let first_n = self.vn + 1;
@@ -370,13 +425,19 @@ impl<W: Write> ObjWriter<W> {
         }
     }
 
-    /// The side of a tube between two rings (`a` behind `b`).
+    /// The side of a tube between two rings (`a` behind `b`): one quad per side
+    /// (planar unless the radius changes).
     fn side(&mut self, a: Ring, b: Ring) {
         let k = self.sides as u64;
         for i in 0..k {
             let j = (i + 1) % k;
-            self.tri((a.v + i, a.n + i), (a.v + j, a.n + j), (b.v + j, b.n + j));
-            self.tri((a.v + i, a.n + i), (b.v + j, b.n + j), (b.v + i, b.n + i));
+            self.buf.push(b'f');
+            self.corner((a.v + i, a.n + i));
+            self.corner((a.v + j, a.n + j));
+            self.corner((b.v + j, b.n + j));
+            self.corner((b.v + i, b.n + i));
+            self.end_line();
+            self.counts.faces += 1;
         }
     }
 
@@ -414,7 +475,10 @@ impl<W: Write> ObjWriter<W> {
                 self.normal(d);
             }
         }
-        let sp = (self.vertex(centre - DVec3::Z * r), self.normal(DVec3::NEG_Z));
+        let sp = (
+            self.vertex(centre - DVec3::Z * r),
+            self.normal(DVec3::NEG_Z),
+        );
         // Vertices and normals are counted separately: both index the same way.
         let at = |j: u64, i: u64| {
             let k = (j - 1) * lon + i % lon;
@@ -476,7 +540,9 @@ impl<W: Write> ObjWriter<W> {
         );
         self.side(chain.ring, ring);
         let n = rot * chain.n;
-        let n = (n - dir * dir.dot(n)).try_normalize().unwrap_or_else(|| perpendicular(dir));
+        let n = (n - dir * dir.dot(n))
+            .try_normalize()
+            .unwrap_or_else(|| perpendicular(dir));
         Chain {
             end: b,
             dir,
@@ -488,19 +554,25 @@ impl<W: Write> ObjWriter<W> {
         }
     }
 
-    /// Remembers that a tube of radius `r` reached `p`; returns the joint.
+    /// Remembers that a tube of radius `r` reached `p`.
     fn remember(&mut self, p: DVec3, r: f64) {
         let k = key(p);
         if let Some(j) = self.joints.get_mut(&k) {
             j.radius = j.radius.max(r);
             return;
         }
-        if self.joint_order.len() >= MAX_JOINTS {
-            if let Some(old) = self.joint_order.pop_front() {
-                self.joints.remove(&old);
-            }
+        if self.joint_order.len() >= MAX_JOINTS
+            && let Some(old) = self.joint_order.pop_front()
+        {
+            self.joints.remove(&old);
         }
-        self.joints.insert(k, Joint { radius: r, sphere: 0.0 });
+        self.joints.insert(
+            k,
+            Joint {
+                radius: r,
+                sphere: 0.0,
+            },
+        );
         self.joint_order.push_back(k);
     }
 
@@ -548,12 +620,24 @@ impl<W: Write> Sink for ObjWriter<W> {
         if !(a.is_finite() && b.is_finite()) {
             return;
         }
+        // Lengths and radii below what the written digits resolve would give
+        // faces of zero area: such segments only move their chain's end, and
+        // radii are at least that resolution.
+        let resolution = RESOLUTION * a.abs().max(b.abs()).max_element().max(1e-9);
         let len = (b - a).length();
-        let dir = (b - a) / len;
-        if !(len > 0.0 && len.is_finite() && dir.is_finite() && dir.is_normalized()) {
+        if len <= resolution {
+            if let Some(c) = self.open.iter_mut().rev().find(|c| c.end == a) {
+                c.end = b;
+                let r = c.radius;
+                self.remember(b, r);
+            }
             return;
         }
-        let r = self.radius(width);
+        let dir = (b - a) / len;
+        if !(len.is_finite() && dir.is_finite() && dir.is_normalized()) {
+            return;
+        }
+        let r = self.radius(width).max(resolution);
         if let Some(i) = self.open.iter().rposition(|c| c.end == a) {
             let chain = self.open.remove(i);
             if Self::can_mitre(&chain, dir, len, r) {
@@ -581,24 +665,9 @@ impl<W: Write> Sink for ObjWriter<W> {
         while pts.len() > 1 && pts.first() == pts.last() {
             pts.pop();
         }
-        if pts.len() < 3 {
-            return;
+        if pts.len() >= 3 && self.face(&pts, None, color) {
+            self.counts.polygons += 1;
         }
-        // Newell's normal: the polygon's area vector.
-        let mut area = DVec3::ZERO;
-        for i in 0..pts.len() {
-            let (p, q) = (pts[i], pts[(i + 1) % pts.len()]);
-            area += DVec3::new(
-                (p.y - q.y) * (p.z + q.z),
-                (p.z - q.z) * (p.x + q.x),
-                (p.x - q.x) * (p.y + q.y),
-            );
-        }
-        let Some(normal) = area.try_normalize() else {
-            return;
-        };
-        self.face(&pts, normal, color);
-        self.counts.polygons += 1;
     }
 
     fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32) {
@@ -615,41 +684,162 @@ impl<W: Write> Sink for ObjWriter<W> {
             .iter()
             .map(|&[x, y]| at + (-l * x + h * y) * scale)
             .collect();
-        if pts.iter().any(|p| !p.is_finite()) {
-            return;
+        if pts.iter().all(|p| p.is_finite()) && self.face(&pts, Some(normal), color) {
+            self.counts.elements += 1;
         }
-        self.face(&pts, normal, color);
-        self.counts.elements += 1;
     }
 }
 
 impl<W: Write> ObjWriter<W> {
-    /// One n-gon face with a single normal.
-    fn face(&mut self, pts: &[DVec3], normal: DVec3, color: u32) {
+    /// One n-gon face with a single normal (by default the polygon's own, by
+    /// Newell's method). Nothing is written for a face whose area the written
+    /// digits would not resolve.
+    fn face(&mut self, pts: &[DVec3], normal: Option<DVec3>, color: u32) -> bool {
+        let mut area = DVec3::ZERO;
+        let mut extent: f64 = 1e-9;
+        for (i, &p) in pts.iter().enumerate() {
+            let q = pts[(i + 1) % pts.len()];
+            area += p.cross(q);
+            extent = extent.max(p.abs().max_element());
+        }
+        let resolution = RESOLUTION * extent;
+        let Some(own) = area.try_normalize() else {
+            return false;
+        };
+        if 0.5 * area.length() <= resolution * resolution {
+            return false;
+        }
+        let normal = normal.unwrap_or(own);
         self.material(color);
         let first = self.v + 1;
         for &p in pts {
             self.vertex(p);
         }
         let n = self.normal(normal);
-        self.write(format_args!("f"));
+        self.buf.push(b'f');
         for k in 0..pts.len() as u64 {
-            self.write(format_args!(" {}//{n}", first + k));
+            self.corner((first + k, n));
         }
-        self.write(format_args!("\n"));
+        self.end_line();
         self.counts.faces += 1;
+        true
     }
 }
 
-/// A coordinate as written: single precision (about 7 significant digits),
-/// shortest form, no negative zero.
-fn f(x: f64) -> f32 {
-    x as f32 + 0.0
+/// Appends a few bytes (cheaper than a `memmove` call for short slices).
+fn put(buf: &mut Vec<u8>, bytes: &[u8]) {
+    for &b in bytes {
+        buf.push(b);
+    }
+}
+
+/// Appends a decimal integer.
+fn push_int(buf: &mut Vec<u8>, mut n: u64) {
+    const PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
+        2021222324252627282930313233343536373839\
+        4041424344454647484950515253545556575859\
+        6061626364656667686970717273747576777879\
+        8081828384858687888990919293949596979899";
+    let mut digits = [0u8; 20];
+    let mut i = digits.len();
+    while n >= 100 {
+        let r = (n % 100) as usize * 2;
+        n /= 100;
+        i -= 2;
+        digits[i..i + 2].copy_from_slice(&PAIRS[r..r + 2]);
+    }
+    if n >= 10 {
+        let r = n as usize * 2;
+        i -= 2;
+        digits[i..i + 2].copy_from_slice(&PAIRS[r..r + 2]);
+    } else {
+        i -= 1;
+        digits[i] = b'0' + n as u8;
+    }
+    put(buf, &digits[i..]);
+}
+
+/// Powers of ten exactly representable as `f64`.
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// `a / 10^(e − 6)` rounded (a > 0): the 7 significant digits of `a` when its
+/// decimal exponent is `e`.
+fn mantissa(a: f64, e: i32) -> u64 {
+    let k = 6 - e;
+    let p = POW10
+        .get(k.unsigned_abs() as usize)
+        .copied()
+        .unwrap_or_else(|| 10f64.powi(k.abs()));
+    (if k >= 0 { a * p } else { a / p } + 0.5) as u64
+}
+
+/// Appends a number with 7 significant digits (about single precision), in
+/// plain decimal notation without exponent, trailing zeros or negative zero.
+/// Deterministic: the same `f64` always gives the same text.
+fn push_number(buf: &mut Vec<u8>, x: f64) {
+    let a = x.abs();
+    if !(1e-15..1e22).contains(&a) {
+        // Zero (and rounding noise around it), non-finite (never written), or
+        // beyond the usual range.
+        if a < 1e-15 || !a.is_finite() {
+            buf.push(b'0');
+        } else {
+            let _ = write!(buf, "{}", x as f32);
+        }
+        return;
+    }
+    // The decimal exponent from the binary one (78913 / 2^18 ≈ log10 2), then
+    // corrected: the estimate may be one off, and rounding may carry to 10^7.
+    let e2 = ((a.to_bits() >> 52) & 0x7ff) as i32 - 1023;
+    let mut e = (e2 * 78913) >> 18;
+    let mut m = mantissa(a, e);
+    for _ in 0..3 {
+        if m >= 10_000_000 {
+            e += 1;
+        } else if m < 1_000_000 {
+            e -= 1;
+        } else {
+            break;
+        }
+        m = mantissa(a, e);
+    }
+    let mut mi = m.clamp(1_000_000, 9_999_999);
+    if x < 0.0 {
+        buf.push(b'-');
+    }
+    let mut digits = [0u8; 7];
+    for d in digits.iter_mut().rev() {
+        *d = b'0' + (mi % 10) as u8;
+        mi /= 10;
+    }
+    let used = digits.iter().rposition(|&d| d != b'0').map_or(1, |i| i + 1);
+    if e >= 6 {
+        put(buf, &digits);
+        buf.extend(std::iter::repeat_n(b'0', (e - 6) as usize));
+    } else if e >= 0 {
+        let int = e as usize + 1;
+        put(buf, &digits[..int]);
+        if used > int {
+            buf.push(b'.');
+            put(buf, &digits[int..used]);
+        }
+    } else {
+        buf.extend_from_slice(b"0.");
+        buf.extend(std::iter::repeat_n(b'0', (-e - 1) as usize));
+        put(buf, &digits[..used]);
+    }
 }
 
 /// The exact position as a map key (−0 and +0 are the same point).
 fn key(p: DVec3) -> [u64; 3] {
-    [(p.x + 0.0).to_bits(), (p.y + 0.0).to_bits(), (p.z + 0.0).to_bits()]
+    [
+        (p.x + 0.0).to_bits(),
+        (p.y + 0.0).to_bits(),
+        (p.z + 0.0).to_bits(),
+    ]
 }
 
 /// A unit vector perpendicular to the unit vector `d`, chosen deterministically.
@@ -775,8 +965,11 @@ mod tests {
 
     /// Each triangle's winding agrees with the normals it references.
     fn check_normals_agree(m: &Mesh) {
-        for face in m.faces.iter().filter(|f| f.len() == 3) {
-            let g = (m.v[face[1].0] - m.v[face[0].0]).cross(m.v[face[2].0] - m.v[face[0].0]);
+        for face in &m.faces {
+            let mut g = DVec3::ZERO;
+            for k in 0..face.len() {
+                g += m.v[face[k].0].cross(m.v[face[(k + 1) % face.len()].0]);
+            }
             for c in face {
                 assert!(g.dot(m.vn[c.1]) > 0.0, "face {face:?} against its normals");
             }
@@ -812,8 +1005,10 @@ mod tests {
                 parent[b] = a;
             }
         }
-        let used: std::collections::BTreeSet<usize> = m.faces.iter().flatten().map(|c| c.0).collect();
-        let roots: std::collections::BTreeSet<usize> = used.into_iter().map(|i| root(&mut parent, i)).collect();
+        let used: std::collections::BTreeSet<usize> =
+            m.faces.iter().flatten().map(|c| c.0).collect();
+        let roots: std::collections::BTreeSet<usize> =
+            used.into_iter().map(|i| root(&mut parent, i)).collect();
         roots.len()
     }
 
@@ -841,7 +1036,7 @@ mod tests {
         assert_eq!((m.tubes, m.spheres, parts(&m)), (1, 0, 1));
         // Two rings and two cap centres; sides, two caps.
         assert_eq!(m.v.len(), 2 * 8 + 2);
-        assert_eq!(m.faces.len(), 16 + 16);
+        assert_eq!(m.faces.len(), 8 + 16);
         assert!((volume(&m) - octagon(0.25) * 2.0).abs() < 1e-5);
         assert!(text.starts_with("# lsyc OBJ"));
     }
@@ -852,7 +1047,9 @@ mod tests {
             default_radius: 0.1,
             ..ObjOptions::default()
         };
-        let m = parse(&write_with(opts, |w| w.segment(DVec3::ZERO, v3(1.0, 0.0, 0.0), 0.0, 0)));
+        let m = parse(&write_with(opts, |w| {
+            w.segment(DVec3::ZERO, v3(1.0, 0.0, 0.0), 0.0, 0)
+        }));
         check_solid(&m);
         assert!((volume(&m) - octagon(0.1)).abs() < 1e-6);
     }
@@ -874,7 +1071,11 @@ mod tests {
         check_solid(&m);
         assert_eq!((m.tubes, m.spheres, parts(&m)), (1, 0, 1));
         // Mitres of a centrally symmetric section keep the volume: area × length.
-        assert!((volume(&m) - octagon(0.1) * 4.5).abs() < 1e-4, "{}", volume(&m));
+        assert!(
+            (volume(&m) - octagon(0.1) * 4.5).abs() < 1e-4,
+            "{}",
+            volume(&m)
+        );
         // Joint rings are shared: 5 rings + 2 centres.
         assert_eq!(m.v.len(), 5 * 8 + 2);
     }
@@ -897,7 +1098,13 @@ mod tests {
         // Between consecutive rings, vertex i keeps its radial direction seen
         // along the segment (no twist). The start ring comes first, then the
         // start cap's centre, then one ring per joint.
-        let ring = |r: usize, i: usize| if r == 0 { m.v[i] } else { m.v[9 + (r - 1) * 8 + i] };
+        let ring = |r: usize, i: usize| {
+            if r == 0 {
+                m.v[i]
+            } else {
+                m.v[9 + (r - 1) * 8 + i]
+            }
+        };
         let centre = |r: usize| (0..8).map(|i| ring(r, i)).sum::<DVec3>() / 8.0;
         for r in 0..40 {
             let d = (centre(r + 1) - centre(r)).normalize();
@@ -927,7 +1134,10 @@ mod tests {
         assert_eq!((m.tubes, m.spheres, parts(&m)), (2, 1, 3));
         assert!(text.contains("usemtl lsyc_color1\n"));
         // The sphere has the trunk's radius, centred at the joint.
-        let far = m.v.iter().filter(|v| (v.distance(p) - 0.1).abs() < 1e-6).count();
+        let far =
+            m.v.iter()
+                .filter(|v| (v.distance(p) - 0.1).abs() < 1e-6)
+                .count();
         assert!(far >= 8 * 3 + 2);
     }
 
@@ -991,6 +1201,24 @@ mod tests {
     }
 
     #[test]
+    fn tiny_segments_and_radii_give_no_degenerate_faces() {
+        let p = v3(1000.0, 0.0, 0.0);
+        let text = write(|w| {
+            w.segment(DVec3::ZERO, p, 0.5, 0);
+            // Too short to show: the chain just ends a little further.
+            w.segment(p, p + v3(1e-9, 1e-9, 0.0), 0.5, 0);
+            w.segment(p + v3(1e-9, 1e-9, 0.0), v3(1000.0, 10.0, 0.0), 0.5, 0);
+            // A tube thinner than the digits resolve at this distance.
+            w.segment(v3(0.0, 1000.0, 0.0), v3(10.0, 1000.0, 0.0), 1e-9, 0);
+            // Tiny everything near the origin.
+            w.segment(DVec3::ZERO, v3(1e-20, 0.0, 0.0), 1e-30, 0);
+        });
+        let m = parse(&text);
+        check_solid(&m);
+        assert_eq!((m.tubes, m.spheres), (2, 0));
+    }
+
+    #[test]
     fn many_open_chains_stay_closed() {
         let text = write(|w| {
             for k in 0..200 {
@@ -1008,9 +1236,15 @@ mod tests {
 
     /// A pseudo-random bracketed 3D walk with varying widths and angles.
     fn random_walk(w: &mut ObjWriter<Vec<u8>>, n: usize, seed: u64) {
+        random_walk_sink(w, n, seed)
+    }
+
+    fn random_walk_sink(w: &mut dyn Sink, n: usize, seed: u64) {
         let mut s = seed;
         let mut rnd = move || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
         let (mut pos, mut h, mut l) = (DVec3::ZERO, DVec3::Y, DVec3::NEG_X);
@@ -1049,6 +1283,85 @@ mod tests {
         }
     }
 
+    /// A manual speed check (not a benchmark target):
+    /// `cargo test --release --lib throughput -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn throughput() {
+        struct Count(u64);
+        impl Write for Count {
+            fn write(&mut self, b: &[u8]) -> io::Result<usize> {
+                self.0 += b.len() as u64;
+                Ok(b.len())
+            }
+            fn flush(&mut self) -> io::Result<()> {
+                Ok(())
+            }
+        }
+        let t = std::time::Instant::now();
+        let mut w = ObjWriter::new(Count(0), ObjOptions::default());
+        random_walk_sink(&mut w, 2_000_000, 3);
+        let (c, v) = (w.counts, w.v);
+        let bytes = w.finish().expect("count").0;
+        eprintln!("walk {:?} {bytes} bytes {c:?} {v} vertices", t.elapsed());
+        let t = std::time::Instant::now();
+        let mut w = ObjWriter::new(Count(0), ObjOptions::default());
+        let mut p = DVec3::ZERO;
+        for k in 0..1_000_000 {
+            let a = k as f64 * 0.1;
+            let q = p + v3(a.cos(), a.sin(), 0.3);
+            w.segment(p, q, 0.1, 0);
+            p = q;
+        }
+        let (c, v) = (w.counts, w.v);
+        let bytes = w.finish().expect("count").0;
+        eprintln!("chain {:?} {bytes} bytes {c:?} {v} vertices", t.elapsed());
+    }
+
+    #[test]
+    fn numbers_have_seven_significant_digits() {
+        let text = |x: f64| {
+            let mut b = Vec::new();
+            push_number(&mut b, x);
+            String::from_utf8(b).expect("ascii")
+        };
+        for (x, t) in [
+            (0.0, "0"),
+            (-0.0, "0"),
+            (1.0, "1"),
+            (-2.5, "-2.5"),
+            (0.1, "0.1"),
+            (0.1 + 0.2, "0.3"),
+            (100.0, "100"),
+            (1e-3, "0.001"),
+            (6.123233995736766e-17, "0"),
+            (1234567.8, "1234568"),
+            (123456789.0, "123456800"),
+            (9999999.6, "10000000"),
+            (0.99999996, "1"),
+            (std::f64::consts::PI, "3.141593"),
+            (-0.000123456789, "-0.0001234568"),
+        ] {
+            assert_eq!(text(x), t, "{x}");
+        }
+        assert_eq!(text(f64::NAN), "0");
+        let mut s = 12345u64;
+        for _ in 0..100_000 {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let x = f64::from_bits((s >> 2) & !(0x7ff << 52) | (((s >> 54) % 60 + 1000) << 52));
+            let x = if s & 1 == 0 { x } else { -x };
+            let t = text(x);
+            let back: f64 = t.parse().expect("a number");
+            assert!((back - x).abs() <= 5.0000001e-7 * x.abs(), "{x} as {t}");
+            assert!(!t.contains('e') && !t.ends_with('.'), "{t}");
+            if t.contains('.') {
+                assert!(!t.ends_with('0'), "{t}");
+            }
+        }
+    }
+
     #[test]
     fn output_is_deterministic() {
         let a = write(|w| random_walk(w, 500, 7));
@@ -1069,8 +1382,13 @@ mod tests {
         ];
         let m = parse(&write(|w| {
             w.polygon(&pts, 2);
-            // Collinear and too short polygons draw nothing.
+            // Collinear, too small and too short polygons draw nothing.
             w.polygon(&[DVec3::ZERO, v3(1.0, 0.0, 0.0), v3(2.0, 0.0, 0.0)], 0);
+            let far = v3(1e6, 0.0, 0.0);
+            w.polygon(
+                &[far, far + v3(1e-3, 0.0, 0.0), far + v3(0.0, 1e-3, 0.0)],
+                0,
+            );
             w.polygon(&[DVec3::ZERO, v3(1.0, 0.0, 0.0)], 0);
         }));
         check_valid(&m);
@@ -1105,7 +1423,12 @@ mod tests {
         check_valid(&m);
         assert_eq!(m.faces.len(), 2);
         let first: Vec<DVec3> = m.faces[0].iter().map(|c| m.v[c.0]).collect();
-        for p in [v3(5.0, 0.0, 0.0), v3(7.0, 2.0, 0.0), v3(9.0, 0.0, 0.0), v3(7.0, -2.0, 0.0)] {
+        for p in [
+            v3(5.0, 0.0, 0.0),
+            v3(7.0, 2.0, 0.0),
+            v3(9.0, 0.0, 0.0),
+            v3(7.0, -2.0, 0.0),
+        ] {
             assert!(first.iter().any(|q| q.distance(p) < 1e-6), "{p} missing");
         }
         for face in &m.faces {
@@ -1125,7 +1448,10 @@ mod tests {
         assert_eq!(outline_from_path(""), None);
         assert_eq!(outline_from_path("not a path"), None);
         let square = outline_from_path("M0 0 H2 V2 H0 Z").expect("square");
-        assert_eq!(square.points, vec![[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]);
+        assert_eq!(
+            square.points,
+            vec![[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]
+        );
         // The largest subpath wins; parsing stops at an error.
         let two = outline_from_path("M0 0 h1 v1 h-1 z M5 5 h3 v3 h-3 z M0 0 L x").expect("two");
         assert_eq!(two.points[0], [5.0, 5.0]);
@@ -1188,17 +1514,16 @@ mod tests {
             let Ok(prog) = crate::compile::compile(&front.file, c, None) else {
                 continue;
             };
-            let Ok(start) = crate::derive::axiom(&prog, &[], 1) else {
+            let Ok(mut s) = crate::derive::axiom(&prog, &[], 1) else {
                 continue;
             };
-            let steps = prog.derive.min(5);
-            let limits = crate::derive::Limits {
-                max_modules: 200_000,
-                ..Default::default()
-            };
-            let Ok(s) = crate::derive::derive(&prog, start, steps, 1, limits, &|_, _| {}) else {
-                continue;
-            };
+            // The default steps, as long as the string stays small.
+            for k in 1..=prog.derive {
+                match crate::derive::step(&prog, &s, k, 1, Default::default()) {
+                    Ok(next) if next.len() <= 800 => s = next,
+                    _ => break,
+                }
+            }
             let name = path.display();
             // Everything: valid indices and faces.
             let mut w = ObjWriter::new(Vec::new(), ObjOptions::for_program(&prog));
