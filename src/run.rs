@@ -224,9 +224,13 @@ pub fn write_output(
             out.write_all(&bytes)?;
             Ok(drawn)
         }
-        Format::Obj => Err(OutputError::Io(std::io::Error::other(
-            "OBJ output is not available in this build",
-        ))),
+        Format::Obj => {
+            let options = render::obj::ObjOptions::for_program(&d.prog);
+            let mut w = render::obj::ObjWriter::new(out, options);
+            let drawn = turtle::interpret(&d.prog, &d.string, seed, &mut w).map_err(diag)?;
+            w.finish()?;
+            Ok(drawn)
+        }
     }
 }
 

@@ -53,25 +53,52 @@ impl Default for State {
     }
 }
 
-/// Rotates `a` toward `b` by `deg` degrees in their plane (a, b orthonormal).
-fn turn(a: DVec3, b: DVec3, deg: f64) -> (DVec3, DVec3) {
-    let (s, c) = deg.to_radians().sin_cos();
+/// The sine and cosine of the last angle turned by: most turns of a program are
+/// by the same angle, so most need no trigonometry.
+#[derive(Clone, Copy, Debug)]
+struct Trig {
+    deg: f64,
+    sin: f64,
+    cos: f64,
+}
+
+impl Trig {
+    fn of(&mut self, deg: f64) -> (f64, f64) {
+        if deg != self.deg {
+            let (s, c) = deg.to_radians().sin_cos();
+            *self = Trig {
+                deg,
+                sin: s,
+                cos: c,
+            };
+        }
+        (self.sin, self.cos)
+    }
+}
+
+/// Rotates `a` toward `b` by the angle with sine `s` and cosine `c` (a, b orthonormal).
+fn turn(a: DVec3, b: DVec3, (s, c): (f64, f64)) -> (DVec3, DVec3) {
     (a * c + b * s, b * c - a * s)
 }
 
+fn neg((s, c): (f64, f64)) -> (f64, f64) {
+    (-s, c)
+}
+
 impl State {
-    fn apply(&mut self, action: Action, arg: Option<f64>, angle: f64, step: f64) {
+    fn apply(&mut self, action: Action, arg: Option<f64>, angle: f64, step: f64, trig: &mut Trig) {
         let a = arg.unwrap_or(angle);
+        let mut sc = || trig.of(a);
         match action {
             // Right-handed about U: H toward L (counter-clockwise seen from +z).
-            Action::TurnLeft => (self.h, self.l) = turn(self.h, self.l, a),
-            Action::TurnRight => (self.h, self.l) = turn(self.h, self.l, -a),
+            Action::TurnLeft => (self.h, self.l) = turn(self.h, self.l, sc()),
+            Action::TurnRight => (self.h, self.l) = turn(self.h, self.l, neg(sc())),
             // Right-handed about L: H toward −U.
-            Action::PitchDown => (self.h, self.u) = turn(self.h, self.u, -a),
-            Action::PitchUp => (self.h, self.u) = turn(self.h, self.u, a),
+            Action::PitchDown => (self.h, self.u) = turn(self.h, self.u, neg(sc())),
+            Action::PitchUp => (self.h, self.u) = turn(self.h, self.u, sc()),
             // Right-handed about H: L toward U.
-            Action::RollLeft => (self.l, self.u) = turn(self.l, self.u, a),
-            Action::RollRight => (self.l, self.u) = turn(self.l, self.u, -a),
+            Action::RollLeft => (self.l, self.u) = turn(self.l, self.u, sc()),
+            Action::RollRight => (self.l, self.u) = turn(self.l, self.u, neg(sc())),
             Action::TurnAround => {
                 self.h = -self.h;
                 self.l = -self.l;
@@ -144,6 +171,12 @@ pub fn interpret(
         drawn: Drawn::default(),
         seed,
         stack_vm: Vec::new(),
+        trig: Trig {
+            deg: 0.0,
+            sin: 0.0,
+            cos: 1.0,
+        },
+        cands: Vec::new(),
     };
     let has_interp = prog.interpret.iter().any(|r| !r.is_empty());
     let mut p = 0usize;
@@ -169,6 +202,9 @@ struct Turtle<'a> {
     drawn: Drawn,
     seed: u64,
     stack_vm: Vec<f64>,
+    trig: Trig,
+    /// Candidates of a stochastic interpretation rule (reused).
+    cands: Vec<(usize, f64)>,
 }
 
 impl Turtle<'_> {
@@ -203,7 +239,8 @@ impl Turtle<'_> {
         while k < rules.len() && chosen.is_none() {
             let group = rules[k].group;
             let end = k + rules[k..].iter().take_while(|r| r.group == group).count();
-            let mut cands: Vec<(usize, f64)> = Vec::new();
+            let mut cands = std::mem::take(&mut self.cands);
+            cands.clear();
             for (idx, r) in rules[k..end].iter().enumerate() {
                 let ok = match r.cond {
                     Some(c) => {
@@ -245,6 +282,7 @@ impl Turtle<'_> {
                 }
                 chosen = Some(&rules[pick]);
             }
+            self.cands = cands;
             k = end;
         }
         let Some(rule) = chosen else {
@@ -252,18 +290,25 @@ impl Turtle<'_> {
             return Ok(());
         };
         for e in &rule.succ {
-            let mut args = Vec::with_capacity(e.args.len());
-            for code in &e.args {
-                args.push(
-                    prog.chunk
-                        .eval(*code, params, &mut rng, &mut self.stack_vm)
-                        .map_err(vm)?,
-                );
+            // Up to 16 parameters live on the stack; more go to the heap.
+            let mut small = [0.0f64; 16];
+            let mut big = Vec::new();
+            let args: &mut [f64] = if e.args.len() <= small.len() {
+                &mut small[..e.args.len()]
+            } else {
+                big.resize(e.args.len(), 0.0);
+                &mut big
+            };
+            for (slot, code) in args.iter_mut().zip(&e.args) {
+                *slot = prog
+                    .chunk
+                    .eval(*code, params, &mut rng, &mut self.stack_vm)
+                    .map_err(vm)?;
             }
             if prog.interpret[e.sym as usize].is_empty() {
-                self.module(e.sym, &args);
+                self.module(e.sym, args);
             } else {
-                self.expand(e.sym, &args, position, depth + 1)?;
+                self.expand(e.sym, args, position, depth + 1)?;
             }
         }
         Ok(())
@@ -276,7 +321,8 @@ impl Turtle<'_> {
         match action {
             Action::Draw | Action::Move => {
                 let from = self.state.pos;
-                self.state.apply(action, arg, prog.angle, prog.step);
+                self.state
+                    .apply(action, arg, prog.angle, prog.step, &mut self.trig);
                 let to = self.state.pos;
                 if let Some(poly) = self.polygons.last_mut() {
                     if poly.is_empty() {
@@ -327,7 +373,9 @@ impl Turtle<'_> {
                 self.sink.element(i, st.pos, st.h, st.l, st.scale, st.color);
             }
             Action::None | Action::Cut => {}
-            other => self.state.apply(other, arg, prog.angle, prog.step),
+            other => self
+                .state
+                .apply(other, arg, prog.angle, prog.step, &mut self.trig),
         }
     }
 }

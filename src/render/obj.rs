@@ -1286,39 +1286,6 @@ mod tests {
     /// A manual speed check (not a benchmark target):
     /// `cargo test --release --lib throughput -- --ignored --nocapture`.
     #[test]
-    #[ignore]
-    fn throughput() {
-        struct Count(u64);
-        impl Write for Count {
-            fn write(&mut self, b: &[u8]) -> io::Result<usize> {
-                self.0 += b.len() as u64;
-                Ok(b.len())
-            }
-            fn flush(&mut self) -> io::Result<()> {
-                Ok(())
-            }
-        }
-        let t = std::time::Instant::now();
-        let mut w = ObjWriter::new(Count(0), ObjOptions::default());
-        random_walk_sink(&mut w, 2_000_000, 3);
-        let (c, v) = (w.counts, w.v);
-        let bytes = w.finish().expect("count").0;
-        eprintln!("walk {:?} {bytes} bytes {c:?} {v} vertices", t.elapsed());
-        let t = std::time::Instant::now();
-        let mut w = ObjWriter::new(Count(0), ObjOptions::default());
-        let mut p = DVec3::ZERO;
-        for k in 0..1_000_000 {
-            let a = k as f64 * 0.1;
-            let q = p + v3(a.cos(), a.sin(), 0.3);
-            w.segment(p, q, 0.1, 0);
-            p = q;
-        }
-        let (c, v) = (w.counts, w.v);
-        let bytes = w.finish().expect("count").0;
-        eprintln!("chain {:?} {bytes} bytes {c:?} {v} vertices", t.elapsed());
-    }
-
-    #[test]
     fn numbers_have_seven_significant_digits() {
         let text = |x: f64| {
             let mut b = Vec::new();

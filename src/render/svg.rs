@@ -8,14 +8,30 @@ use crate::turtle::Sink;
 use glam::{DVec2, DVec3};
 use std::io::{self, Write};
 
+/// A `<path>` being written: its style, and a pending straight run that later
+/// collinear segments extend (a Koch curve's `FF` is one `l`).
+struct Open {
+    width: f64,
+    color: u32,
+    /// Where the last segment ended, exactly.
+    end: DVec2,
+    /// The last point written, in fixed-point units (relative moves are taken
+    /// from the rounded point, so rounding never accumulates).
+    written: (i64, i64),
+    /// Direction of the pending run, if any.
+    run: Option<DVec2>,
+}
+
 /// Writes SVG to `out` as the turtle draws.
 pub struct SvgWriter<W: Write> {
     out: W,
     view: View,
     /// Decimal places for coordinates, from the drawing's size.
     decimals: usize,
-    /// The open `<path>`: its style and where its last segment ended.
-    open: Option<(f64, u32, DVec2)>,
+    /// 10^decimals: coordinates are written as integers in these units.
+    scale: f64,
+    /// The open `<path>`.
+    open: Option<Open>,
     buf: Vec<u8>,
     error: Option<io::Error>,
 }
@@ -32,7 +48,7 @@ impl<W: Write> SvgWriter<W> {
         let (min, max) = bounds.framed(0.02);
         let size = max - min;
         let extent = size.x.max(size.y);
-        let decimals = (3.0 - extent.log10().floor()).clamp(0.0, 9.0) as usize;
+        let decimals = (4.0 - extent.log10().floor()).clamp(0.0, 9.0) as usize;
         let hairline = extent / 700.0;
         let (w, h) = if size.x >= size.y {
             (800.0, 800.0 * size.y / size.x)
@@ -83,6 +99,7 @@ impl<W: Write> SvgWriter<W> {
             out,
             view,
             decimals,
+            scale: 10f64.powi(decimals as i32),
             open: None,
             buf: Vec::with_capacity(64),
             error: None,
@@ -97,7 +114,40 @@ impl<W: Write> SvgWriter<W> {
         }
     }
 
+    fn fixed(&self, p: DVec2) -> (i64, i64) {
+        (
+            (p.x * self.scale).round() as i64,
+            (-p.y * self.scale).round() as i64,
+        )
+    }
+
+    /// Writes the pending run of the open path.
+    fn flush_run(&mut self) {
+        let Some(open) = self.open.as_mut() else {
+            return;
+        };
+        if open.run.take().is_none() {
+            return;
+        }
+        let end = open.end;
+        let (x, y) = (
+            (end.x * self.scale).round() as i64,
+            (-end.y * self.scale).round() as i64,
+        );
+        let (dx, dy) = (x - open.written.0, y - open.written.1);
+        open.written = (x, y);
+        let mut buf = std::mem::take(&mut self.buf);
+        buf.clear();
+        buf.push(b' ');
+        write_fixed(&mut buf, dx, self.decimals);
+        buf.push(b' ');
+        write_fixed(&mut buf, dy, self.decimals);
+        self.write(&buf);
+        self.buf = buf;
+    }
+
     fn close_path(&mut self) {
+        self.flush_run();
         if self.open.take().is_some() {
             self.write(b"\"/>\n");
         }
@@ -119,36 +169,53 @@ impl<W: Write> Sink for SvgWriter<W> {
     fn segment(&mut self, a: DVec3, b: DVec3, width: f64, color: u32) {
         let pa = self.view.project(a);
         let pb = self.view.project(b);
+        let d = pb - pa;
+        if let Some(open) = self.open.as_mut()
+            && open.width == width
+            && open.color == color
+            && open.end == pa
+        {
+            // Extend a collinear run; otherwise write it and start another.
+            if let Some(dir) = open.run {
+                let len = d.length();
+                if len > 0.0 && dir.perp_dot(d / len).abs() < 1e-9 && dir.dot(d) > 0.0 {
+                    open.end = pb;
+                    return;
+                }
+            }
+            self.flush_run();
+            if let Some(open) = self.open.as_mut() {
+                open.run = Some(d.normalize_or_zero());
+                open.end = pb;
+            }
+            return;
+        }
+        self.close_path();
+        let start = self.fixed(pa);
         let mut buf = std::mem::take(&mut self.buf);
         buf.clear();
-        match self.open {
-            Some((w, c, end)) if w == width && c == color && end == pa => {
-                buf.extend_from_slice(b"l");
-            }
-            _ => {
-                self.close_path();
-                buf.extend_from_slice(b"<path");
-                buf.extend_from_slice(b" stroke=\"");
-                buf.extend_from_slice(palette(color).as_bytes());
-                buf.push(b'"');
-                if width > 0.0 {
-                    buf.extend_from_slice(b" stroke-width=\"");
-                    write_num(&mut buf, width, self.decimals + 1);
-                    buf.push(b'"');
-                }
-                buf.extend_from_slice(b" d=\"M");
-                write_num(&mut buf, pa.x, self.decimals);
-                buf.push(b' ');
-                write_num(&mut buf, -pa.y, self.decimals);
-                buf.extend_from_slice(b"l");
-            }
+        buf.extend_from_slice(b"<path stroke=\"");
+        buf.extend_from_slice(palette(color).as_bytes());
+        buf.push(b'"');
+        if width > 0.0 {
+            buf.extend_from_slice(b" stroke-width=\"");
+            write_num(&mut buf, width, self.decimals + 1);
+            buf.push(b'"');
         }
-        write_num(&mut buf, pb.x - pa.x, self.decimals);
+        buf.extend_from_slice(b" d=\"M");
+        write_fixed(&mut buf, start.0, self.decimals);
         buf.push(b' ');
-        write_num(&mut buf, -(pb.y - pa.y), self.decimals);
+        write_fixed(&mut buf, start.1, self.decimals);
+        buf.push(b'l');
         self.write(&buf);
         self.buf = buf;
-        self.open = Some((width, color, pb));
+        self.open = Some(Open {
+            width,
+            color,
+            end: pb,
+            written: start,
+            run: Some(d.normalize_or_zero()),
+        });
     }
 
     fn polygon(&mut self, points: &[DVec3], color: u32) {
@@ -204,6 +271,40 @@ pub fn xml(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
+/// Writes the fixed-point integer `n` (units of 10^-decimals) as a decimal
+/// number, trailing zeros dropped, without allocating.
+pub fn write_fixed(buf: &mut Vec<u8>, n: i64, decimals: usize) {
+    if n == 0 {
+        buf.push(b'0');
+        return;
+    }
+    if n < 0 {
+        buf.push(b'-');
+    }
+    let mut m = n.unsigned_abs();
+    let mut digits = [0u8; 24];
+    let mut len = 0;
+    while m > 0 || len <= decimals {
+        digits[len] = b'0' + (m % 10) as u8;
+        m /= 10;
+        len += 1;
+    }
+    // digits[..len] holds the number backwards; the first `decimals` are the fraction.
+    let mut frac_start = 0;
+    while frac_start < decimals && digits[frac_start] == b'0' {
+        frac_start += 1;
+    }
+    for k in (decimals..len).rev() {
+        buf.push(digits[k]);
+    }
+    if frac_start < decimals {
+        buf.push(b'.');
+        for k in (frac_start..decimals).rev() {
+            buf.push(digits[k]);
+        }
+    }
+}
+
 /// Writes `v` with at most `decimals` decimals, trailing zeros dropped.
 pub fn write_num(buf: &mut Vec<u8>, v: f64, decimals: usize) {
     if !v.is_finite() {
@@ -252,6 +353,24 @@ mod tests {
         let mut b = Vec::new();
         write_num(&mut b, v, d);
         String::from_utf8(b).unwrap_or_default()
+    }
+
+    fn f(n: i64, d: usize) -> String {
+        let mut b = Vec::new();
+        super::write_fixed(&mut b, n, d);
+        String::from_utf8(b).unwrap_or_default()
+    }
+
+    #[test]
+    fn fixed_point_numbers() {
+        assert_eq!(f(0, 3), "0");
+        assert_eq!(f(1500, 3), "1.5");
+        assert_eq!(f(-1250, 3), "-1.25");
+        assert_eq!(f(41, 3), "0.041");
+        assert_eq!(f(-1, 3), "-0.001");
+        assert_eq!(f(12, 0), "12");
+        assert_eq!(f(120, 1), "12");
+        assert_eq!(f(i64::MIN + 1, 2).len(), 21);
     }
 
     #[test]

@@ -397,3 +397,54 @@ fn run_refuses_to_overwrite_its_input_and_unknown_formats() {
     let o = lsyc(&["run", ps, "-o", "x.pdf"]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+#[test]
+fn obj_output_is_a_valid_mesh() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for prog in ["hilbert-3d", "bush-3d", "monopodial-tree"] {
+        let out = dir.path().join(format!("{prog}.obj"));
+        let input = root().join(format!("lang-examples/{prog}.lsy"));
+        let o = lsyc(&[
+            "run",
+            input.to_str().expect("utf-8"),
+            "-n",
+            "3",
+            "-o",
+            out.to_str().expect("utf-8"),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let text = std::fs::read_to_string(&out).expect("obj");
+        let (mut v, mut vn, mut faces) = (0usize, 0usize, 0usize);
+        for line in text.lines() {
+            let mut parts = line.split_whitespace();
+            match parts.next() {
+                Some("v") => v += 1,
+                Some("vn") => vn += 1,
+                Some("f") => {
+                    faces += 1;
+                    let idx: Vec<(usize, Option<usize>)> = parts
+                        .map(|p| {
+                            let mut it = p.split("//");
+                            let vi = it.next().and_then(|x| x.parse().ok()).unwrap_or(0);
+                            (vi, it.next().and_then(|x| x.parse().ok()))
+                        })
+                        .collect();
+                    assert!(idx.len() >= 3, "{prog}: a face with fewer than 3 corners");
+                    let mut seen = std::collections::HashSet::new();
+                    for &(vi, ni) in &idx {
+                        assert!(vi >= 1 && vi <= v, "{prog}: vertex index {vi} of {v}");
+                        if let Some(n) = ni {
+                            assert!(n >= 1 && n <= vn, "{prog}: normal index {n} of {vn}");
+                        }
+                        assert!(
+                            seen.insert(vi),
+                            "{prog}: a degenerate face repeats vertex {vi}"
+                        );
+                    }
+                }
+                _ => {}
+            }
+        }
+        assert!(faces > 100 && vn > 0, "{prog}: {faces} faces, {vn} normals");
+    }
+}
