@@ -13,6 +13,7 @@ pub mod diagnostic;
 pub mod dump;
 pub mod fmt;
 pub mod frontend;
+pub mod infer;
 pub mod lexer;
 pub mod parser;
 pub mod query;

@@ -5,6 +5,7 @@
 
 mod check;
 mod fmt;
+mod infer;
 mod run;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -68,6 +69,11 @@ pub enum Command {
         after_help = "Examples:\n  lsyc fmt plant.lsy > tidy.lsy\n  lsyc fmt --write plant.lsy\n  lsyc fmt --check lang-examples/*.lsy"
     )]
     Fmt(fmt::Args),
+    /// Infer a program from a drawing: `--skeleton SKETCH.svg` turns a tree sketch into a recursive L-system.
+    #[command(
+        after_help = "Examples:\n  lsyc infer --skeleton sketch.svg -o tree.lsy\n  lsyc infer --skeleton sketch.svg --3d --seed 7 -o tree3d.lsy"
+    )]
+    Infer(infer::Args),
 }
 
 /// Where diagnostics go and how they look.
@@ -131,6 +137,7 @@ pub fn main() -> ExitCode {
         Command::Check(args) => check::run(args, &reporter),
         Command::Fmt(args) => fmt::run(args, &reporter),
         Command::Run(args) => run::run(args, &reporter),
+        Command::Infer(args) => infer::run(args, &reporter),
     };
     ExitCode::from(status)
 }

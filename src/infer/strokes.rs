@@ -1,0 +1,202 @@
+//! Strokes of a sketch: every path, line, polyline or polygon of an SVG, in
+//! document order, as a polyline in world coordinates.
+//!
+//! Owns: reading SVG with usvg (which turns shapes into paths and resolves
+//! `<g transform>`, `<use>` and the viewBox), applying each path's absolute
+//! transform, flattening curves into points, turning the SVG's y-down user
+//! space into the language's y-up world (x, −y), and the stroke width in the
+//! same units. Each subpath is a stroke. Must not decide what a stroke means.
+
+use glam::DVec2;
+use usvg::tiny_skia_path::{PathSegment, Point, Transform};
+
+/// Points per flattened curve segment.
+const CURVE_STEPS: usize = 12;
+
+/// One stroke of the sketch.
+#[derive(Clone, Debug)]
+pub struct Stroke {
+    /// 1-based position among all subpaths of the document, for messages.
+    pub number: usize,
+    /// The SVG `id` of the element it came from (may be empty).
+    pub id: String,
+    /// Which subpath of that element (0 for the first).
+    pub subpath: usize,
+    /// The points, world coordinates (y up), no two consecutive equal.
+    pub points: Vec<DVec2>,
+    /// Stroke width in world units, if the element has a stroke.
+    pub width: Option<f64>,
+}
+
+impl Stroke {
+    /// How a person finds the stroke in the SVG: "stroke 4 (the path with id `b3`)".
+    pub fn describe(&self) -> String {
+        let what = if self.id.is_empty() {
+            "a path without an id".to_string()
+        } else {
+            format!("the path with id `{}`", self.id)
+        };
+        if self.subpath > 0 {
+            format!(
+                "stroke {} (subpath {} of {what})",
+                self.number,
+                self.subpath + 1
+            )
+        } else {
+            format!("stroke {} ({what})", self.number)
+        }
+    }
+
+    pub fn length(&self) -> f64 {
+        self.points.windows(2).map(|w| w[0].distance(w[1])).sum()
+    }
+}
+
+/// Reads the strokes of an SVG document. Subpaths with no length are skipped
+/// (their numbers are not reused). The error is usvg's reason, for a message.
+pub fn read(data: &[u8]) -> Result<Vec<Stroke>, String> {
+    let tree = usvg::Tree::from_data(data, &usvg::Options::default()).map_err(|e| e.to_string())?;
+    let mut out = Vec::new();
+    let mut number = 0;
+    walk(tree.root(), &mut out, &mut number);
+    Ok(out)
+}
+
+fn walk(group: &usvg::Group, out: &mut Vec<Stroke>, number: &mut usize) {
+    for node in group.children() {
+        match node {
+            usvg::Node::Group(g) => walk(g, out, number),
+            usvg::Node::Path(p) => path_strokes(p, out, number),
+            usvg::Node::Image(_) | usvg::Node::Text(_) => {}
+        }
+    }
+}
+
+fn path_strokes(path: &usvg::Path, out: &mut Vec<Stroke>, number: &mut usize) {
+    let t = path.abs_transform();
+    // A width scales with the transform's mean scale factor.
+    let scale = f64::from((t.sx * t.sy - t.kx * t.ky).abs()).sqrt();
+    let width = path
+        .stroke()
+        .map(|s| f64::from(s.width().get()) * scale)
+        .filter(|w| w.is_finite() && *w > 0.0);
+    let mut subpaths: Vec<Vec<DVec2>> = Vec::new();
+    let mut current: Vec<DVec2> = Vec::new();
+    let mut last = Point::zero();
+    let mut start = Point::zero();
+    for seg in path.data().segments() {
+        match seg {
+            PathSegment::MoveTo(p) => {
+                if !current.is_empty() {
+                    subpaths.push(std::mem::take(&mut current));
+                }
+                push(&mut current, t, p);
+                last = p;
+                start = p;
+            }
+            PathSegment::LineTo(p) => {
+                push(&mut current, t, p);
+                last = p;
+            }
+            PathSegment::QuadTo(c, p) => {
+                for k in 1..=CURVE_STEPS {
+                    let s = k as f32 / CURVE_STEPS as f32;
+                    let u = 1.0 - s;
+                    let q = Point::from_xy(
+                        u * u * last.x + 2.0 * u * s * c.x + s * s * p.x,
+                        u * u * last.y + 2.0 * u * s * c.y + s * s * p.y,
+                    );
+                    push(&mut current, t, q);
+                }
+                last = p;
+            }
+            PathSegment::CubicTo(c1, c2, p) => {
+                for k in 1..=CURVE_STEPS {
+                    let s = k as f32 / CURVE_STEPS as f32;
+                    let u = 1.0 - s;
+                    let (a, b, c, d) = (u * u * u, 3.0 * u * u * s, 3.0 * u * s * s, s * s * s);
+                    let q = Point::from_xy(
+                        a * last.x + b * c1.x + c * c2.x + d * p.x,
+                        a * last.y + b * c1.y + c * c2.y + d * p.y,
+                    );
+                    push(&mut current, t, q);
+                }
+                last = p;
+            }
+            PathSegment::Close => {
+                push(&mut current, t, start);
+                last = start;
+            }
+        }
+    }
+    if !current.is_empty() {
+        subpaths.push(current);
+    }
+    for (k, points) in subpaths.into_iter().enumerate() {
+        *number += 1;
+        if points.len() < 2 {
+            continue;
+        }
+        out.push(Stroke {
+            number: *number,
+            id: path.id().to_string(),
+            subpath: k,
+            points,
+            width,
+        });
+    }
+}
+
+/// Appends `p` mapped by `t` and flipped to y-up, unless it repeats the last point.
+fn push(points: &mut Vec<DVec2>, t: Transform, mut p: Point) {
+    t.map_point(&mut p);
+    let q = DVec2::new(f64::from(p.x), -f64::from(p.y));
+    if !q.is_finite() {
+        return;
+    }
+    if points.last().is_none_or(|l| l.distance(q) > 1e-9) {
+        points.push(q);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shapes_transforms_and_curves() {
+        let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100">
+            <path id="a" d="M10 90 L10 50" stroke="black" stroke-width="4" fill="none"/>
+            <g transform="translate(5 0) scale(2)">
+                <polyline id="b" points="5 25 10 20 15 10" stroke="black" fill="none"/>
+            </g>
+            <line x1="0" y1="0" x2="0" y2="0" stroke="black"/>
+            <path d="M0 0 C10 0 10 10 20 10 M30 30 L40 40" stroke="black"/>
+        </svg>"#;
+        let s = read(svg.as_bytes()).expect("reads");
+        assert_eq!(s.len(), 4, "{s:?}");
+        assert_eq!(
+            s[0].points,
+            vec![DVec2::new(10.0, -90.0), DVec2::new(10.0, -50.0)]
+        );
+        assert_eq!(s[0].width, Some(4.0));
+        assert_eq!(s[1].id, "b");
+        assert_eq!(s[1].points[0], DVec2::new(15.0, -50.0));
+        assert_eq!(s[1].points[2], DVec2::new(35.0, -20.0));
+        assert_eq!(s[1].width, Some(2.0));
+        // The zero-length line is skipped, but keeps its number.
+        assert_eq!(s[2].number, 4);
+        assert_eq!(s[2].points.len(), CURVE_STEPS + 1);
+        assert_eq!(s[3].subpath, 1);
+        assert_eq!(
+            s[3].describe(),
+            "stroke 5 (subpath 2 of a path without an id)"
+        );
+    }
+
+    #[test]
+    fn not_svg_is_an_error() {
+        assert!(read(b"hello").is_err());
+        assert!(read(b"<svg").is_err());
+    }
+}
