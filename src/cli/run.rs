@@ -122,6 +122,19 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     let Some(checked) = fe.checked.as_ref().filter(|_| !fe.has_errors()) else {
         return 1;
     };
+    let has_scene = fe
+        .file
+        .items
+        .stmts
+        .iter()
+        .any(|i| matches!(i.node, lsyc::ast::Item::Scene(_)));
+    if has_scene && args.system.is_none() && !args.disasm {
+        reporter.say(&format!(
+            "error: `{}` holds a scene; scenes (guides, links, query answers) are not run yet. Run one of its lsystems on its own with --system NAME",
+            src.name
+        ));
+        return 2;
+    }
     let opts = Options {
         steps: args.steps,
         seed: args.seed,

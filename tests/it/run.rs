@@ -448,3 +448,14 @@ fn obj_output_is_a_valid_mesh() {
         assert!(faces > 100 && vn > 0, "{prog}: {faces} faces, {vn} normals");
     }
 }
+
+#[test]
+fn a_scene_needs_its_environment_or_a_chosen_system() {
+    let palm = root().join("lang-examples/palm.lsy");
+    let p = palm.to_str().expect("utf-8");
+    let o = lsyc(&["run", p]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--system"));
+    let o = lsyc(&["run", p, "--system", "Trunk", "--stats"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
