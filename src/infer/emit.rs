@@ -69,8 +69,14 @@ fn mul(a: Expr, b: Expr) -> Expr {
     Expr::new(ExprKind::Binary(BinOp::Mul, Box::new(a), Box::new(b)))
 }
 
+/// A turtle symbol or a single letter (`F`, `f`) with an optional parameter.
 fn sym(c: char, arg: Option<Expr>) -> Module {
-    Module::new(ModName::Symbol(c), arg.map(|a| vec![a]))
+    let name = if c.is_alphabetic() {
+        ModName::Name(c.to_string())
+    } else {
+        ModName::Symbol(c)
+    };
+    Module::new(name, arg.map(|a| vec![a]))
 }
 
 fn named(name: &str, args: Vec<Expr>) -> Module {
