@@ -12,6 +12,10 @@ use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
+    /// A drawing whose repeated elements to infer (not available yet; see --skeleton).
+    #[arg(value_name = "ART.svg")]
+    pub art: Option<PathBuf>,
+
     /// A tree sketch (SVG): each path, line or polyline is a branch, the first the trunk.
     #[arg(long, value_name = "SKETCH.svg")]
     pub skeleton: Option<PathBuf>,
@@ -36,12 +40,20 @@ pub struct Args {
 pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     let Some(sketch) = &args.skeleton else {
         reporter.say(
-            "error: `lsyc infer` needs --skeleton SKETCH.svg: inferring repeated elements \
-             from a drawing is a separate feature that is not available yet\n\
+            "error: `lsyc infer` needs --skeleton SKETCH.svg (a tree sketch): inferring repeated \
+             elements from a drawing is a separate feature that is not available yet\n\
              usage: lsyc infer --skeleton SKETCH.svg [-o TREE.lsy] [--3d] [--epsilon E] [--seed N]",
         );
         return 2;
     };
+    if let Some(art) = &args.art {
+        reporter.say(&format!(
+            "error: give the sketch once, after --skeleton (`{}` is extra): inferring repeated \
+             elements from a drawing is a separate feature that is not available yet",
+            art.display()
+        ));
+        return 2;
+    }
     if let Some(e) = args.epsilon
         && !(e.is_finite() && e >= 0.0)
     {

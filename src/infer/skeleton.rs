@@ -173,6 +173,14 @@ pub fn build(strokes: &[Stroke], epsilon: Option<f64>) -> Result<Skeleton, Detac
                 limit: attach,
             });
         }
+        // Starting at the start of a sibling (a fork drawn as separate strokes)
+        // means starting where that sibling starts: on their parent.
+        let (mut j, mut s) = (j, s);
+        while s <= attach / 2.0
+            && let Some((pj, ps)) = parent[j]
+        {
+            (j, s) = (pj, ps);
+        }
         parent[i] = Some((j, s));
     }
     // Junctions on each stroke, by arc length.
@@ -414,6 +422,19 @@ mod tests {
         assert_eq!(sk.branches[2].points[0], DVec2::new(0.0, 10.0));
         assert_eq!(sk.height(), 1);
         assert_eq!(sk.segments(), 3);
+    }
+
+    #[test]
+    fn a_stroke_starting_at_a_siblings_start_attaches_to_the_parent() {
+        let strokes = vec![
+            stroke(1, &[(0.0, 0.0), (0.0, 100.0)]),
+            stroke(2, &[(0.0, 100.0), (-40.0, 140.0)]),
+            // Starts nearer to stroke 2's start than to the trunk's tip.
+            stroke(3, &[(-0.5, 101.0), (40.0, 140.0)]),
+        ];
+        let sk = build(&strokes, None).expect("attaches");
+        assert_eq!(sk.branches[2].parent, Some(0));
+        assert_eq!(sk.branches[0].children, vec![1, 2]);
     }
 
     #[test]
