@@ -11,6 +11,7 @@ pub mod compile;
 pub mod derive;
 pub mod diagnostic;
 pub mod dump;
+pub mod edit;
 pub mod fmt;
 pub mod frontend;
 pub mod infer;

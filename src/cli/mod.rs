@@ -4,6 +4,7 @@
 //! error) and where output goes: results on stdout, diagnostics on stderr.
 
 mod check;
+mod edit;
 mod fmt;
 mod infer;
 mod run;
@@ -74,6 +75,11 @@ pub enum Command {
         after_help = "Examples:\n  lsyc infer --skeleton sketch.svg -o tree.lsy\n  lsyc infer --skeleton sketch.svg --3d --seed 7 -o tree3d.lsy"
     )]
     Infer(infer::Args),
+    /// Edit a scene's guides with a mass-spring system: drag vertices, move, rotate, scale guides.
+    #[command(
+        after_help = "Examples:\n  lsyc edit palm.lsy --move trunk.v2=40,310\n  lsyc edit palm.lsy --by crown.v1=20,0 --pin trunk\n  lsyc edit palm.lsy --translate crown=10,0 --rotate crown=15 --write"
+    )]
+    Edit(edit::Args),
 }
 
 /// Where diagnostics go and how they look.
@@ -138,6 +144,7 @@ pub fn main() -> ExitCode {
         Command::Fmt(args) => fmt::run(args, &reporter),
         Command::Run(args) => run::run(args, &reporter),
         Command::Infer(args) => infer::run(args, &reporter),
+        Command::Edit(args) => edit::run(args, &reporter),
     };
     ExitCode::from(status)
 }
