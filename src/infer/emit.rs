@@ -422,9 +422,9 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
     ));
     header.push("-n with more steps grows the tree further.".into());
     if let Some(seed) = s.seed_3d {
-        header.push(format!(
-            "3D: children spread around their parent at angles 360/n apart plus a random"
-        ));
+        header.push(
+            "3D: children spread around their parent at angles 360/n apart plus a random".into(),
+        );
         header.push(format!(
             "perturbation (seed {seed}); each leans SPREAD times the sine of its angle out of the plane."
         ));

@@ -20,6 +20,8 @@ use thiserror::Error;
 
 /// The largest sketch read, in bytes.
 pub const MAX_SVG_BYTES: usize = 64 * 1024 * 1024;
+/// The most strokes a sketch may have (attaching them is quadratic).
+pub const MAX_STROKES: usize = 10_000;
 
 /// Options of `lsyc infer --skeleton`.
 #[derive(Clone, Debug, Default)]
@@ -53,6 +55,8 @@ pub enum InferError {
     },
     #[error("`{file}` is larger than {} MiB", MAX_SVG_BYTES >> 20)]
     TooLarge { file: String },
+    #[error("`{file}` has {strokes} strokes; lsyc infers trees of up to {MAX_STROKES}")]
+    TooManyStrokes { file: String, strokes: usize },
 }
 
 /// A sketch and what was inferred from it.
@@ -77,6 +81,12 @@ pub fn skeleton_from_svg(data: &[u8], name: &str, opts: &Options) -> Result<Infe
     })?;
     if strokes.is_empty() {
         return Err(InferError::NoStrokes { file: name.into() });
+    }
+    if strokes.len() > MAX_STROKES {
+        return Err(InferError::TooManyStrokes {
+            file: name.into(),
+            strokes: strokes.len(),
+        });
     }
     let sk = skeleton::build(&strokes, opts.epsilon).map_err(|d| InferError::Detached {
         file: name.into(),

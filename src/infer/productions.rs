@@ -165,48 +165,48 @@ pub fn pre_reduce(initial: &[Production]) -> Vec<Production> {
 }
 
 /// Whether two branches have the same sequel-context until either reaches a
-/// terminal.
-fn similar(
-    a: Child,
-    b: Child,
-    succ: &HashMap<usize, &[Child]>,
-    memo: &mut HashMap<(usize, usize), bool>,
-) -> bool {
-    let (Child::Id(x), Child::Id(y)) = (a, b) else {
-        return true;
-    };
-    if x == y {
-        return true;
+/// terminal. Iterative, so that deep sketches cannot overflow the stack.
+fn similar(a: usize, b: usize, succ: &HashMap<usize, &[Child]>) -> bool {
+    let mut stack = vec![(a, b)];
+    while let Some((x, y)) = stack.pop() {
+        if x == y {
+            continue;
+        }
+        let (Some(sx), Some(sy)) = (succ.get(&x), succ.get(&y)) else {
+            continue;
+        };
+        if sx.len() != sy.len() {
+            return false;
+        }
+        for (p, q) in sx.iter().zip(sy.iter()) {
+            if let (Child::Id(p), Child::Id(q)) = (p, q) {
+                stack.push((*p, *q));
+            }
+        }
     }
-    if let Some(&v) = memo.get(&(x, y)) {
-        return v;
-    }
-    let (Some(sx), Some(sy)) = (succ.get(&x), succ.get(&y)) else {
-        return true;
-    };
-    let v = sx.len() == sy.len()
-        && sx
-            .iter()
-            .zip(sy.iter())
-            .all(|(&p, &q)| similar(p, q, succ, memo));
-    memo.insert((x, y), v);
-    v
+    true
 }
 
 /// The table R: for each production but the root's (in P order), the similar
 /// ids on the nearest lower level that has any, left to right.
 pub fn reduction_table(prods: &[Production], level: &[usize]) -> Vec<(usize, Vec<usize>)> {
     let succ: HashMap<usize, &[Child]> = prods.iter().map(|p| (p.id, p.succ.as_slice())).collect();
-    let mut memo = HashMap::new();
+    let mut by_level: Vec<Vec<usize>> = Vec::new();
+    for p in prods {
+        let lvl = level.get(p.id).copied().unwrap_or(0);
+        if by_level.len() <= lvl {
+            by_level.resize(lvl + 1, Vec::new());
+        }
+        by_level[lvl].push(p.id);
+    }
     let mut table = Vec::new();
     for p in prods.iter().filter(|p| p.id != 0) {
         let own = level.get(p.id).copied().unwrap_or(0);
-        for lvl in (0..own).rev() {
-            let found: Vec<usize> = prods
+        for ids in by_level.iter().take(own).rev() {
+            let found: Vec<usize> = ids
                 .iter()
-                .filter(|q| level.get(q.id) == Some(&lvl))
-                .filter(|q| similar(Child::Id(p.id), Child::Id(q.id), &succ, &mut memo))
-                .map(|q| q.id)
+                .copied()
+                .filter(|&q| similar(p.id, q, &succ))
                 .collect();
             if !found.is_empty() {
                 table.push((p.id, found));

@@ -243,6 +243,9 @@ pub fn simplify_with_junctions(
     cuts: &[(usize, f64)],
     epsilon: f64,
 ) -> (Vec<DVec2>, Vec<(usize, usize)>) {
+    if points.len() < 2 {
+        return (points.to_vec(), cuts.iter().map(|&(c, _)| (c, 0)).collect());
+    }
     let total: f64 = points.windows(2).map(|w| w[0].distance(w[1])).sum();
     let snap = epsilon.min(total / 4.0);
     let mut cuts: Vec<(usize, f64)> = cuts
