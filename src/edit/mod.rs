@@ -43,7 +43,7 @@ pub const K_LINK: f64 = 100.0;
 /// Stiffness of a `--stiff` spring.
 pub const K_STIFF: f64 = 100.0;
 /// The inertia weight w = m/h² of every particle (relative to `K_EDGE`).
-pub const INERTIA: f64 = 0.01;
+pub const INERTIA: f64 = 0.001;
 /// Vertices closer than this fraction of the scene size are one particle.
 pub const SNAP: f64 = 1e-4;
 
@@ -703,4 +703,158 @@ pub fn centroid(pts: &[P2]) -> P2 {
 fn round(v: f64, places: usize) -> f64 {
     let r = format!("{v:.places$}").parse::<f64>().unwrap_or(v);
     if r == 0.0 { 0.0 } else { r }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frontend;
+
+    const SCENE: &str = "\
+const w = 10;
+lsystem A { axiom F; }
+scene S {
+    guide a { polygon (0, 0) (w, 0) (w, 10) (0, 10); system A; } // a
+    guide b { polygon (10, 0) (20, 0) (20, 10) (10, 10); system A; } // snapped to a
+    guide c { polygon (50, 50) (60, 50) (55, 60); system A; } // alone
+    link a.edge(3) -> c.edge(0) { tokens 1; }
+}
+";
+
+    fn run(text: &str, ops: &[Op]) -> Result<(String, Outcome), EditError> {
+        let fe = frontend::run(text, Vec::new(), &[]);
+        assert!(!fe.has_errors(), "{:?}", fe.diagnostics);
+        let checked = fe.checked.as_ref().expect("checked");
+        let mut file = fe.file.clone();
+        let out = edit(&mut file, checked, ops, None)?;
+        Ok((crate::fmt::format_file(&file), out))
+    }
+
+    fn polygon_line<'a>(text: &'a str, guide: &str) -> &'a str {
+        let mut lines = text
+            .lines()
+            .skip_while(|l| !l.contains(&format!("guide {guide} ")));
+        lines.find(|l| l.contains("polygon")).unwrap_or("")
+    }
+
+    #[test]
+    fn no_operation_leaves_the_program_as_fmt_prints_it() {
+        let (out, o) = run(SCENE, &[]).expect("edits");
+        let fe = frontend::run(SCENE, Vec::new(), &[]);
+        assert_eq!(out, crate::fmt::format_file(&fe.file));
+        assert!(o.changed.is_empty());
+        assert_eq!(o.free, 0);
+    }
+
+    #[test]
+    fn snapped_guides_share_particles_and_move_together() {
+        // a.v1 = b.v0 and a.v2 = b.v3 are one particle each.
+        let ops = [parse_move("a.v1=12,0").expect("parses")];
+        let (out, o) = run(SCENE, &ops).expect("edits");
+        assert_eq!(o.particles, 4 + 2 + 3);
+        let a = polygon_line(&out, "a");
+        let b = polygon_line(&out, "b");
+        assert!(a.contains("(12, 0)"), "{a}");
+        assert!(b.contains("polygon (12, 0)"), "{b}");
+        // The alone guide is untouched, byte for byte.
+        assert_eq!(
+            polygon_line(&out, "c").trim(),
+            "polygon (50, 50) (60, 50) (55, 60);"
+        );
+        assert_eq!(
+            o.changed.iter().map(|c| c.0.as_str()).collect::<Vec<_>>(),
+            ["a", "b"]
+        );
+    }
+
+    #[test]
+    fn expressions_stay_unless_their_coordinate_moves() {
+        let ops = [
+            parse_by("a.v0=0,-2").expect("parses"),
+            parse_by("a.v1=0,-2").expect("parses"),
+            parse_pin("a.v2").expect("parses"),
+            parse_pin("a.v3").expect("parses"),
+        ];
+        let (out, o) = run(SCENE, &ops).expect("edits");
+        let a = polygon_line(&out, "a");
+        // x of v1 did not change: `w` stays; its y is now -2.
+        assert!(a.contains("(w, -2)"), "{a}");
+        assert!(o.replaced.is_empty(), "{:?}", o.replaced);
+        let ops = [parse_translate("a=1,0").expect("parses")];
+        let (out, o) = run(SCENE, &ops).expect("edits");
+        assert!(polygon_line(&out, "a").contains("(11, 0)"), "{out}");
+        assert_eq!(o.replaced.len(), 2, "{:?}", o.replaced);
+    }
+
+    #[test]
+    fn rotate_and_scale_about_the_centroid() {
+        let ops = [parse_rotate("c=180").expect("parses")];
+        let (_, o) = run(SCENE, &ops).expect("edits");
+        assert_eq!(o.changed, [("c".to_string(), 3)]);
+        let ops = [parse_scale("a=2").expect("parses")];
+        let (out, _) = run(SCENE, &ops).expect("edits");
+        assert!(
+            polygon_line(&out, "a").contains("polygon (-5, -5) (15, -5) (15, 15) (-5, 15)"),
+            "{out}"
+        );
+        assert_eq!(
+            centroid(&[[0.0, 0.0], [4.0, 0.0], [4.0, 2.0], [0.0, 2.0]]),
+            [2.0, 1.0]
+        );
+        // A degenerate polygon: the mean of its vertices.
+        assert_eq!(centroid(&[[0.0, 0.0], [2.0, 0.0], [4.0, 0.0]]), [2.0, 0.0]);
+    }
+
+    #[test]
+    fn errors_name_the_guide_and_the_vertex() {
+        let e = run(SCENE, &[parse_move("aa.v0=1,1").expect("parses")]).unwrap_err();
+        assert!(
+            matches!(&e, EditError::Usage(m, Some(h)) if m.contains("`aa`") && h.contains("`a`")),
+            "{e:?}"
+        );
+        let e = run(SCENE, &[parse_move("c.v3=1,1").expect("parses")]).unwrap_err();
+        assert!(
+            matches!(&e, EditError::Usage(m, _) if m.contains("v0 to v2") && m.contains("c.v3")),
+            "{e:?}"
+        );
+        let e = run("lsystem A { axiom F; }", &[]).unwrap_err();
+        assert!(matches!(e, EditError::Input(_)), "{e:?}");
+    }
+
+    #[test]
+    fn argument_syntax() {
+        assert_eq!(
+            parse_move("trunk.v2=40,-310.5"),
+            Ok(Op::Move(
+                VertexRef {
+                    guide: "trunk".into(),
+                    index: 2
+                },
+                [40.0, -310.5]
+            ))
+        );
+        assert_eq!(parse_pin("trunk"), Ok(Op::Pin("trunk".into(), None)));
+        assert_eq!(parse_pin("trunk.v1"), Ok(Op::Pin("trunk".into(), Some(1))));
+        for bad in [
+            "trunk=1,2",
+            "trunk.2=1,2",
+            "trunk.v2",
+            "trunk.v2=1",
+            "trunk.v2=a,1",
+            "trunk.v2=inf,1",
+            ".v2=1,1",
+            "tr unk.v2=1,1",
+            "trunk.v-1=1,1",
+        ] {
+            assert!(parse_move(bad).is_err(), "{bad}");
+        }
+        assert!(parse_scale("a=0").is_err());
+        assert!(parse_scale("a=-1").is_err());
+        assert!(parse_rotate("a=NaN").is_err());
+        assert!(parse_stiff("a.v0=b").is_err());
+        assert_eq!(decimals(12.345), 3);
+        assert_eq!(decimals(40.0), 0);
+        assert_eq!(round(0.1 + 0.2, 3), 0.3);
+        assert_eq!(round(-0.0001, 2).to_bits(), 0.0f64.to_bits());
+    }
 }
