@@ -3,6 +3,7 @@
 mod cli;
 mod corpus;
 mod diagnostics;
+mod edit;
 mod run;
 mod sketch;
 mod support;
