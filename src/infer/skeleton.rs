@@ -146,6 +146,13 @@ pub fn build(strokes: &[Stroke], epsilon: Option<f64>) -> Result<Skeleton, Detac
     let attach = (ATTACH_OF_DIAGONAL * diagonal).max(2.0 * epsilon);
     let n = strokes.len();
     let mut raw: Vec<Vec<DVec2>> = strokes.iter().map(|s| s.points.clone()).collect();
+    // Trees grow up: a trunk drawn downward is turned round.
+    if let Some(t) = raw.first_mut()
+        && let (Some(a), Some(b)) = (t.first(), t.last())
+        && b.y < a.y
+    {
+        t.reverse();
+    }
     let mut parent: Vec<Option<(usize, f64)>> = vec![None; n];
     for i in 1..n {
         let near = |p: DVec2| {
@@ -438,6 +445,17 @@ mod tests {
         let sk = build(&strokes, None).expect("attaches");
         assert_eq!(sk.branches[2].parent, Some(0));
         assert_eq!(sk.branches[0].children, vec![1, 2]);
+    }
+
+    #[test]
+    fn a_trunk_drawn_downward_grows_up() {
+        let strokes = vec![
+            stroke(1, &[(0.0, 100.0), (0.0, 0.0)]),
+            stroke(2, &[(0.0, 100.0), (30.0, 130.0)]),
+        ];
+        let sk = build(&strokes, None).expect("attaches");
+        assert_eq!(sk.branches[0].points[0], DVec2::ZERO);
+        assert_eq!(sk.branches[0].child_vertex, vec![1]);
     }
 
     #[test]
