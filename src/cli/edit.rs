@@ -16,6 +16,7 @@ pub struct Args {
     pub file: PathBuf,
     pub write: bool,
     pub scene: Option<String>,
+    pub move_seeds: bool,
     /// The operations, in command-line order.
     pub ops: Vec<Op>,
 }
@@ -85,6 +86,7 @@ impl clap::FromArgMatches for Args {
             file,
             write: m.get_flag("write"),
             scene: m.get_one::<String>("scene").cloned(),
+            move_seeds: m.get_flag("move-seeds"),
             ops: ops.into_iter().map(|(_, op)| op).collect(),
         })
     }
@@ -116,6 +118,12 @@ impl clap::Args for Args {
                     .long("scene")
                     .value_name("NAME")
                     .help("Which scene of the file to edit (default: the first)"),
+            )
+            .arg(
+                Arg::new("move-seeds")
+                    .long("move-seeds")
+                    .action(ArgAction::SetTrue)
+                    .help("Carry the seeds of a moved guide along (position and heading)"),
             );
         for &(id, value_name, help, parser) in OPS {
             cmd = cmd.arg(
@@ -154,7 +162,11 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         }
     };
     let mut file = fe.file.clone();
-    let outcome = match edit::edit(&mut file, checked, &args.ops, args.scene.as_deref()) {
+    let options = edit::Options {
+        scene: args.scene.clone(),
+        move_seeds: args.move_seeds,
+    };
+    let outcome = match edit::edit(&mut file, checked, &args.ops, &options) {
         Ok(o) => o,
         Err(EditError::Input(msg)) => {
             reporter.say(&format!("error: {}: {msg}", src.name));
@@ -173,6 +185,9 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
             "note: {r} (its expression was replaced by the number)"
         ));
     }
+    for w in &outcome.warnings {
+        reporter.say(&format!("warning: {w}"));
+    }
     if !outcome.converged {
         reporter.say(&format!(
             "warning: the spring system did not settle in {} iterations; the positions are the last ones",
@@ -189,6 +204,11 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
             .map(|(g, n)| format!("{g} ({n} vert{})", if *n == 1 { "ex" } else { "ices" }))
             .collect();
         format!("changed {}", list.join(", "))
+    };
+    let changed = match outcome.seeds_moved {
+        0 => changed,
+        1 => format!("{changed}, 1 seed carried along"),
+        n => format!("{changed}, {n} seeds carried along"),
     };
     let summary = format!(
         "{}: scene {}: {changed}; {} particles, {} springs, {} relaxed in {} iteration{}",

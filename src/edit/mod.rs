@@ -241,6 +241,16 @@ pub enum EditError {
     Usage(String, Option<String>),
 }
 
+/// Choices beyond the operations.
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// The scene to edit (default: the first of the file).
+    pub scene: Option<String>,
+    /// Carry the seeds of a moved guide along (position and heading), by the
+    /// affine map that best fits the guide's old vertices to its new ones.
+    pub move_seeds: bool,
+}
+
 /// What an edit did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Outcome {
@@ -258,6 +268,10 @@ pub struct Outcome {
     pub converged: bool,
     /// Decimals the coordinates are written with.
     pub decimals: usize,
+    /// Seeds carried along with their guides (`--move-seeds`).
+    pub seeds_moved: usize,
+    /// Things a person should know (seeds left outside their moved guide).
+    pub warnings: Vec<String>,
 }
 
 struct GuideInfo {
@@ -277,8 +291,9 @@ pub fn edit(
     file: &mut File,
     checked: &Checked,
     ops: &[Op],
-    scene: Option<&str>,
+    options: &Options,
 ) -> Result<Outcome, EditError> {
+    let scene = options.scene.as_deref();
     let scenes: Vec<(usize, &Scene)> = file
         .items
         .stmts
@@ -477,48 +492,100 @@ pub fn edit(
         return Err(EditError::Input("the scene disappeared".to_string()));
     };
     for g in &guides {
-        let Some(GuideStmt::Polygon(pts)) = (match &mut scene_mut.body.stmts[g.stmt].node {
-            SceneStmt::Guide(guide) => guide
-                .body
-                .stmts
-                .iter_mut()
-                .map(|s| &mut s.node)
-                .find(|s| matches!(s, GuideStmt::Polygon(_))),
+        let SceneStmt::Guide(guide) = &mut scene_mut.body.stmts[g.stmt].node else {
+            continue;
+        };
+        let Some(pts) = guide.body.stmts.iter_mut().find_map(|s| match &mut s.node {
+            GuideStmt::Polygon(pts) => Some(pts),
             _ => None,
         }) else {
             continue;
         };
+        let new: Vec<P2> = g.particles.iter().map(|&p| sol.positions[p]).collect();
         let mut moved = 0;
-        for (k, (pt, &p)) in pts.iter_mut().zip(&g.particles).enumerate() {
-            let new = sol.positions[p];
-            if new == sys.rest[p] {
+        for (k, pt) in pts.iter_mut().enumerate() {
+            if new[k] == sys.rest[g.particles[k]] {
                 continue;
             }
             let mut any = false;
             for (axis, e) in [&mut pt.x, &mut pt.y].into_iter().enumerate() {
-                let v = round(new[axis], places);
-                if v == round(g.points[k][axis], places) {
-                    continue;
-                }
-                if literal(e).is_none() {
-                    outcome.replaced.push(format!(
-                        "{}.v{k} {}: `{}` is now {}",
-                        g.name,
-                        ["x", "y"][axis],
-                        crate::fmt::format_expr(e),
-                        crate::fmt::format_number(v)
-                    ));
-                }
-                *e = Expr {
-                    kind: ExprKind::Num(v),
-                    span: e.span,
-                };
-                any = true;
+                let what = format!("{}.v{k} {}", g.name, ["x", "y"][axis]);
+                any |= write_number(
+                    e,
+                    new[k][axis],
+                    g.points[k][axis],
+                    places,
+                    &what,
+                    &mut outcome,
+                );
             }
             moved += usize::from(any);
         }
-        if moved > 0 {
-            outcome.changed.push((g.name.clone(), moved));
+        if moved == 0 {
+            continue;
+        }
+        outcome.changed.push((g.name.clone(), moved));
+        let fit = affine_fit(&g.points, &new);
+        for (si, st) in guide.body.stmts.iter_mut().enumerate() {
+            let GuideStmt::Seed(seed) = &mut st.node else {
+                continue;
+            };
+            let (Some(x), Some(y)) = (
+                const_value(&seed.at.x, checked),
+                const_value(&seed.at.y, checked),
+            ) else {
+                continue;
+            };
+            let to = fit.apply([x, y]);
+            if options.move_seeds {
+                let name = format!("{}'s seed {}", g.name, si);
+                write_number(
+                    &mut seed.at.x,
+                    to[0],
+                    x,
+                    places,
+                    &format!("{name} x"),
+                    &mut outcome,
+                );
+                write_number(
+                    &mut seed.at.y,
+                    to[1],
+                    y,
+                    places,
+                    &format!("{name} y"),
+                    &mut outcome,
+                );
+                let turn = fit.rotation_degrees();
+                let old = seed
+                    .heading
+                    .as_ref()
+                    .and_then(|h| const_value(h, checked))
+                    .unwrap_or(0.0);
+                let places = places.max(1);
+                if round(turn, places) != 0.0 {
+                    match &mut seed.heading {
+                        Some(h) => {
+                            write_number(
+                                h,
+                                old + turn,
+                                old,
+                                places,
+                                &format!("{name} heading"),
+                                &mut outcome,
+                            );
+                        }
+                        None => seed.heading = Some(Expr::num(round(old + turn, places))),
+                    }
+                }
+                outcome.seeds_moved += 1;
+            } else if !inside(&new, [x, y]) {
+                outcome.warnings.push(format!(
+                    "the seed at ({}, {}) of guide `{}` is outside its moved polygon; --move-seeds carries seeds with their guides",
+                    crate::fmt::format_number(x),
+                    crate::fmt::format_number(y),
+                    g.name
+                ));
+            }
         }
     }
     Ok(outcome)
@@ -638,6 +705,132 @@ fn validate(
     Ok(())
 }
 
+/// Writes `new` (rounded) into the coordinate `e` whose value was `old`, if the
+/// rounded values differ; notes an expression replaced by a number. Returns
+/// whether it wrote.
+fn write_number(
+    e: &mut Expr,
+    new: f64,
+    old: f64,
+    places: usize,
+    what: &str,
+    outcome: &mut Outcome,
+) -> bool {
+    let v = round(new, places);
+    if v == round(old, places) {
+        return false;
+    }
+    if literal(e).is_none() {
+        outcome.replaced.push(format!(
+            "{what}: `{}` is now {}",
+            crate::fmt::format_expr(e),
+            crate::fmt::format_number(v)
+        ));
+    }
+    *e = Expr {
+        kind: ExprKind::Num(v),
+        span: e.span,
+    };
+    true
+}
+
+/// An affine map of the plane: x ↦ A x + t.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Affine {
+    /// Row-major 2×2 matrix.
+    pub a: [f64; 4],
+    pub t: P2,
+}
+
+impl Affine {
+    pub fn apply(&self, p: P2) -> P2 {
+        [
+            self.a[0] * p[0] + self.a[1] * p[1] + self.t[0],
+            self.a[2] * p[0] + self.a[3] * p[1] + self.t[1],
+        ]
+    }
+
+    /// The angle (degrees, counter-clockwise) of the rotation closest to A.
+    pub fn rotation_degrees(&self) -> f64 {
+        (self.a[2] - self.a[1])
+            .atan2(self.a[0] + self.a[3])
+            .to_degrees()
+    }
+}
+
+/// The least-squares affine map taking `from` to `to` (a translation when the
+/// points are collinear).
+pub fn affine_fit(from: &[P2], to: &[P2]) -> Affine {
+    let n = from.len().min(to.len()).max(1) as f64;
+    let mean = |ps: &[P2]| {
+        let s = ps
+            .iter()
+            .fold([0.0, 0.0], |s, p| [s[0] + p[0], s[1] + p[1]]);
+        [s[0] / n, s[1] / n]
+    };
+    let (mp, mq) = (mean(from), mean(to));
+    let (mut pp, mut qp) = ([0.0; 4], [0.0; 4]);
+    for (p, q) in from.iter().zip(to) {
+        let d = [p[0] - mp[0], p[1] - mp[1]];
+        let e = [q[0] - mq[0], q[1] - mq[1]];
+        pp = [
+            pp[0] + d[0] * d[0],
+            pp[1] + d[0] * d[1],
+            pp[2] + d[1] * d[0],
+            pp[3] + d[1] * d[1],
+        ];
+        qp = [
+            qp[0] + e[0] * d[0],
+            qp[1] + e[0] * d[1],
+            qp[2] + e[1] * d[0],
+            qp[3] + e[1] * d[1],
+        ];
+    }
+    let det = pp[0] * pp[3] - pp[1] * pp[2];
+    let scale = (pp[0] + pp[3]).max(f64::MIN_POSITIVE);
+    let a = if det.abs() <= 1e-12 * scale * scale {
+        [1.0, 0.0, 0.0, 1.0]
+    } else {
+        let inv = [pp[3] / det, -pp[1] / det, -pp[2] / det, pp[0] / det];
+        [
+            qp[0] * inv[0] + qp[1] * inv[2],
+            qp[0] * inv[1] + qp[1] * inv[3],
+            qp[2] * inv[0] + qp[3] * inv[2],
+            qp[2] * inv[1] + qp[3] * inv[3],
+        ]
+    };
+    let t = [
+        mq[0] - (a[0] * mp[0] + a[1] * mp[1]),
+        mq[1] - (a[2] * mp[0] + a[3] * mp[1]),
+    ];
+    Affine { a, t }
+}
+
+/// Whether `p` is inside the polygon (even-odd rule; the boundary counts as inside).
+fn inside(poly: &[P2], p: P2) -> bool {
+    let n = poly.len();
+    let mut odd = false;
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        let cross = (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
+        let within = p[0] >= a[0].min(b[0])
+            && p[0] <= a[0].max(b[0])
+            && p[1] >= a[1].min(b[1])
+            && p[1] <= a[1].max(b[1]);
+        let len = spring::dist(a, b);
+        if within && cross.abs() <= 1e-9 * len * len.max(1.0) {
+            return true;
+        }
+        if (a[1] > p[1]) != (b[1] > p[1]) {
+            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+            if p[0] < x {
+                odd = !odd;
+            }
+        }
+    }
+    odd
+}
+
 /// The value of a number literal (`3`, `-2.5`), or `None` for any other expression.
 fn literal(e: &Expr) -> Option<f64> {
     match &e.kind {
@@ -726,7 +919,7 @@ scene S {
         assert!(!fe.has_errors(), "{:?}", fe.diagnostics);
         let checked = fe.checked.as_ref().expect("checked");
         let mut file = fe.file.clone();
-        let out = edit(&mut file, checked, ops, None)?;
+        let out = edit(&mut file, checked, ops, &Options::default())?;
         Ok((crate::fmt::format_file(&file), out))
     }
 
@@ -819,6 +1012,52 @@ scene S {
         );
         let e = run("lsystem A { axiom F; }", &[]).unwrap_err();
         assert!(matches!(e, EditError::Input(_)), "{e:?}");
+    }
+
+    #[test]
+    fn seeds_follow_their_guide_only_when_asked() {
+        let text = "lsystem A { axiom F; }\nscene S { guide g { polygon (0, 0) (10, 0) (10, 10) (0, 10); system A; seed (5, 1); } }\n";
+        let ops = [parse_rotate("g=90").expect("parses")];
+        let (out, o) = run(text, &ops).expect("edits");
+        assert!(out.contains("seed (5, 1);"), "{out}");
+        assert_eq!(o.seeds_moved, 0);
+        // (5, 1) rotated by 90° about (5, 5) is (9, 5), inside: no warning.
+        assert!(o.warnings.is_empty(), "{:?}", o.warnings);
+        let fe = frontend::run(text, Vec::new(), &[]);
+        let mut file = fe.file.clone();
+        let checked = fe.checked.as_ref().expect("checked");
+        let options = Options {
+            move_seeds: true,
+            ..Options::default()
+        };
+        let o = edit(&mut file, checked, &ops, &options).expect("edits");
+        let out = crate::fmt::format_file(&file);
+        assert!(out.contains("seed (9, 5) heading 90;"), "{out}");
+        assert_eq!(o.seeds_moved, 1);
+        // Translated away without --move-seeds: a warning.
+        let (_, o) = run(text, &[parse_translate("g=100,0").expect("parses")]).expect("edits");
+        assert_eq!(o.warnings.len(), 1, "{:?}", o.warnings);
+    }
+
+    #[test]
+    fn affine_fit_recovers_a_similarity() {
+        let from = [[0.0, 0.0], [4.0, 0.0], [4.0, 2.0], [0.0, 3.0]];
+        let (s, c) = 30f64.to_radians().sin_cos();
+        let map = |p: P2| {
+            [
+                2.0 * (c * p[0] - s * p[1]) + 7.0,
+                2.0 * (s * p[0] + c * p[1]) - 1.0,
+            ]
+        };
+        let to: Vec<P2> = from.iter().map(|&p| map(p)).collect();
+        let fit = affine_fit(&from, &to);
+        let q = fit.apply([1.0, 1.0]);
+        let want = map([1.0, 1.0]);
+        assert!((q[0] - want[0]).abs() < 1e-9 && (q[1] - want[1]).abs() < 1e-9);
+        assert!((fit.rotation_degrees() - 30.0).abs() < 1e-9);
+        assert!(inside(&from, [1.0, 1.0]));
+        assert!(inside(&from, [4.0, 1.0]));
+        assert!(!inside(&from, [5.0, 1.0]));
     }
 
     #[test]

@@ -297,3 +297,15 @@ fn input_errors_exit_1() {
     ];
     insta::assert_snapshot!("input_errors", cases.join("\n"));
 }
+
+#[test]
+fn seeds_stay_unless_asked_to_follow() {
+    insta::assert_snapshot!(
+        "seeds",
+        [
+            snapshot(&["--rotate", "bed=-30"]),
+            snapshot(&["--rotate", "bed=-30", "--move-seeds"]),
+        ]
+        .join("\n")
+    );
+}
