@@ -18,6 +18,7 @@ use crate::ast::{
 use crate::lexer::Comment;
 use crate::span::Span;
 use glam::DVec2;
+use std::collections::HashMap;
 
 /// Stroke widths vary when the widest is this much wider than the narrowest.
 const WIDTHS_VARY: f64 = 1.15;
@@ -89,11 +90,39 @@ fn turn(deg: f64) -> Option<Module> {
     (d != 0.0).then(|| sym(if d > 0.0 { '+' } else { '-' }, Some(Expr::num(d.abs()))))
 }
 
-/// The module name of an id: `R` for the root, `B<k>` otherwise.
-pub fn module_name(c: Child) -> String {
+/// The letters that name modules, in order: not `F` (it draws) nor `R` (the root).
+const LETTERS: &str = "ABCDEGHIJKLMNOPQSTUVWXYZ";
+
+/// The `k`-th module name after `R`: `A`, `B`, …, `Z`, then `AA`, `AB`, …
+/// Letters only, so that a derived string reads back as an axiom.
+fn letters_name(mut k: usize) -> String {
+    let base = LETTERS.len();
+    let mut out = Vec::new();
+    loop {
+        out.push(LETTERS.as_bytes()[k % base] as char);
+        if k < base {
+            break;
+        }
+        k = k / base - 1;
+    }
+    out.iter().rev().collect()
+}
+
+/// Module names of the productions: `R` for the root `r`, letters for the
+/// other ids in P order.
+pub fn module_names(prods: &[Production]) -> HashMap<usize, String> {
+    let mut names = HashMap::from([(0, "R".to_string())]);
+    for p in prods.iter().filter(|p| p.id != 0) {
+        let k = names.len() - 1;
+        names.insert(p.id, letters_name(k));
+    }
+    names
+}
+
+fn name_of(names: &HashMap<usize, String>, c: Child) -> String {
     match c {
-        Child::Id(0) | Child::T => "R".to_string(),
-        Child::Id(k) => format!("B{k}"),
+        Child::Id(k) => names.get(&k).cloned().unwrap_or_else(|| "R".to_string()),
+        Child::T => "R".to_string(),
     }
 }
 
@@ -246,6 +275,7 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
     });
     axiom.push(named("R", vec![trunk_len, width]));
 
+    let names = module_names(&prods);
     // Children of each rule, measured on its base branch.
     let mut geoms: Vec<Vec<ChildGeom>> = Vec::new();
     for p in &prods {
@@ -266,7 +296,7 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
                 None => 0.0,
             };
             g.push(ChildGeom {
-                module: module_name(*c),
+                module: name_of(&names, *c),
                 vertex: v,
                 angle: angle(b.heading_at(v), child.direction(0)),
                 ratio: child.length() / b.length().max(f64::MIN_POSITIVE),
@@ -292,7 +322,7 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
     stmts.push(node(Stmt::Axiom(axiom)));
     let mut decls: Vec<Node<Item>> = Vec::new();
     for (p, g) in prods.iter().zip(&geoms) {
-        let m = module_name(Child::Id(p.id));
+        let m = name_of(&names, Child::Id(p.id));
         decls.push(node(Item::Module(ModuleDecl {
             name: Ident::new(m.clone()),
             params: vec![Ident::new("l"), Ident::new("w")],
@@ -377,7 +407,7 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
             succ,
         }));
         rule.trivia.leading.push(comment(format!(
-            "{p}: drawn like {}{}",
+            "{p}: module {m}, drawn like {}{}",
             stroke_name(s, base),
             if p.succ.is_empty() {
                 ""
@@ -412,9 +442,24 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
     for p in &a.reduced {
         header.push(format!("  {p}"));
     }
-    header.push(
-        "Module R is r, Bk is k. Each rule draws the branch that names it as sketched".into(),
-    );
+    let mut named: Vec<String> = prods
+        .iter()
+        .map(|p| {
+            format!(
+                "{} is {}",
+                name_of(&names, Child::Id(p.id)),
+                Child::Id(p.id)
+            )
+        })
+        .collect();
+    if let Some(last) = named.last_mut() {
+        last.push('.');
+    }
+    for (k, chunk) in named.chunks(8).enumerate() {
+        let lead = if k == 0 { "Modules: " } else { "  " };
+        header.push(format!("{lead}{}", chunk.join(", ")));
+    }
+    header.push("Each rule draws the branch that names it as sketched".into());
     header.push(format!(
         "and its children at their junctions; derive {} draws the sketch's {} levels,",
         sk.height() + 1,
@@ -478,9 +523,8 @@ pub fn system_name(stem: &str) -> String {
             out.extend(cs);
         }
     }
-    let clashes = out == "R"
-        || out.contains('_')
-        || (out.starts_with('B') && out.len() > 1 && out[1..].chars().all(|c| c.is_ascii_digit()));
+    // All capitals could be a module (`R`, `AB`) or a constant (`KW`).
+    let clashes = out == out.to_ascii_uppercase();
     if out.is_empty() || out.starts_with(|c: char| c.is_ascii_digit()) || clashes {
         out = format!("Sketch{out}");
     }
@@ -496,7 +540,19 @@ mod tests {
         assert_eq!(system_name("sketch-tree"), "SketchTree");
         assert_eq!(system_name("3d_oak"), "Sketch3dOak");
         assert_eq!(system_name("r"), "SketchR");
+        assert_eq!(system_name("KW"), "SketchKW");
         assert_eq!(system_name("b12"), "SketchB12");
         assert_eq!(system_name("é"), "Sketch");
+    }
+
+    #[test]
+    fn module_names_are_letters() {
+        assert_eq!(letters_name(0), "A");
+        assert_eq!(letters_name(4), "E");
+        assert_eq!(letters_name(5), "G");
+        assert_eq!(letters_name(23), "Z");
+        assert_eq!(letters_name(24), "AA");
+        assert_eq!(letters_name(24 * 25 - 1), "ZZ");
+        assert_eq!(letters_name(24 * 25), "AAA");
     }
 }

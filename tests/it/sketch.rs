@@ -143,7 +143,7 @@ fn figure_2_sketched_gives_the_papers_productions() {
     ] {
         assert!(inf.text.contains(line), "{}", inf.text);
     }
-    assert!(inf.text.contains("B2(l, w) -> "), "{}", inf.text);
+    assert!(inf.text.contains("B(l, w) -> "), "{}", inf.text);
 }
 
 /// Parses an OBJ file and checks it: every face index names an existing vertex
