@@ -203,7 +203,16 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
             .iter()
             .map(|(g, n)| format!("{g} ({n} vert{})", if *n == 1 { "ex" } else { "ices" }))
             .collect();
-        format!("changed {}", list.join(", "))
+        const SHOWN: usize = 8;
+        if list.len() > SHOWN {
+            format!(
+                "changed {} and {} more guides",
+                list[..SHOWN].join(", "),
+                list.len() - SHOWN
+            )
+        } else {
+            format!("changed {}", list.join(", "))
+        }
     };
     let changed = match outcome.seeds_moved {
         0 => changed,
