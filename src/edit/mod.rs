@@ -1060,6 +1060,51 @@ scene S {
         assert!(!inside(&from, [5.0, 1.0]));
     }
 
+    fn points(line: &str) -> Vec<P2> {
+        line.trim()
+            .trim_start_matches("polygon")
+            .trim_end_matches(';')
+            .split(')')
+            .filter_map(|p| {
+                let (x, y) = p.trim().trim_start_matches('(').split_once(',')?;
+                Some([x.trim().parse().ok()?, y.trim().parse().ok()?])
+            })
+            .collect()
+    }
+
+    #[test]
+    fn linked_edges_keep_their_length() {
+        // p and q are the same square; q's edge 0 carries a link.
+        let text = "lsystem A { axiom F; }\nscene S {\n\
+            guide p { polygon (0, 0) (10, 0) (10, 10) (0, 10); system A; }\n\
+            guide q { polygon (20, 0) (30, 0) (30, 10) (20, 10); system A; }\n\
+            guide r { polygon (50, 50) (60, 50) (55, 60); system A; }\n\
+            link q.edge(0) -> r.edge(1) { tokens 1; }\n}\n";
+        let ops: Vec<Op> = ["p", "q"]
+            .iter()
+            .flat_map(|g| {
+                [
+                    parse_pin(&format!("{g}.v0")),
+                    parse_pin(&format!("{g}.v3")),
+                    parse_by(&format!("{g}.v2=4,0")),
+                ]
+            })
+            .collect::<Result<_, _>>()
+            .expect("parses");
+        let (out, _) = run(text, &ops).expect("edits");
+        let edge0 = |g: &str| {
+            let pts = points(polygon_line(&out, g));
+            assert_eq!(pts.len(), 4, "{out}");
+            spring::dist(pts[0], pts[1])
+        };
+        let (free, linked) = (edge0("p") - 10.0, edge0("q") - 10.0);
+        assert!(free.abs() > 0.1, "{out}");
+        assert!(
+            linked.abs() < free.abs() / 10.0,
+            "linked {linked} vs free {free}\n{out}"
+        );
+    }
+
     #[test]
     fn argument_syntax() {
         assert_eq!(
