@@ -137,6 +137,26 @@ fn nearest(points: &[DVec2], p: DVec2) -> (f64, f64) {
     best
 }
 
+/// The stroke nearest to `p` among those whose bounding box is within `within`
+/// of it: (index, (distance, arc length there)).
+fn near(
+    raw: &[Vec<DVec2>],
+    boxes: &[[f64; 4]],
+    p: DVec2,
+    within: f64,
+) -> Option<(usize, (f64, f64))> {
+    raw.iter()
+        .zip(boxes)
+        .enumerate()
+        .filter(|(_, (_, b))| {
+            let dx = (b[0] - p.x).max(p.x - b[2]).max(0.0);
+            let dy = (b[1] - p.y).max(p.y - b[3]).max(0.0);
+            dx * dx + dy * dy <= within * within
+        })
+        .map(|(j, (r, _))| (j, nearest(r, p)))
+        .min_by(|a, b| a.1.0.total_cmp(&b.1.0))
+}
+
 /// Builds the tree. `epsilon` defaults to `EPSILON_OF_DIAGONAL` of the drawing.
 /// `strokes` must not be empty.
 pub fn build(strokes: &[Stroke], epsilon: Option<f64>) -> Result<Skeleton, Detached> {
@@ -153,33 +173,31 @@ pub fn build(strokes: &[Stroke], epsilon: Option<f64>) -> Result<Skeleton, Detac
     {
         t.reverse();
     }
+    let boxes: Vec<[f64; 4]> = raw.iter().map(|r| bbox(r.iter())).collect();
     let mut parent: Vec<Option<(usize, f64)>> = vec![None; n];
     for i in 1..n {
-        let near = |p: DVec2| {
-            (0..i)
-                .map(|j| (j, nearest(&raw[j], p)))
-                .min_by(|a, b| a.1.0.total_cmp(&b.1.0))
-        };
         let (Some(first), Some(last)) = (raw[i].first().copied(), raw[i].last().copied()) else {
             continue;
         };
-        let (Some(at_start), Some(at_end)) = (near(first), near(last)) else {
-            continue;
+        let at_start = near(&raw[..i], &boxes[..i], first, attach);
+        let at_end = near(&raw[..i], &boxes[..i], last, attach);
+        let (j, s) = match (at_start, at_end) {
+            (Some((j, (d, s))), _) if d <= attach => (j, s),
+            (_, Some((j, (d, s)))) if d <= attach => {
+                // Drawn from the tip inward: turn it round.
+                raw[i].reverse();
+                (j, s)
+            }
+            _ => {
+                let distance = near(&raw[..i], &boxes[..i], first, f64::INFINITY)
+                    .map_or(f64::INFINITY, |(_, (d, _))| d);
+                return Err(Detached {
+                    stroke: strokes[i].describe(),
+                    distance,
+                    limit: attach,
+                });
+            }
         };
-        let (j, (dist, s)) = if at_start.1.0 <= attach || at_end.1.0 > attach {
-            at_start
-        } else {
-            // Drawn from the tip inward: turn it round.
-            raw[i].reverse();
-            at_end
-        };
-        if dist > attach {
-            return Err(Detached {
-                stroke: strokes[i].describe(),
-                distance: dist,
-                limit: attach,
-            });
-        }
         // Starting at the start of a sibling (a fork drawn as separate strokes)
         // means starting where that sibling starts: on their parent.
         let (mut j, mut s) = (j, s);
@@ -220,10 +238,16 @@ pub fn build(strokes: &[Stroke], epsilon: Option<f64>) -> Result<Skeleton, Detac
             branches[i].level = branches[p].level + 1;
         }
     }
-    for p in 0..n {
-        let mut kids: Vec<(f64, usize, usize)> = (0..n)
-            .filter(|&c| branches[c].parent == Some(p))
-            .map(|c| {
+    let mut children_of: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (c, b) in branches.iter().enumerate() {
+        if let Some(p) = b.parent {
+            children_of[p].push(c);
+        }
+    }
+    for (p, cs) in children_of.iter().enumerate() {
+        let mut kids: Vec<(f64, usize, usize)> = cs
+            .iter()
+            .map(|&c| {
                 let v = vertex_of[c];
                 let a = angle(branches[p].heading_at(v), branches[c].direction(0));
                 (a, v, c)
