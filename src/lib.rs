@@ -12,6 +12,7 @@ pub mod derive;
 pub mod diagnostic;
 pub mod dump;
 pub mod edit;
+pub mod env;
 pub mod fmt;
 pub mod frontend;
 pub mod infer;

@@ -267,3 +267,202 @@ impl Stats {
         }
     }
 }
+
+/// A scene after its run, ready to draw.
+pub struct SceneRun {
+    pub scene: crate::env::Scene,
+    pub outcome: crate::env::Outcome,
+    pub derive_ms: f64,
+}
+
+/// Builds and runs the scene called `name` (or the first one).
+pub fn run_scene(
+    file: &File,
+    checked: &Checked,
+    name: Option<&str>,
+    opts: &Options,
+) -> Result<SceneRun, Diagnostic> {
+    let mut scene =
+        crate::env::build(file, checked, name).map_err(crate::env::scene::build_error)?;
+    let start = Instant::now();
+    let outcome = crate::env::run(&mut scene, opts.seed, opts.limits, opts.steps)?;
+    Ok(SceneRun {
+        scene,
+        outcome,
+        derive_ms: start.elapsed().as_secs_f64() * 1000.0,
+    })
+}
+
+/// Draws every instance of a scene into `sink`, each clipped to its guide by
+/// the centre rule.
+fn draw_scene(
+    r: &SceneRun,
+    seed: u64,
+    sink: &mut dyn crate::turtle::Sink,
+) -> Result<Drawn, Diagnostic> {
+    let mut total = Drawn::default();
+    for (gi, g) in r.scene.guides.iter().enumerate() {
+        let prog = &r.scene.programs[g.program];
+        for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
+            let mut clip = crate::env::scene::Clip {
+                polygon: &g.polygon,
+                inner: &mut *sink,
+                kept: 0,
+                removed: 0,
+            };
+            let d = turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
+                .map_err(|e| runtime_diagnostic(&e, prog))?;
+            total.segments += clip.kept;
+            total.elements += d.elements;
+            total.polygons += d.polygons;
+            if let Some(b) = d.bbox {
+                let t = total.bbox.get_or_insert(b);
+                *t = [
+                    t[0].min(b[0]),
+                    t[1].min(b[1]),
+                    t[2].max(b[2]),
+                    t[3].max(b[3]),
+                ];
+            }
+        }
+    }
+    Ok(total)
+}
+
+/// The `--stats` of a scene: the contract's fields plus answered queries and messages.
+#[derive(Serialize)]
+pub struct SceneStats {
+    pub scene: String,
+    pub modules: usize,
+    pub segments: u64,
+    pub elements: u64,
+    pub polygons: u64,
+    pub bbox: Option<[f64; 4]>,
+    pub steps: u32,
+    pub systems: usize,
+    pub queries: u64,
+    pub messages: u64,
+    pub derive_ms: f64,
+    pub interpret_ms: f64,
+}
+
+/// Writes a scene in `format` to `out` (`guides`: draw outlines and links too).
+pub fn write_scene(
+    r: &SceneRun,
+    format: Option<Format>,
+    picture: Picture,
+    seed: u64,
+    guides: bool,
+    out: &mut dyn Write,
+) -> Result<SceneStats, OutputError> {
+    let start = Instant::now();
+    let view = View::new(r.scene.programs.iter().any(|p| p.is_3d));
+    // Elements are items of the file, the same for every system of the scene.
+    let elements: &[crate::compile::ElementDef] =
+        r.scene.programs.first().map_or(&[], |p| &p.elements);
+    let boxes: Vec<[f64; 4]> = r.scene.programs.first().map_or(Vec::new(), element_boxes);
+    let used = vec![true; elements.len()];
+    let mut bounds_sink = BoundsSink {
+        view,
+        bounds: Bounds::default(),
+        element_boxes: &boxes,
+    };
+    let drawn = draw_scene(r, seed, &mut bounds_sink).map_err(OutputError::Diagnostic)?;
+    let mut bounds = bounds_sink.bounds;
+    for g in &r.scene.guides {
+        for p in &g.polygon {
+            bounds.add(view.project(p.extend(0.0)));
+        }
+    }
+    let outline = |g: &crate::env::scene::Guide| -> Vec<glam::DVec3> {
+        g.polygon.iter().map(|p| p.extend(0.0)).collect()
+    };
+    let edge_mid = |(g, e): (usize, usize)| {
+        let poly = &r.scene.guides[g].polygon;
+        let n = poly.len().max(1);
+        ((poly[e % n] + poly[(e + 1) % n]) * 0.5).extend(0.0)
+    };
+    match format {
+        Some(Format::Svg) => {
+            let mut w = render::svg::SvgWriter::new(out, view, &bounds, elements, &used)?;
+            let names: Vec<&str> = r.scene.guides.iter().map(|g| g.name.as_str()).collect();
+            for (gi, g) in r.scene.guides.iter().enumerate() {
+                w.begin_guide(names[gi]);
+                let prog = &r.scene.programs[g.program];
+                for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
+                    let mut clip = crate::env::scene::Clip {
+                        polygon: &g.polygon,
+                        inner: &mut w,
+                        kept: 0,
+                        removed: 0,
+                    };
+                    turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
+                        .map_err(|e| OutputError::Diagnostic(runtime_diagnostic(&e, prog)))?;
+                }
+                w.end_guide();
+            }
+            if guides {
+                for g in &r.scene.guides {
+                    w.guide_outline(&g.name, &outline(g));
+                }
+                for l in &r.scene.links {
+                    w.link_line(
+                        names[l.from.0],
+                        names[l.to.0],
+                        edge_mid(l.from),
+                        edge_mid(l.to),
+                    );
+                }
+            }
+            w.finish()?;
+        }
+        Some(Format::Png) => {
+            let mut w = render::png::PngWriter::new(
+                picture.size,
+                picture.background,
+                view,
+                &bounds,
+                elements,
+            )
+            .ok_or_else(|| std::io::Error::other("the image size is not possible"))?;
+            draw_scene(r, seed, &mut w).map_err(OutputError::Diagnostic)?;
+            if guides {
+                for g in &r.scene.guides {
+                    let pts = outline(g);
+                    for i in 0..pts.len() {
+                        crate::turtle::Sink::segment(
+                            &mut w,
+                            pts[i],
+                            pts[(i + 1) % pts.len()],
+                            0.0,
+                            10,
+                        );
+                    }
+                }
+            }
+            let bytes = w.finish().map_err(std::io::Error::other)?;
+            out.write_all(&bytes)?;
+        }
+        Some(other) => {
+            return Err(OutputError::Io(std::io::Error::other(format!(
+                "{other:?} output of a scene is not available; use .svg or .png"
+            ))));
+        }
+        None => {}
+    }
+    let round = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
+    Ok(SceneStats {
+        scene: r.scene.name.clone(),
+        modules: r.outcome.instances.iter().map(|i| i.string.len()).sum(),
+        segments: drawn.segments,
+        elements: drawn.elements,
+        polygons: drawn.polygons,
+        bbox: drawn.bbox.map(|b| b.map(round)),
+        steps: r.outcome.steps,
+        systems: r.outcome.instances.len(),
+        queries: r.outcome.queries,
+        messages: r.outcome.messages,
+        derive_ms: round(r.derive_ms),
+        interpret_ms: round(start.elapsed().as_secs_f64() * 1000.0),
+    })
+}

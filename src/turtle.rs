@@ -25,6 +25,10 @@ pub trait Sink {
     /// Element `index` printed at `at`, its local +y along `h`, its local −x along
     /// `l` (so local +x is −l), scaled by `scale`.
     fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32);
+    /// Query module number `module` of the string (kind: index into
+    /// `query::QUERIES`) met with the turtle in `state`. Only the environment
+    /// of a scene listens.
+    fn query(&mut self, _module: usize, _kind: u8, _state: &State) {}
 }
 
 /// The turtle's state, saved by `[` and restored by `]`.
@@ -162,10 +166,22 @@ pub fn interpret(
     seed: u64,
     sink: &mut dyn Sink,
 ) -> Result<Drawn, DeriveError> {
+    interpret_from(prog, s, seed, State::default(), sink)
+}
+
+/// Interprets from a given start state (a seed's position and heading).
+pub fn interpret_from(
+    prog: &Program,
+    s: &ModString,
+    seed: u64,
+    start: State,
+    sink: &mut dyn Sink,
+) -> Result<Drawn, DeriveError> {
     let mut t = Turtle {
         prog,
         sink,
-        state: State::default(),
+        state: start,
+        module_index: 0,
         stack: Vec::new(),
         polygons: Vec::new(),
         drawn: Drawn::default(),
@@ -184,6 +200,7 @@ pub fn interpret(
         let n = prog.symbols.arity(sym);
         let params = &s.params[p..p + n];
         p += n;
+        t.module_index = i;
         if has_interp && !prog.interpret[sym as usize].is_empty() {
             t.expand(sym, params, i as u64, 0)?;
         } else {
@@ -205,6 +222,8 @@ struct Turtle<'a> {
     trig: Trig,
     /// Candidates of a stochastic interpretation rule (reused).
     cands: Vec<(usize, f64)>,
+    /// Index of the module being interpreted (for query answers).
+    module_index: usize,
 }
 
 impl Turtle<'_> {
@@ -371,6 +390,10 @@ impl Turtle<'_> {
                 self.drawn.grow(self.state.pos);
                 let st = self.state;
                 self.sink.element(i, st.pos, st.h, st.l, st.scale, st.color);
+            }
+            Action::Query(kind) => {
+                let st = self.state;
+                self.sink.query(self.module_index, kind, &st);
             }
             Action::None | Action::Cut => {}
             other => self

@@ -61,6 +61,15 @@ pub struct Args {
     /// Print the compiled bytecode of every rule and exit.
     #[arg(long)]
     pub disasm: bool,
+
+    /// For a scene: also draw the guides' outlines and the links.
+    #[arg(long)]
+    pub guides: bool,
+
+    /// Which scene of the file to run (default: the first); `--system` runs one
+    /// lsystem on its own instead.
+    #[arg(long, value_name = "NAME")]
+    pub scene: Option<String>,
 }
 
 pub fn run(args: &Args, reporter: &Reporter) -> u8 {
@@ -117,7 +126,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         ));
         return 2;
     }
-    let fe = frontend::run(&src.text, src.diagnostics, &ovr);
+    let fe = frontend::run(&src.text, src.diagnostics.clone(), &ovr);
     reporter.emit(&fe.diagnostics, &src.name, &src.text);
     let Some(checked) = fe.checked.as_ref().filter(|_| !fe.has_errors()) else {
         return 1;
@@ -128,13 +137,6 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         .stmts
         .iter()
         .any(|i| matches!(i.node, lsyc::ast::Item::Scene(_)));
-    if has_scene && args.system.is_none() && !args.disasm {
-        reporter.say(&format!(
-            "error: `{}` holds a scene; scenes (guides, links, query answers) are not run yet. Run one of its lsystems on its own with --system NAME",
-            src.name
-        ));
-        return 2;
-    }
     let opts = Options {
         steps: args.steps,
         seed: args.seed,
@@ -144,6 +146,11 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         },
         system: args.system.clone(),
     };
+    if has_scene && args.system.is_none() && !args.disasm {
+        return run_scene(
+            args, reporter, &src, &fe.file, checked, &opts, format, background,
+        );
+    }
     if args.disasm {
         return match lsyc::compile::compile(&fe.file, checked, opts.system.as_deref()) {
             Ok(p) => {
@@ -267,4 +274,93 @@ fn progress_bar(steps: Option<u32>) -> Option<indicatif::ProgressBar> {
         bar.set_style(style);
     }
     Some(bar)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_scene(
+    args: &Args,
+    reporter: &Reporter,
+    src: &source::Source,
+    file: &lsyc::ast::File,
+    checked: &lsyc::check::Checked,
+    opts: &Options,
+    format: Option<Format>,
+    background: [u8; 4],
+) -> u8 {
+    let r = match run::run_scene(file, checked, args.scene.as_deref(), opts) {
+        Ok(r) => r,
+        Err(d) => {
+            reporter.emit(&[d], &src.name, &src.text);
+            return 1;
+        }
+    };
+    let picture = Picture {
+        size: args.size,
+        background,
+    };
+    let stats = match &args.output {
+        Some(path) => {
+            let mut stats = None;
+            let written = source::write_atomic_with(path, |w| {
+                match run::write_scene(&r, format, picture, args.seed, args.guides, w) {
+                    Ok(s) => {
+                        stats = Some(s);
+                        Ok(())
+                    }
+                    Err(OutputError::Io(e)) => Err(e),
+                    Err(OutputError::Diagnostic(d)) => {
+                        reporter.emit(&[d], &src.name, &src.text);
+                        Err(std::io::Error::other("stopped by an error"))
+                    }
+                }
+            });
+            match (written, stats) {
+                (Ok(()), Some(s)) => s,
+                (Err(e), _) if e.to_string() != "stopped by an error" => {
+                    reporter.emit(
+                        &[Diagnostic::error(
+                            Code::WriteOutput,
+                            format!("cannot write `{}`: {e}", path.display()),
+                        )],
+                        &src.name,
+                        &src.text,
+                    );
+                    return 1;
+                }
+                _ => return 1,
+            }
+        }
+        None => match run::write_scene(&r, None, picture, args.seed, false, &mut std::io::sink()) {
+            Ok(s) => s,
+            Err(OutputError::Diagnostic(d)) => {
+                reporter.emit(&[d], &src.name, &src.text);
+                return 1;
+            }
+            Err(OutputError::Io(e)) => {
+                reporter.say(&format!("error: {e}"));
+                return 1;
+            }
+        },
+    };
+    if args.stats
+        && let Ok(s) = serde_json::to_string(&stats)
+    {
+        println!("{s}");
+    }
+    let wrote = args
+        .output
+        .as_ref()
+        .map_or(String::new(), |p| format!(", wrote {}", p.display()));
+    reporter.say(&format!(
+        "scene {}: {} systems, {} modules, {} segments, {} elements, {} queries, {} messages after {} steps{wrote}",
+        stats.scene,
+        stats.systems,
+        stats.modules,
+        stats.segments,
+        stats.elements,
+        stats.queries,
+        stats.messages,
+        stats.steps
+    ));
+    0
 }

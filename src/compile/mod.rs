@@ -45,6 +45,8 @@ pub enum Action {
     Cut,
     /// Prints element `n` (index into `Program::elements`).
     Element(u16),
+    /// A query module (index into `query::QUERIES`), answered by the environment.
+    Query(u8),
 }
 
 #[derive(Clone, Debug)]
@@ -215,7 +217,10 @@ fn action_of(name: &ModName, element: Option<u16>) -> Action {
             _ => Action::None,
         },
         ModName::Cut => Action::Cut,
-        ModName::Query(_) => Action::None,
+        ModName::Query(q) => crate::query::QUERIES
+            .iter()
+            .position(|x| x.name == q)
+            .map_or(Action::None, |i| Action::Query(i as u8)),
     }
 }
 

@@ -153,6 +153,61 @@ impl<W: Write> SvgWriter<W> {
         }
     }
 
+    /// Starts the layer of one guide's drawing.
+    pub fn begin_guide(&mut self, name: &str) {
+        self.close_path();
+        let line = format!("<g class=\"guide-content\" data-guide=\"{}\">\n", xml(name));
+        self.write(line.as_bytes());
+    }
+
+    /// Ends the layer started by `begin_guide`.
+    pub fn end_guide(&mut self) {
+        self.close_path();
+        self.write(b"</g>\n");
+    }
+
+    /// Draws a guide's outline.
+    pub fn guide_outline(&mut self, name: &str, points: &[DVec3]) {
+        self.close_path();
+        let mut buf = format!(
+            "<polygon class=\"guide\" data-guide=\"{}\" fill=\"none\" stroke=\"#1565c0\" stroke-dasharray=\"4 3\" vector-effect=\"non-scaling-stroke\" points=\"",
+            xml(name)
+        )
+        .into_bytes();
+        for (i, &p) in points.iter().enumerate() {
+            if i > 0 {
+                buf.push(b' ');
+            }
+            let q = self.view.project(p);
+            write_num(&mut buf, q.x, self.decimals);
+            buf.push(b',');
+            write_num(&mut buf, -q.y, self.decimals);
+        }
+        buf.extend_from_slice(b"\"/>\n");
+        self.write(&buf);
+    }
+
+    /// Draws a link from the middle of one edge to the middle of another.
+    pub fn link_line(&mut self, from: &str, to: &str, a: DVec3, b: DVec3) {
+        self.close_path();
+        let (pa, pb) = (self.view.project(a), self.view.project(b));
+        let mut buf = format!(
+            "<line class=\"link\" data-from=\"{}\" data-to=\"{}\" stroke=\"#c62828\" vector-effect=\"non-scaling-stroke\" x1=\"",
+            xml(from),
+            xml(to)
+        )
+        .into_bytes();
+        write_num(&mut buf, pa.x, self.decimals);
+        buf.extend_from_slice(b"\" y1=\"");
+        write_num(&mut buf, -pa.y, self.decimals);
+        buf.extend_from_slice(b"\" x2=\"");
+        write_num(&mut buf, pb.x, self.decimals);
+        buf.extend_from_slice(b"\" y2=\"");
+        write_num(&mut buf, -pb.y, self.decimals);
+        buf.extend_from_slice(b"\"/>\n");
+        self.write(&buf);
+    }
+
     /// Ends the document and returns the writer.
     pub fn finish(mut self) -> io::Result<W> {
         self.close_path();

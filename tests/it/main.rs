@@ -5,5 +5,6 @@ mod corpus;
 mod diagnostics;
 mod edit;
 mod run;
+mod scene;
 mod sketch;
 mod support;

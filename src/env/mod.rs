@@ -1,0 +1,13 @@
+//! The environment of Open L-systems: scenes of guides that host L-systems,
+//! links between guide edges that carry tokens and send messages, and the
+//! answers to query modules.
+//!
+//! Owns: building a runnable scene from a checked file (`scene::build`), the
+//! derive–interpret–answer loop of Měch & Prusinkiewicz (1996) over all active
+//! L-systems (`scene::run`), the centre rule that clips each guide's drawing,
+//! and geometry helpers. Must not parse or print programs.
+
+pub mod geometry;
+pub mod scene;
+
+pub use scene::{Outcome, Scene, build, run};
