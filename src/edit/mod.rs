@@ -1106,6 +1106,46 @@ scene S {
     }
 
     #[test]
+    fn snapping_has_a_tolerance_relative_to_the_scene() {
+        // b's first vertex is 10⁻⁵ of the scene away from a's second: one particle.
+        let near = "lsystem A { axiom F; }\nscene S {\n\
+            guide a { polygon (0, 0) (10, 0) (5, 8); system A; }\n\
+            guide b { polygon (10.001, 0) (20, 0) (15, 8); system A; }\n}\n";
+        let (_, o) = run(near, &[]).expect("edits");
+        assert_eq!(o.particles, 5);
+        let (out, o) = run(near, &[parse_by("a.v1=0,1").expect("parses")]).expect("edits");
+        assert_eq!(o.changed.len(), 2, "{out}");
+        // 1% of the scene apart: two particles, b stays.
+        let far = near.replace("10.001", "10.2");
+        let (out, o) = run(&far, &[parse_by("a.v1=0,1").expect("parses")]).expect("edits");
+        assert_eq!(o.particles, 6);
+        assert_eq!(o.changed, [("a".to_string(), 3)], "{out}");
+    }
+
+    #[test]
+    fn the_scene_is_chosen_by_name() {
+        let text = "lsystem A { axiom F; }\n\
+            scene One { guide a { polygon (0, 0) (1, 0) (0, 1); system A; } }\n\
+            scene Two { guide b { polygon (0, 0) (1, 0) (0, 1); system A; } }\n";
+        let e = run(text, &[parse_translate("b=1,0").expect("parses")]).unwrap_err();
+        assert!(
+            matches!(&e, EditError::Usage(_, Some(h)) if h.contains("--scene Two")),
+            "{e:?}"
+        );
+        let fe = frontend::run(text, Vec::new(), &[]);
+        let mut file = fe.file.clone();
+        let options = Options {
+            scene: Some("Two".to_string()),
+            ..Options::default()
+        };
+        let checked = fe.checked.as_ref().expect("checked");
+        let ops = [parse_translate("b=1,0").expect("parses")];
+        let o = edit(&mut file, checked, &ops, &options).expect("edits");
+        assert_eq!(o.scene, "Two");
+        assert_eq!(o.changed, [("b".to_string(), 3)]);
+    }
+
+    #[test]
     fn argument_syntax() {
         assert_eq!(
             parse_move("trunk.v2=40,-310.5"),
