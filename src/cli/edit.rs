@@ -190,8 +190,9 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     }
     if !outcome.converged {
         reporter.say(&format!(
-            "warning: the spring system did not settle in {} iterations; the positions are the last ones",
-            outcome.iterations
+            "warning: the spring system did not settle in {} iteration{}; the positions are the last ones",
+            outcome.iterations,
+            if outcome.iterations == 1 { "" } else { "s" }
         ));
     }
     let out = lsyc::fmt::format_file(&file);

@@ -468,6 +468,27 @@ pub fn edit(
         }
     }
 
+    if let Some((&p, t)) = pins
+        .iter()
+        .find(|(_, t)| !(t[0].is_finite() && t[1].is_finite()))
+    {
+        let (g, k) = guides
+            .iter()
+            .find_map(|g| {
+                g.particles
+                    .iter()
+                    .position(|&q| q == p)
+                    .map(|k| (&g.name, k))
+            })
+            .map_or((&sc.name.name, 0), |(g, k)| (g, k));
+        return Err(EditError::Usage(
+            format!(
+                "the operations move {g}.v{k} to ({}, {}), beyond the range of numbers",
+                t[0], t[1]
+            ),
+            None,
+        ));
+    }
     let params = Params {
         inertia: INERTIA,
         size,
@@ -1008,6 +1029,12 @@ scene S {
         let e = run(SCENE, &[parse_move("c.v3=1,1").expect("parses")]).unwrap_err();
         assert!(
             matches!(&e, EditError::Usage(m, _) if m.contains("v0 to v2") && m.contains("c.v3")),
+            "{e:?}"
+        );
+        let huge = parse_scale("c=1e300").expect("parses");
+        let e = run(SCENE, &[huge.clone(), huge]).unwrap_err();
+        assert!(
+            matches!(&e, EditError::Usage(m, _) if m.contains("beyond the range")),
             "{e:?}"
         );
         let e = run("lsystem A { axiom F; }", &[]).unwrap_err();

@@ -198,7 +198,11 @@ impl System {
             }
             sol.iterations = it + 1;
             if !accepted {
-                sol.converged = true;
+                // No step lowers the energy: at the minimum up to rounding, unless
+                // the gradient is still large (numbers out of range).
+                let kmax = springs.iter().fold(params.inertia, |m, s| m.max(s.k));
+                let gmax = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                sol.converged = gmax <= 1e-8 * kmax * problem.size;
                 return sol;
             }
             let moved = p.iter().fold(0.0f64, |m, v| m.max((alpha * v).abs()));
