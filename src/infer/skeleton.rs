@@ -355,6 +355,20 @@ pub fn simplify_with_junctions(
     for w in anchors.windows(2) {
         douglas_peucker(&dense, w[0], w[1], epsilon, &mut keep);
     }
+    // A closed stroke whose ends meet keeps its farthest point, so that it
+    // does not collapse into nothing.
+    if let (Some(a), Some(b)) = (dense.first(), dense.last())
+        && a.distance(*b) <= epsilon
+        && keep.iter().filter(|k| **k).count() == 2
+        && let Some((far, _)) = dense
+            .iter()
+            .enumerate()
+            .max_by(|x, y| x.1.distance(*a).total_cmp(&y.1.distance(*a)))
+        && far > 0
+        && far + 1 < dense.len()
+    {
+        keep[far] = true;
+    }
     let mut new_index = vec![0; dense.len()];
     let mut out = Vec::new();
     for (k, p) in dense.iter().enumerate() {
@@ -430,6 +444,16 @@ mod tests {
         );
         let (out, _) = simplify_with_junctions(&pts, &[], 0.05);
         assert_eq!(out.len(), 5);
+    }
+
+    #[test]
+    fn a_closed_stroke_keeps_its_far_point() {
+        let pts: Vec<DVec2> = [(0.0, 0.0), (1.0, 0.0), (0.0, 0.0)]
+            .iter()
+            .map(|&(x, y)| DVec2::new(x, y))
+            .collect();
+        let (out, _) = simplify_with_junctions(&pts, &[], 5.0);
+        assert_eq!(out.len(), 3);
     }
 
     #[test]
