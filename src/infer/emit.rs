@@ -459,13 +459,14 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
         let lead = if k == 0 { "Modules: " } else { "  " };
         header.push(format!("{lead}{}", chunk.join(", ")));
     }
-    header.push("Each rule draws the branch that names it as sketched".into());
+    header.push(
+        "Each rule draws its branch as sketched, with the children at their junctions;".into(),
+    );
     header.push(format!(
-        "and its children at their junctions; derive {} draws the sketch's {} levels,",
+        "derive {} draws the sketch's {} levels, and more steps (-n) grow the tree further.",
         sk.height() + 1,
         sk.height() + 1
     ));
-    header.push("-n with more steps grows the tree further.".into());
     if let Some(seed) = s.seed_3d {
         header.push(
             "3D: children spread around their parent at angles 360/n apart plus a random".into(),
