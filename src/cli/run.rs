@@ -193,35 +193,11 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
                 size: args.size,
                 background,
             };
-            let mut drawn = None;
-            let written = source::write_atomic_with(path, |w| {
-                match run::write_output(&derived, format, picture, args.seed, w) {
-                    Ok(d) => {
-                        drawn = Some(d);
-                        Ok(())
-                    }
-                    Err(OutputError::Io(e)) => Err(e),
-                    Err(OutputError::Diagnostic(d)) => {
-                        reporter.emit(&[d], &src.name, &src.text);
-                        Err(std::io::Error::other("stopped by an error"))
-                    }
-                }
-            });
-            match (written, drawn) {
-                (Ok(()), Some(d)) => d,
-                (Err(e), None) if e.to_string() == "stopped by an error" => return 1,
-                (Err(e), _) => {
-                    reporter.emit(
-                        &[Diagnostic::error(
-                            Code::WriteOutput,
-                            format!("cannot write `{}`: {e}", path.display()),
-                        )],
-                        &src.name,
-                        &src.text,
-                    );
-                    return 1;
-                }
-                (Ok(()), None) => return 1,
+            match write_file(path, reporter, &src, |w| {
+                run::write_output(&derived, format, picture, args.seed, w)
+            }) {
+                Some(d) => d,
+                None => return 1,
             }
         }
         _ => match run::measure(&derived, args.seed) {
@@ -254,6 +230,46 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     ));
     let _ = std::io::stdout().flush();
     0
+}
+
+/// Writes an output file atomically with `fill`; on failure reports why (a
+/// runtime diagnostic or an IO error naming the file) and returns `None`. The
+/// file is left untouched unless `fill` succeeds.
+fn write_file<T>(
+    path: &std::path::Path,
+    reporter: &Reporter,
+    src: &source::Source,
+    fill: impl FnOnce(&mut dyn Write) -> Result<T, OutputError>,
+) -> Option<T> {
+    let mut result = None;
+    let mut failed = None;
+    let written = source::write_atomic_with(path, |w| match fill(w) {
+        Ok(v) => {
+            result = Some(v);
+            Ok(())
+        }
+        Err(OutputError::Io(e)) => Err(e),
+        Err(OutputError::Diagnostic(d)) => {
+            failed = Some(d);
+            Err(std::io::Error::other("stopped by an error"))
+        }
+    });
+    if let Some(d) = failed {
+        reporter.emit(&[d], &src.name, &src.text);
+        return None;
+    }
+    if let Err(e) = written {
+        reporter.emit(
+            &[Diagnostic::error(
+                Code::WriteOutput,
+                format!("cannot write `{}`: {e}", path.display()),
+            )],
+            &src.name,
+            &src.text,
+        );
+        return None;
+    }
+    result
 }
 
 fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
@@ -300,34 +316,11 @@ fn run_scene(
     };
     let stats = match &args.output {
         Some(path) => {
-            let mut stats = None;
-            let written = source::write_atomic_with(path, |w| {
-                match run::write_scene(&r, format, picture, args.seed, args.guides, w) {
-                    Ok(s) => {
-                        stats = Some(s);
-                        Ok(())
-                    }
-                    Err(OutputError::Io(e)) => Err(e),
-                    Err(OutputError::Diagnostic(d)) => {
-                        reporter.emit(&[d], &src.name, &src.text);
-                        Err(std::io::Error::other("stopped by an error"))
-                    }
-                }
-            });
-            match (written, stats) {
-                (Ok(()), Some(s)) => s,
-                (Err(e), _) if e.to_string() != "stopped by an error" => {
-                    reporter.emit(
-                        &[Diagnostic::error(
-                            Code::WriteOutput,
-                            format!("cannot write `{}`: {e}", path.display()),
-                        )],
-                        &src.name,
-                        &src.text,
-                    );
-                    return 1;
-                }
-                _ => return 1,
+            match write_file(path, reporter, src, |w| {
+                run::write_scene(&r, format, picture, args.seed, args.guides, w)
+            }) {
+                Some(s) => s,
+                None => return 1,
             }
         }
         None => match run::write_scene(&r, None, picture, args.seed, false, &mut std::io::sink()) {
