@@ -117,10 +117,15 @@ impl Reporter {
         self.format == Format::Json
     }
 
-    /// A one-line message for a person on stderr (suppressed in JSON mode).
+    /// A one-line message on stderr. In JSON mode summaries are left out, and a
+    /// message starting with `error: ` is written as a JSON object, so that a
+    /// tool reading stderr sees every error.
     pub fn say(&self, msg: &str) {
         if !self.is_json() {
             eprintln!("{msg}");
+        } else if let Some(text) = msg.strip_prefix("error: ") {
+            let v = serde_json::json!({ "severity": "error", "message": text });
+            eprintln!("{v}");
         }
     }
 }
