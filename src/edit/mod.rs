@@ -1173,6 +1173,41 @@ scene S {
     }
 
     #[test]
+    fn a_guide_hanging_from_a_shared_vertex_follows_without_flipping() {
+        // The palm's layout: the crown shares one vertex with the trunk's top; the
+        // linked edges are stiff.
+        let text = "lsystem A { axiom F; }\nscene S {\n\
+            guide trunk { polygon (0, 0) (30, 0) (30, 300) (0, 300); system A; }\n\
+            guide crown { polygon (0, 300) (40, 300) (-30, 470) (-170, 380); system A; }\n\
+            link trunk.edge(2) -> crown.edge(0) { tokens 1; }\n\
+            link crown.edge(2) -> trunk.edge(3) { tokens 0; }\n}\n";
+        let area = |pts: &[P2]| {
+            (0..pts.len())
+                .map(|i| {
+                    let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+                    a[0] * b[1] - b[0] * a[1]
+                })
+                .sum::<f64>()
+                / 2.0
+        };
+        for deg in ["-10", "10", "-45", "90"] {
+            let ops = [parse_rotate(&format!("crown={deg}")).expect("parses")];
+            let (out, o) = run(text, &ops).expect("edits");
+            assert!(o.converged, "{deg}: {o:?}");
+            let trunk = points(polygon_line(&out, "trunk"));
+            assert!((area(&trunk) - 9000.0).abs() < 200.0, "{deg}: {out}");
+            for k in 0..4 {
+                let l = spring::dist(trunk[k], trunk[(k + 1) % 4]);
+                let want = if k % 2 == 0 { 30.0 } else { 300.0 };
+                assert!(
+                    (l - want).abs() < 0.05 * want,
+                    "{deg}: edge {k} is {l}\n{out}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn argument_syntax() {
         assert_eq!(
             parse_move("trunk.v2=40,-310.5"),

@@ -16,9 +16,12 @@
 //! guides not connected to a dragged vertex stay exactly where they are, and a
 //! connected guide follows as a near-rigid body when w is small beside k.
 //!
-//! The solver is Newton's method on E with the spring Hessians projected to be
-//! positive semidefinite, each step solved by Jacobi-preconditioned conjugate
-//! gradients, and a backtracking (Armijo) line search. Every loop runs in a fixed
+//! The solver starts the free particles at the harmonic extension of the pinned
+//! displacements, then runs Newton's method on E: each step solved by
+//! Jacobi-preconditioned conjugate gradients truncated at negative curvature, no
+//! step longer than half the shortest spring (a guide must not jump into its
+//! mirror image, which has the same spring energy), and a backtracking (Armijo)
+//! line search. Every loop runs in a fixed
 //! order, so the result is the same bit for bit on every run. Only the particles
 //! connected through springs to a pinned particle are variables; with nothing
 //! pinned nothing is touched, and a system whose pinned particles sit where they
@@ -67,7 +70,7 @@ impl Default for Params {
     fn default() -> Params {
         Params {
             inertia: 0.001,
-            max_iterations: 200,
+            max_iterations: 500,
             tolerance: 1e-10,
             size: 1.0,
         }
@@ -164,8 +167,16 @@ impl System {
             size: params.size.max(f64::MIN_POSITIVE),
         };
         let step_tol = params.tolerance * problem.size;
+        // No Newton step moves a particle further than half the shortest spring,
+        // so that a guide cannot jump through itself into its mirror image.
+        let cap = springs
+            .iter()
+            .map(|s| 0.5 * s.rest)
+            .filter(|r| *r > 1e-9 * problem.size)
+            .fold(f64::INFINITY, f64::min);
         sol.converged = false;
         let x = &mut sol.positions;
+        problem.initial_guess(x);
         for it in 0..params.max_iterations {
             let g = problem.gradient(x);
             if g.iter().all(|v| *v == 0.0) {
@@ -183,7 +194,10 @@ impl System {
                 return sol;
             }
             let e0 = problem.energy(x);
-            let mut alpha = 1.0;
+            let longest = (0..free.len())
+                .map(|v| p[2 * v].hypot(p[2 * v + 1]))
+                .fold(0.0f64, f64::max);
+            let mut alpha = if longest > cap { cap / longest } else { 1.0 };
             let mut trial = x.clone();
             let mut accepted = false;
             for _ in 0..40 {
@@ -241,6 +255,43 @@ impl Problem<'_> {
             e += 0.5 * self.w * d * d;
         }
         e
+    }
+
+    /// Starts the free particles at the harmonic extension of the pinned
+    /// particles' displacements: (w I + Σ k L) u = pinned neighbours' pull, the
+    /// springs treated as isotropic. A translation carries a guide hanging from a
+    /// dragged vertex along; a local drag fades with distance. Nothing pinned
+    /// away from its rest position gives u = 0 exactly.
+    fn initial_guess(&self, x: &mut [P2]) {
+        let m = self.free.len();
+        let mut diag = vec![[self.w, 0.0, 0.0, self.w]; m];
+        let mut off = Vec::new();
+        let mut rhs = vec![0.0; 2 * m];
+        for s in self.springs {
+            let (va, vb) = (self.var[s.a], self.var[s.b]);
+            let block = [s.k, 0.0, 0.0, s.k];
+            for v in [va, vb] {
+                if v != usize::MAX {
+                    diag[v][0] += s.k;
+                    diag[v][3] += s.k;
+                }
+            }
+            let pull = |v: usize, other: usize, rhs: &mut [f64]| {
+                rhs[2 * v] += s.k * (x[other][0] - self.rest[other][0]);
+                rhs[2 * v + 1] += s.k * (x[other][1] - self.rest[other][1]);
+            };
+            match (va != usize::MAX, vb != usize::MAX) {
+                (true, true) => off.push((va, vb, block)),
+                (true, false) => pull(va, s.b, &mut rhs),
+                (false, true) => pull(vb, s.a, &mut rhs),
+                (false, false) => {}
+            }
+        }
+        let neg: Vec<f64> = rhs.iter().map(|v| -v).collect();
+        let u = Hessian { diag, off }.solve_neg(&neg);
+        for (v, &i) in self.free.iter().enumerate() {
+            x[i] = [self.rest[i][0] + u[2 * v], self.rest[i][1] + u[2 * v + 1]];
+        }
     }
 
     /// The unit direction from b to a and the length, or `None` when they coincide.
