@@ -18,6 +18,9 @@ const EXAMPLES: &str = "\
 Examples:
   lsyc run lang-examples/koch-island.lsy -o koch.svg
   lsyc run lang-examples/plant-e.lsy -o plant.png --stats
+  lsyc run lang-examples/palm.lsy -o palm.svg --guides
+  lsyc edit lang-examples/palm.lsy --by crown.v2=-40,20 --write
+  lsyc infer --skeleton sketch.svg -o tree.lsy
   lsyc check lang-examples/koch-island.lsy
   lsyc check tree.lsy -D depth=9 --error-format json
   lsyc fmt tree.lsy                 # print the canonical form
