@@ -187,3 +187,22 @@ fn svg_layers_per_guide() {
     assert!(stats["queries"].as_u64().unwrap_or(0) > 10);
     usvg::Tree::from_str(&svg, &usvg::Options::default()).expect("usvg reads it");
 }
+
+#[test]
+fn the_spiral_turns_away_from_walls_and_stays_inside() {
+    let text = std::fs::read_to_string(root().join("lang-examples/spiral.lsy")).expect("spiral");
+    let r = run_scene(&text);
+    let stats = run::write_scene(&r, None, Default::default(), 0, false, &mut std::io::sink())
+        .unwrap_or_else(|_| panic!("draws"));
+    assert!(stats.segments > 500, "{} segments", stats.segments);
+    let b = stats.bbox.expect("drawn");
+    // Every segment stays well inside the 400 × 300 guide: it turned before each wall.
+    assert!(
+        b[0] > 0.0 && b[1] >= 0.0 && b[2] < 400.0 && b[3] < 300.0,
+        "{b:?}"
+    );
+    assert!(
+        b[2] - b[0] > 300.0 && b[3] - b[1] > 200.0,
+        "it goes round the guide: {b:?}"
+    );
+}
