@@ -209,15 +209,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         },
     };
     let stats = Stats::new(&derived, &drawn, start.elapsed().as_secs_f64() * 1000.0);
-    if args.stats
-        && let Ok(s) = serde_json::to_string(&stats)
-    {
-        println!("{s}");
-    }
-    let wrote = args
-        .output
-        .as_ref()
-        .map_or(String::new(), |p| format!(", wrote {}", p.display()));
+    let wrote = report_stats(args, &stats);
     reporter.say(&format!(
         "{}: {} modules, {} segments, {} elements after {} steps (derive {:.0} ms, draw {:.0} ms){wrote}",
         stats.system,
@@ -270,6 +262,19 @@ fn write_file<T>(
         return None;
     }
     result
+}
+
+/// Prints `--stats` as one JSON object on stdout; returns the ", wrote OUT" part
+/// of the summary line.
+fn report_stats(args: &Args, stats: &impl serde::Serialize) -> String {
+    if args.stats
+        && let Ok(s) = serde_json::to_string(stats)
+    {
+        println!("{s}");
+    }
+    args.output
+        .as_ref()
+        .map_or(String::new(), |p| format!(", wrote {}", p.display()))
 }
 
 fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
@@ -335,15 +340,7 @@ fn run_scene(
             }
         },
     };
-    if args.stats
-        && let Ok(s) = serde_json::to_string(&stats)
-    {
-        println!("{s}");
-    }
-    let wrote = args
-        .output
-        .as_ref()
-        .map_or(String::new(), |p| format!(", wrote {}", p.display()));
+    let wrote = report_stats(args, &stats);
     reporter.say(&format!(
         "scene {}: {} systems, {} modules, {} segments, {} elements, {} queries, {} messages after {} steps{wrote}",
         stats.scene,

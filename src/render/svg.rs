@@ -153,6 +153,19 @@ impl<W: Write> SvgWriter<W> {
         }
     }
 
+    /// Appends `x,y x,y …` (projected, y flipped) for a `points` attribute.
+    fn write_points(&self, buf: &mut Vec<u8>, points: &[DVec3]) {
+        for (i, &p) in points.iter().enumerate() {
+            if i > 0 {
+                buf.push(b' ');
+            }
+            let q = self.view.project(p);
+            write_num(buf, q.x, self.decimals);
+            buf.push(b',');
+            write_num(buf, -q.y, self.decimals);
+        }
+    }
+
     /// Starts the layer of one guide's drawing.
     pub fn begin_guide(&mut self, name: &str) {
         self.close_path();
@@ -174,15 +187,7 @@ impl<W: Write> SvgWriter<W> {
             xml(name)
         )
         .into_bytes();
-        for (i, &p) in points.iter().enumerate() {
-            if i > 0 {
-                buf.push(b' ');
-            }
-            let q = self.view.project(p);
-            write_num(&mut buf, q.x, self.decimals);
-            buf.push(b',');
-            write_num(&mut buf, -q.y, self.decimals);
-        }
+        self.write_points(&mut buf, points);
         buf.extend_from_slice(b"\"/>\n");
         self.write(&buf);
     }
@@ -279,15 +284,7 @@ impl<W: Write> Sink for SvgWriter<W> {
         buf.extend_from_slice(b"<polygon fill=\"");
         buf.extend_from_slice(palette(color).as_bytes());
         buf.extend_from_slice(b"\" stroke=\"none\" points=\"");
-        for (i, &p) in points.iter().enumerate() {
-            if i > 0 {
-                buf.push(b' ');
-            }
-            let q = self.view.project(p);
-            write_num(&mut buf, q.x, self.decimals);
-            buf.push(b',');
-            write_num(&mut buf, -q.y, self.decimals);
-        }
+        self.write_points(&mut buf, points);
         buf.extend_from_slice(b"\"/>\n");
         self.write(&buf);
     }
