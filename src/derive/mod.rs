@@ -80,21 +80,41 @@ pub enum DeriveError {
     InterpretTooDeep { module: String, depth: usize },
 }
 
+/// Appends a successor (or the axiom) with its parameters evaluated on `slots`.
+#[inline]
+fn emit(
+    prog: &Program,
+    succ: &[crate::compile::Emit],
+    slots: &[f64],
+    rng: &mut Random,
+    stack: &mut Vec<f64>,
+    syms: &mut Vec<Sym>,
+    params: &mut Vec<f64>,
+) -> Result<(), VmError> {
+    for e in succ {
+        syms.push(e.sym);
+        for code in &e.args {
+            params.push(prog.chunk.eval(*code, slots, rng, stack)?);
+        }
+    }
+    Ok(())
+}
+
 /// Evaluates the axiom with the lsystem's parameters.
 pub fn axiom(prog: &Program, args: &[f64], seed: u64) -> Result<ModString, DeriveError> {
     let mut out = ModString::default();
     let mut rng = Random::new(seed, 0, u64::MAX);
     let mut stack = Vec::new();
-    for e in &prog.axiom {
-        out.syms.push(e.sym);
-        for code in &e.args {
-            let v = prog
-                .chunk
-                .eval(*code, args, &mut rng, &mut stack)
-                .map_err(|error| DeriveError::Vm { step: 0, error })?;
-            out.params.push(v);
-        }
-    }
+    emit(
+        prog,
+        &prog.axiom,
+        args,
+        &mut rng,
+        &mut stack,
+        &mut out.syms,
+        &mut out.params,
+    )
+    .map_err(|error| DeriveError::Vm { step: 0, error })?;
     if prog.has_cut {
         out = apply_cut(prog, out);
     }
@@ -447,16 +467,16 @@ fn rewrite_chunk(
             && r.left.is_empty()
             && r.right.is_empty()
         {
-            for e in &r.succ {
-                out.syms.push(e.sym);
-                for code in &e.args {
-                    let v = prog
-                        .chunk
-                        .eval(*code, params, &mut rng, &mut stack)
-                        .map_err(vm)?;
-                    out.params.push(v);
-                }
-            }
+            emit(
+                prog,
+                &r.succ,
+                params,
+                &mut rng,
+                &mut stack,
+                &mut out.syms,
+                &mut out.params,
+            )
+            .map_err(vm)?;
         } else {
             let chosen = choose(
                 view,
@@ -471,16 +491,16 @@ fn rewrite_chunk(
             .map_err(vm)?;
             match chosen {
                 Some(r) => {
-                    for e in &r.succ {
-                        out.syms.push(e.sym);
-                        for code in &e.args {
-                            let v = prog
-                                .chunk
-                                .eval(*code, &slots, &mut rng, &mut stack)
-                                .map_err(vm)?;
-                            out.params.push(v);
-                        }
-                    }
+                    emit(
+                        prog,
+                        &r.succ,
+                        &slots,
+                        &mut rng,
+                        &mut stack,
+                        &mut out.syms,
+                        &mut out.params,
+                    )
+                    .map_err(vm)?;
                 }
                 None => {
                     out.syms.push(sym);

@@ -80,12 +80,7 @@ fn formatter_round_trip_and_idempotence() {
         }
         let once = fmt::format_file(&parsed.file);
         let reparsed = parser::parse(&once);
-        let errs: Vec<_> = reparsed
-            .diagnostics
-            .iter()
-            .filter(|d| d.is_error())
-            .cloned()
-            .collect();
+        let errs = crate::support::parse_errors(&once);
         assert!(
             errs.is_empty(),
             "{}: the formatted text does not parse:\n{}\n{once}",

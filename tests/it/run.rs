@@ -297,13 +297,7 @@ fn text_output_parses_back_as_an_axiom() {
             continue;
         }
         let program = format!("lsystem Again {{ axiom {s}; }}");
-        let parsed = lsyc::parser::parse(&program);
-        let errs: Vec<_> = parsed
-            .diagnostics
-            .iter()
-            .filter(|d| d.is_error())
-            .cloned()
-            .collect();
+        let errs = crate::support::parse_errors(&program);
         assert!(
             errs.is_empty(),
             "{}: {}",

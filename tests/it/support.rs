@@ -47,3 +47,12 @@ pub fn read_text(path: &Path) -> String {
 pub fn render_plain(diags: &[Diagnostic], file: &str, text: &str) -> String {
     diagnostic::render(diags, file, text, Format::Human { color: false })
 }
+
+/// The errors (not warnings) of parsing `text`.
+pub fn parse_errors(text: &str) -> Vec<Diagnostic> {
+    lsyc::parser::parse(text)
+        .diagnostics
+        .into_iter()
+        .filter(Diagnostic::is_error)
+        .collect()
+}
