@@ -2,9 +2,12 @@
 //! over links, termination, and the SVG layers.
 
 use crate::support::root;
+use glam::DVec2;
+use lsyc::env::geometry::{closest_on_segment, inside};
 use lsyc::env::scene::Instance;
 use lsyc::frontend;
 use lsyc::run::{self, Options, SceneRun};
+use std::collections::HashMap;
 
 fn run_scene(text: &str) -> SceneRun {
     let fe = frontend::run(text, Vec::new(), &[]);
@@ -188,21 +191,189 @@ fn svg_layers_per_guide() {
     usvg::Tree::from_str(&svg, &usvg::Options::default()).expect("usvg reads it");
 }
 
+/// What the SVG of a scene drew, read back from its layers: per guide, the
+/// segments of its paths, the centres of its elements and of its polygons, and
+/// its outline (all in the scene's coordinates, +y up).
+#[derive(Default)]
+struct Layers {
+    outlines: HashMap<String, Vec<DVec2>>,
+    segments: HashMap<String, Vec<(DVec2, DVec2)>>,
+    centres: HashMap<String, Vec<DVec2>>,
+}
+
+impl Layers {
+    fn segments(&self, guide: &str) -> &[(DVec2, DVec2)] {
+        self.segments.get(guide).map_or(&[], Vec::as_slice)
+    }
+}
+
+fn attr<'a>(line: &'a str, name: &str) -> Option<&'a str> {
+    let key = format!(" {name}=\"");
+    let at = line.find(&key)? + key.len();
+    line[at..].split('"').next()
+}
+
+fn numbers(s: &str) -> Vec<f64> {
+    s.split(|c: char| c.is_whitespace() || c == ',')
+        .filter(|t| !t.is_empty())
+        .map(|t| t.parse::<f64>().unwrap_or_else(|_| panic!("a number: {t}")))
+        .collect()
+}
+
+/// SVG points (y down) back to the scene's coordinates.
+fn points(s: &str) -> Vec<DVec2> {
+    numbers(s)
+        .chunks(2)
+        .map(|p| DVec2::new(p[0], -p[1]))
+        .collect()
+}
+
+fn read_layers(svg: &str) -> Layers {
+    let mut layers = Layers::default();
+    let mut guide: Option<String> = None;
+    for line in svg.lines() {
+        if line.starts_with("<g class=\"guide-content\"") {
+            guide = attr(line, "data-guide").map(str::to_string);
+            continue;
+        }
+        if line.starts_with("<polygon class=\"guide\"") {
+            let name = attr(line, "data-guide").expect("named").to_string();
+            layers
+                .outlines
+                .insert(name, points(attr(line, "points").expect("points")));
+            continue;
+        }
+        let Some(g) = guide.clone() else {
+            continue;
+        };
+        if line == "</g>" {
+            guide = None;
+        } else if line.starts_with("<path") {
+            // M x y l dx dy dx dy …: one absolute start, then relative steps.
+            let d = attr(line, "d").expect("path data");
+            let (start, steps) = d[1..].split_once('l').expect("M … l …");
+            let mut at = points(start)[0];
+            let segs = layers.segments.entry(g).or_default();
+            for step in points(steps) {
+                segs.push((at, at + step));
+                at += step;
+            }
+        } else if line.starts_with("<use") {
+            // matrix(a b c d e f): the base at (e, f), the element's axis (c, d).
+            let t = attr(line, "transform").expect("transform");
+            let m = numbers(&t["matrix(".len()..t.len() - 1]);
+            let centre = DVec2::new(m[4] + 0.5 * m[2], -(m[5] + 0.5 * m[3]));
+            layers.centres.entry(g).or_default().push(centre);
+        } else if line.starts_with("<polygon") {
+            let pts = points(attr(line, "points").expect("points"));
+            let c = pts.iter().fold(DVec2::ZERO, |s, &p| s + p) / pts.len() as f64;
+            layers.centres.entry(g).or_default().push(c);
+        }
+    }
+    layers
+}
+
+/// Runs `lsyc run FILE --scene NAME -o OUT.svg --guides --stats`.
+fn draw(file: &str, scene: Option<&str>) -> (Layers, serde_json::Value) {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("scene.svg");
+    let mut args = vec![
+        "run".to_string(),
+        root().join(file).to_str().expect("utf-8").to_string(),
+        "-o".to_string(),
+        out.to_str().expect("utf-8").to_string(),
+        "--guides".to_string(),
+        "--stats".to_string(),
+    ];
+    if let Some(s) = scene {
+        args.extend(["--scene".to_string(), s.to_string()]);
+    }
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_lsyc"))
+        .args(&args)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let svg = std::fs::read_to_string(&out).expect("svg");
+    let stats = serde_json::from_slice(&o.stdout).expect("json");
+    (read_layers(&svg), stats)
+}
+
+/// Inside the polygon, or within the rounding of the SVG's numbers of it.
+fn inside_or_on(p: DVec2, poly: &[DVec2]) -> bool {
+    let n = poly.len();
+    inside(p, poly)
+        || (0..n).any(|i| (closest_on_segment(p, poly[i], poly[(i + 1) % n]) - p).length() < 0.02)
+}
+
+/// Every scene of every gallery file: each drawn segment has its middle, and
+/// each element and polygon its centre, inside the guide that drew it.
 #[test]
-fn the_spiral_turns_away_from_walls_and_stays_inside() {
-    let text = std::fs::read_to_string(root().join("lang-examples/spiral.lsy")).expect("spiral");
-    let r = run_scene(&text);
-    let stats = run::write_scene(&r, None, Default::default(), 0, false, &mut std::io::sink())
-        .unwrap_or_else(|_| panic!("draws"));
-    assert!(stats.segments > 500, "{} segments", stats.segments);
-    let b = stats.bbox.expect("drawn");
-    // Every segment stays well inside the 400 × 300 guide: it turned before each wall.
-    assert!(
-        b[0] > 0.0 && b[1] >= 0.0 && b[2] < 400.0 && b[3] < 300.0,
-        "{b:?}"
+fn the_centre_rule_holds_in_every_gallery_scene() {
+    let mut scenes = 0;
+    for path in crate::support::lsy_files(&["lang-examples"]) {
+        let text = crate::support::read_text(&path);
+        let file = crate::support::rel(&path);
+        for name in text
+            .lines()
+            .filter_map(|l| l.strip_prefix("scene "))
+            .filter_map(|l| l.split_whitespace().next())
+        {
+            scenes += 1;
+            let (layers, stats) = draw(&file, Some(name));
+            let drawn: usize = layers.segments.values().map(Vec::len).sum();
+            assert!(drawn > 0, "{file} {name}: nothing drawn");
+            assert!(stats["segments"].as_u64().unwrap_or(0) > 0, "{file} {name}");
+            for (guide, segs) in &layers.segments {
+                let poly = &layers.outlines[guide];
+                for (a, b) in segs {
+                    let m = (*a + *b) * 0.5;
+                    assert!(
+                        inside_or_on(m, poly),
+                        "{file} {name}: the segment {a} – {b} of `{guide}` has its middle outside"
+                    );
+                }
+            }
+            for (guide, centres) in &layers.centres {
+                let poly = &layers.outlines[guide];
+                for c in centres {
+                    assert!(
+                        inside_or_on(*c, poly),
+                        "{file} {name}: an element of `{guide}` has its centre {c} outside"
+                    );
+                }
+            }
+        }
+    }
+    assert!(scenes >= 2, "{scenes} scenes");
+}
+
+#[test]
+fn the_spiral_sends_branches_that_grow_lateral_spirals() {
+    let (layers, stats) = draw("lang-examples/spiral.lsy", None);
+    // One message per lateral guide, each seeding a spiral there.
+    assert_eq!(stats["messages"], 4);
+    assert_eq!(stats["systems"], 5);
+    let main = layers.segments("main");
+    assert!(main.len() > 500, "{} segments in main", main.len());
+    for lateral in ["ne", "nw", "sw", "se"] {
+        let segs = layers.segments(lateral);
+        assert!(segs.len() > 150, "{lateral}: {} segments", segs.len());
+        // A spiral winds: its heading turns through more than two full turns.
+        let mut turned = 0.0;
+        for w in segs.windows(2) {
+            let (u, v) = (w[0].1 - w[0].0, w[1].1 - w[1].0);
+            turned += u.perp_dot(v).atan2(u.dot(v));
+        }
+        assert!(
+            turned > 4.0 * std::f64::consts::PI,
+            "{lateral}: turned {turned} rad"
+        );
+    }
+    // The main spiral stays inside its octagon; every branch reaches its link.
+    let r = run_scene(
+        &std::fs::read_to_string(root().join("lang-examples/spiral.lsy")).expect("spiral"),
     );
-    assert!(
-        b[2] - b[0] > 300.0 && b[3] - b[1] > 200.0,
-        "it goes round the guide: {b:?}"
-    );
+    for l in &r.scene.links {
+        assert_eq!(l.used, 1, "every link's token is used");
+    }
 }
