@@ -1,3 +1,5 @@
+//! `lsyc infer ART.svg [-o OUT.lsy]`: a drawing of repeated elements to
+//! sequence and branching rules (see `lsyc::infer::art`), and
 //! `lsyc infer --skeleton SKETCH.svg [-o TREE.lsy] [--3d]`: a tree sketch to a
 //! recursive L-system (see `lsyc::infer`).
 //!
@@ -5,55 +7,239 @@
 //! file written atomically, never over the sketch) and the exit statuses.
 
 use super::Reporter;
+use lsyc::infer::art::{self, rules::Weights};
 use lsyc::infer::{self, MAX_SVG_BYTES, Options};
 use lsyc::source;
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// A drawing whose repeated elements to infer (not available yet; see --skeleton).
+    /// A drawing of repeated elements (SVG) to turn into sequence and branching rules.
     #[arg(value_name = "ART.svg")]
     pub art: Option<PathBuf>,
 
     /// A tree sketch (SVG): each path, line or polyline is a branch, the first the trunk.
-    #[arg(long, value_name = "SKETCH.svg")]
+    #[arg(long, value_name = "SKETCH.svg", conflicts_with = "art")]
     pub skeleton: Option<PathBuf>,
 
     /// Where to write the program (default: stdout).
     #[arg(short = 'o', long = "output", value_name = "OUT.lsy")]
     pub output: Option<PathBuf>,
 
-    /// Emit a 3D tree: children spread around their parent.
-    #[arg(long = "3d")]
+    /// Sketch: emit a 3D tree, children spread around their parent.
+    #[arg(long = "3d", requires = "skeleton")]
     pub three_d: bool,
 
-    /// Douglas–Peucker tolerance in drawing units (default: 1.5% of the drawing's diagonal).
-    #[arg(long, value_name = "E")]
+    /// Sketch: Douglas–Peucker tolerance in drawing units (default: 1.5% of the drawing's diagonal).
+    #[arg(long, value_name = "E", requires = "skeleton")]
     pub epsilon: Option<f64>,
 
-    /// Seed of the random perturbation of the 3D spread.
-    #[arg(long, default_value_t = 0)]
+    /// Sketch: seed of the random perturbation of the 3D spread.
+    #[arg(long, default_value_t = 0, requires = "skeleton")]
     pub seed: u64,
+
+    /// Art: weights of cluster importance w = wn·n + wh·h + wφ·φ + wl·l (count, proximity, similarity, length).
+    #[arg(long, value_name = "WN,WH,WPHI,WL", conflicts_with = "skeleton")]
+    pub weights: Option<String>,
+
+    /// Art: relaxed tolerances, so a noisy drawing comes out as a regular one.
+    #[arg(long, conflicts_with = "skeleton")]
+    pub symmetrize: bool,
+
+    /// Art: how different two elements may be and still be one kind (mean misfit relative to size).
+    #[arg(
+        long,
+        value_name = "S",
+        default_value_t = 0.02,
+        conflicts_with = "skeleton"
+    )]
+    pub similarity: f64,
+
+    /// Art: print what was found (elements, kinds, clusters, rules, time per phase) as JSON on stderr.
+    #[arg(long)]
+    pub stats: bool,
 }
 
 pub fn run(args: &Args, reporter: &Reporter) -> u8 {
-    let Some(sketch) = &args.skeleton else {
+    if let Some(sketch) = &args.skeleton {
+        return run_sketch(args, sketch, reporter);
+    }
+    let Some(art) = &args.art else {
         reporter.say(
-            "error: `lsyc infer` needs --skeleton SKETCH.svg (a tree sketch): inferring repeated \
-             elements from a drawing is a separate feature that is not available yet\n\
-             usage: lsyc infer --skeleton SKETCH.svg [-o TREE.lsy] [--3d] [--epsilon E] [--seed N]",
+            "error: give a drawing to infer from\n\
+             usage: lsyc infer ART.svg [-o OUT.lsy]  (repeated elements)\n       \
+             lsyc infer --skeleton SKETCH.svg [-o TREE.lsy]  (a tree sketch)",
         );
         return 2;
     };
-    if let Some(art) = &args.art {
+    let mut opts = art::Options {
+        symmetrize: args.symmetrize,
+        ..art::Options::default()
+    };
+    if !(args.similarity.is_finite() && args.similarity > 0.0 && args.similarity < 1.0) {
         reporter.say(&format!(
-            "error: give the sketch once, after --skeleton (`{}` is extra): inferring repeated \
-             elements from a drawing is a separate feature that is not available yet",
-            art.display()
+            "error: --similarity must be between 0 and 1 (a misfit relative to the element's size), not {}",
+            args.similarity
         ));
         return 2;
     }
+    opts.similarity = args.similarity;
+    if let Some(w) = &args.weights {
+        match parse_weights(w) {
+            Ok(w) => opts.weights = w,
+            Err(why) => {
+                reporter.say(&format!("error: --weights {w}: {why}"));
+                return 2;
+            }
+        }
+    }
+    if let Some(code) = same_as_input(args.output.as_deref(), art, "drawing", reporter) {
+        return code;
+    }
+    let name = art.display().to_string();
+    let data = match read_input(art, &name, reporter) {
+        Ok(d) => d,
+        Err(code) => return code,
+    };
+    let bar = std::io::stderr()
+        .is_terminal()
+        .then(|| indicatif::ProgressBar::new(0));
+    if let Some(b) = &bar
+        && let Ok(style) = indicatif::ProgressStyle::with_template("inferring {bar:30} {msg}")
+    {
+        b.set_style(style);
+    }
+    let mut first = None;
+    let mut progress = |left: usize| {
+        if let Some(b) = &bar {
+            let total = *first.get_or_insert(left);
+            if total >= 1000 {
+                b.set_length(total as u64);
+                b.set_position((total - left) as u64);
+                b.set_message(format!("{left} instances left"));
+            }
+        }
+    };
+    let result = art::from_svg(&data, &name, &opts, &mut progress);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let inferred = match result {
+        Ok(i) => i,
+        Err(e) => {
+            reporter.say(&format!("error: {e}"));
+            return 1;
+        }
+    };
+    for s in &inferred.skipped {
+        reporter.say(&format!(
+            "warning: {name}: skipped {s} (only paths and shapes are elements)"
+        ));
+    }
+    if args.stats
+        && let Ok(json) = serde_json::to_string(&inferred.stats)
+    {
+        reporter.say(&json);
+    }
+    let st = &inferred.stats;
+    let summary = format!(
+        "{name}: {} elements of {} kind{}, {} rule{}",
+        st.elements,
+        st.kinds,
+        if st.kinds == 1 { "" } else { "s" },
+        st.rules,
+        if st.rules == 1 { "" } else { "s" },
+    );
+    write_program(args.output.as_deref(), &inferred.text, &summary, reporter)
+}
+
+fn parse_weights(text: &str) -> Result<Weights, String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    if parts.len() != 4 {
+        return Err("give four numbers, wn,wh,wphi,wl (for example 1,1,0.5,1)".into());
+    }
+    let mut v = [0.0; 4];
+    for (k, p) in parts.iter().enumerate() {
+        v[k] = p
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite() && (0.0..=1.0).contains(x))
+            .ok_or_else(|| format!("`{p}` is not a weight between 0 and 1"))?;
+    }
+    Ok(Weights {
+        n: v[0],
+        h: v[1],
+        phi: v[2],
+        l: v[3],
+    })
+}
+
+/// Refuses to write the program over its input: `Some(exit status)` if it would.
+fn same_as_input(
+    out: Option<&std::path::Path>,
+    input: &std::path::Path,
+    what: &str,
+    reporter: &Reporter,
+) -> Option<u8> {
+    let out = out?;
+    let same = match (std::fs::canonicalize(out), std::fs::canonicalize(input)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    if same {
+        reporter.say(&format!(
+            "error: the output `{}` is the {what}; choose another file",
+            out.display()
+        ));
+        return Some(2);
+    }
+    None
+}
+
+fn read_input(path: &std::path::Path, name: &str, reporter: &Reporter) -> Result<Vec<u8>, u8> {
+    let too_large = std::fs::metadata(path).is_ok_and(|m| m.len() > MAX_SVG_BYTES as u64);
+    if too_large {
+        reporter.say(&format!(
+            "error: `{name}` is larger than {} MiB",
+            MAX_SVG_BYTES >> 20
+        ));
+        return Err(1);
+    }
+    std::fs::read(path).map_err(|e| {
+        let why = match e.kind() {
+            std::io::ErrorKind::NotFound => "no such file".to_string(),
+            std::io::ErrorKind::IsADirectory => "it is a directory".to_string(),
+            _ => e.to_string(),
+        };
+        reporter.say(&format!("error: cannot read `{name}`: {why}"));
+        1
+    })
+}
+
+/// Writes the program to `out` (atomically) with a summary on stderr, or to stdout.
+fn write_program(
+    out: Option<&std::path::Path>,
+    text: &str,
+    summary: &str,
+    reporter: &Reporter,
+) -> u8 {
+    match out {
+        Some(out) => {
+            if let Err(e) = source::write_atomic(out, text.as_bytes()) {
+                reporter.say(&format!("error: cannot write `{}`: {e}", out.display()));
+                return 1;
+            }
+            reporter.say(&format!("{summary}, wrote {}", out.display()));
+        }
+        None => {
+            let _ = std::io::stdout().write_all(text.as_bytes());
+        }
+    }
+    0
+}
+
+fn run_sketch(args: &Args, sketch: &std::path::Path, reporter: &Reporter) -> u8 {
     if let Some(e) = args.epsilon
         && !(e.is_finite() && e >= 0.0)
     {
@@ -62,39 +248,13 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         ));
         return 2;
     }
-    if let Some(out) = &args.output {
-        let same = match (std::fs::canonicalize(out), std::fs::canonicalize(sketch)) {
-            (Ok(a), Ok(b)) => a == b,
-            _ => false,
-        };
-        if same {
-            reporter.say(&format!(
-                "error: the output `{}` is the sketch; choose another file",
-                out.display()
-            ));
-            return 2;
-        }
+    if let Some(code) = same_as_input(args.output.as_deref(), sketch, "sketch", reporter) {
+        return code;
     }
     let name = sketch.display().to_string();
-    let too_large = std::fs::metadata(sketch).is_ok_and(|m| m.len() > MAX_SVG_BYTES as u64);
-    if too_large {
-        reporter.say(&format!(
-            "error: `{name}` is larger than {} MiB",
-            MAX_SVG_BYTES >> 20
-        ));
-        return 1;
-    }
-    let data = match std::fs::read(sketch) {
+    let data = match read_input(sketch, &name, reporter) {
         Ok(d) => d,
-        Err(e) => {
-            let why = match e.kind() {
-                std::io::ErrorKind::NotFound => "no such file".to_string(),
-                std::io::ErrorKind::IsADirectory => "it is a directory".to_string(),
-                _ => e.to_string(),
-            };
-            reporter.say(&format!("error: cannot read `{name}`: {why}"));
-            return 1;
-        }
+        Err(code) => return code,
     };
     let opts = Options {
         epsilon: args.epsilon,
@@ -108,22 +268,10 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
             return 1;
         }
     };
-    match &args.output {
-        Some(out) => {
-            if let Err(e) = source::write_atomic(out, inferred.text.as_bytes()) {
-                reporter.say(&format!("error: cannot write `{}`: {e}", out.display()));
-                return 1;
-            }
-            reporter.say(&format!(
-                "{name}: {} strokes, {} productions after reduction, wrote {}",
-                inferred.skeleton.branches.len(),
-                inferred.analysis.reduced.len().max(1),
-                out.display()
-            ));
-        }
-        None => {
-            let _ = std::io::stdout().write_all(inferred.text.as_bytes());
-        }
-    }
-    0
+    let summary = format!(
+        "{name}: {} strokes, {} productions after reduction",
+        inferred.skeleton.branches.len(),
+        inferred.analysis.reduced.len().max(1)
+    );
+    write_program(args.output.as_deref(), &inferred.text, &summary, reporter)
 }

@@ -41,12 +41,12 @@ pub struct Settings<'a> {
     pub seed_3d: Option<u64>,
 }
 
-fn round(v: f64, digits: i32) -> f64 {
+pub(crate) fn round(v: f64, digits: i32) -> f64 {
     let k = 10f64.powi(digits);
     (v * k).round() / k + 0.0
 }
 
-fn comment(text: impl AsRef<str>) -> Comment {
+pub(crate) fn comment(text: impl AsRef<str>) -> Comment {
     let t = text.as_ref();
     Comment {
         text: if t.is_empty() {
@@ -58,20 +58,20 @@ fn comment(text: impl AsRef<str>) -> Comment {
     }
 }
 
-fn node<T>(node: T) -> Node<T> {
+pub(crate) fn node<T>(node: T) -> Node<T> {
     Node::new(node, Span::default())
 }
 
-fn var(name: &str) -> Expr {
+pub(crate) fn var(name: &str) -> Expr {
     Expr::new(ExprKind::Var(name.to_string()))
 }
 
-fn mul(a: Expr, b: Expr) -> Expr {
+pub(crate) fn mul(a: Expr, b: Expr) -> Expr {
     Expr::new(ExprKind::Binary(BinOp::Mul, Box::new(a), Box::new(b)))
 }
 
 /// A turtle symbol or a single letter (`F`, `f`) with an optional parameter.
-fn sym(c: char, arg: Option<Expr>) -> Module {
+pub(crate) fn sym(c: char, arg: Option<Expr>) -> Module {
     let name = if c.is_alphabetic() {
         ModName::Name(c.to_string())
     } else {
@@ -80,7 +80,7 @@ fn sym(c: char, arg: Option<Expr>) -> Module {
     Module::new(name, arg.map(|a| vec![a]))
 }
 
-fn named(name: &str, args: Vec<Expr>) -> Module {
+pub(crate) fn named(name: &str, args: Vec<Expr>) -> Module {
     Module::new(ModName::Name(name.to_string()), Some(args))
 }
 

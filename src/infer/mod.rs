@@ -5,9 +5,11 @@
 //! Image*: strokes (`strokes`), the tree with Douglas–Peucker simplification
 //! (`skeleton`), productions, pre-reduction, the reduction table and the reduced
 //! productions (`productions`), and the program as an AST (`emit`), printed by
-//! `fmt::format_file`. Must not write files or print: the CLI does that, and
+//! `fmt::format_file`; and `lsyc infer ART.svg`, repeated elements to sequence
+//! and branching rules (`art`). Must not write files or print: the CLI does that, and
 //! must not panic on any input.
 
+pub mod art;
 pub mod emit;
 pub mod productions;
 pub mod skeleton;
@@ -57,6 +59,21 @@ pub enum InferError {
     TooLarge { file: String },
     #[error("`{file}` has {strokes} strokes; lsyc infers trees of up to {MAX_STROKES}")]
     TooManyStrokes { file: String, strokes: usize },
+    #[error(
+        "`{file}` has nothing to infer from: no paths or shapes with an extent{}",
+        if *skipped > 0 { format!(" ({skipped} text, image or empty shapes skipped)") } else { String::new() }
+    )]
+    NoElements { file: String, skipped: usize },
+    #[error(
+        "`{file}` has coordinates as large as {largest:e}; lsyc infers drawings whose coordinates stay within ±{:e} user units (scale the drawing down)",
+        art::read::MAX_COORDINATE
+    )]
+    Huge { file: String, largest: f64 },
+    #[error(
+        "`{file}` has {elements} elements; lsyc infers drawings of up to {}",
+        art::MAX_ELEMENTS
+    )]
+    TooManyElements { file: String, elements: usize },
 }
 
 /// A sketch and what was inferred from it.

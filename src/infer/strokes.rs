@@ -58,82 +58,65 @@ pub fn read(data: &[u8]) -> Result<Vec<Stroke>, String> {
     let tree = usvg::Tree::from_data(data, &usvg::Options::default()).map_err(|e| e.to_string())?;
     let mut out = Vec::new();
     let mut number = 0;
-    walk(tree.root(), &mut out, &mut number);
+    let user = user_space(data, &tree);
+    walk(tree.root(), user, &mut out, &mut number);
     Ok(out)
 }
 
-fn walk(group: &usvg::Group, out: &mut Vec<Stroke>, number: &mut usize) {
+/// The map from usvg's coordinates back to the document's user space: usvg
+/// puts the root `viewBox` (and a root `transform`) into one group around the
+/// content, which `abs_transform` includes; lsyc works in user units so that
+/// what it draws back lies on the input.
+pub fn user_space(data: &[u8], tree: &usvg::Tree) -> Transform {
+    let root_group = || match tree.root().children() {
+        [usvg::Node::Group(g)] if g.id().is_empty() => g.transform().invert(),
+        _ => None,
+    };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return Transform::identity();
+    };
+    let Ok(doc) = usvg::roxmltree::Document::parse(text) else {
+        return Transform::identity();
+    };
+    let svg = doc.root_element();
+    let size = tree.size();
+    let moved = svg.attribute("transform").is_some()
+        || svg.attribute("viewBox").is_some_and(|v| {
+            v.parse::<svgtypes::ViewBox>().is_ok_and(|b| {
+                b.x != 0.0
+                    || b.y != 0.0
+                    || (b.w - f64::from(size.width())).abs() > 1e-9
+                    || (b.h - f64::from(size.height())).abs() > 1e-9
+            })
+        });
+    if moved {
+        root_group().unwrap_or_default()
+    } else {
+        Transform::identity()
+    }
+}
+
+fn walk(group: &usvg::Group, user: Transform, out: &mut Vec<Stroke>, number: &mut usize) {
     for node in group.children() {
         match node {
-            usvg::Node::Group(g) => walk(g, out, number),
-            usvg::Node::Path(p) => path_strokes(p, out, number),
+            usvg::Node::Group(g) => walk(g, user, out, number),
+            usvg::Node::Path(p) => path_strokes(p, user, out, number),
             usvg::Node::Image(_) | usvg::Node::Text(_) => {}
         }
     }
 }
 
-fn path_strokes(path: &usvg::Path, out: &mut Vec<Stroke>, number: &mut usize) {
-    let t = path.abs_transform();
+fn path_strokes(path: &usvg::Path, user: Transform, out: &mut Vec<Stroke>, number: &mut usize) {
+    let t = user.pre_concat(path.abs_transform());
     // A width scales with the transform's mean scale factor.
     let scale = f64::from((t.sx * t.sy - t.kx * t.ky).abs()).sqrt();
     let width = path
         .stroke()
         .map(|s| f64::from(s.width().get()) * scale)
         .filter(|w| w.is_finite() && *w > 0.0);
-    let mut subpaths: Vec<Vec<DVec2>> = Vec::new();
-    let mut current: Vec<DVec2> = Vec::new();
-    let mut last = Point::zero();
-    let mut start = Point::zero();
-    for seg in path.data().segments() {
-        match seg {
-            PathSegment::MoveTo(p) => {
-                if !current.is_empty() {
-                    subpaths.push(std::mem::take(&mut current));
-                }
-                push(&mut current, t, p);
-                last = p;
-                start = p;
-            }
-            PathSegment::LineTo(p) => {
-                push(&mut current, t, p);
-                last = p;
-            }
-            PathSegment::QuadTo(c, p) => {
-                for k in 1..=CURVE_STEPS {
-                    let s = k as f32 / CURVE_STEPS as f32;
-                    let u = 1.0 - s;
-                    let q = Point::from_xy(
-                        u * u * last.x + 2.0 * u * s * c.x + s * s * p.x,
-                        u * u * last.y + 2.0 * u * s * c.y + s * s * p.y,
-                    );
-                    push(&mut current, t, q);
-                }
-                last = p;
-            }
-            PathSegment::CubicTo(c1, c2, p) => {
-                for k in 1..=CURVE_STEPS {
-                    let s = k as f32 / CURVE_STEPS as f32;
-                    let u = 1.0 - s;
-                    let (a, b, c, d) = (u * u * u, 3.0 * u * u * s, 3.0 * u * s * s, s * s * s);
-                    let q = Point::from_xy(
-                        a * last.x + b * c1.x + c * c2.x + d * p.x,
-                        a * last.y + b * c1.y + c * c2.y + d * p.y,
-                    );
-                    push(&mut current, t, q);
-                }
-                last = p;
-            }
-            PathSegment::Close => {
-                push(&mut current, t, start);
-                last = start;
-            }
-        }
-    }
-    if !current.is_empty() {
-        subpaths.push(current);
-    }
-    for (k, points) in subpaths.into_iter().enumerate() {
+    for (k, sub) in subpaths(path, user).into_iter().enumerate() {
         *number += 1;
+        let points = flatten(&sub);
         if points.len() < 2 {
             continue;
         }
@@ -147,13 +130,108 @@ fn path_strokes(path: &usvg::Path, out: &mut Vec<Stroke>, number: &mut usize) {
     }
 }
 
-/// Appends `p` mapped by `t` and flipped to y-up, unless it repeats the last point.
-fn push(points: &mut Vec<DVec2>, t: Transform, mut p: Point) {
-    t.map_point(&mut p);
-    let q = DVec2::new(f64::from(p.x), -f64::from(p.y));
-    if !q.is_finite() {
-        return;
+/// One segment of a subpath in world coordinates (y up); each starts where the
+/// previous one ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Seg {
+    Move(DVec2),
+    Line(DVec2),
+    Quad(DVec2, DVec2),
+    Cubic(DVec2, DVec2, DVec2),
+    Close,
+}
+
+/// The subpaths of a path in world coordinates (its absolute transform and
+/// then `user` applied, y flipped up), exactly: curves stay curves. A subpath whose
+/// points are not all finite is dropped.
+pub fn subpaths(path: &usvg::Path, user: Transform) -> Vec<Vec<Seg>> {
+    let t = user.pre_concat(path.abs_transform());
+    let map = |mut p: Point| {
+        t.map_point(&mut p);
+        DVec2::new(f64::from(p.x), -f64::from(p.y))
+    };
+    let mut out: Vec<Vec<Seg>> = Vec::new();
+    let mut current: Vec<Seg> = Vec::new();
+    for seg in path.data().segments() {
+        let s = match seg {
+            PathSegment::MoveTo(p) => {
+                if !current.is_empty() {
+                    out.push(std::mem::take(&mut current));
+                }
+                Seg::Move(map(p))
+            }
+            PathSegment::LineTo(p) => Seg::Line(map(p)),
+            PathSegment::QuadTo(c, p) => Seg::Quad(map(c), map(p)),
+            PathSegment::CubicTo(c1, c2, p) => Seg::Cubic(map(c1), map(c2), map(p)),
+            PathSegment::Close => Seg::Close,
+        };
+        current.push(s);
     }
+    if !current.is_empty() {
+        out.push(current);
+    }
+    out.retain(|sub| {
+        sub.iter()
+            .all(|s| seg_points(s).iter().all(|p| p.is_finite()))
+    });
+    out
+}
+
+/// The points a segment names (controls, then its end).
+pub fn seg_points(s: &Seg) -> Vec<DVec2> {
+    match *s {
+        Seg::Move(p) | Seg::Line(p) => vec![p],
+        Seg::Quad(c, p) => vec![c, p],
+        Seg::Cubic(a, b, p) => vec![a, b, p],
+        Seg::Close => Vec::new(),
+    }
+}
+
+/// A subpath as a polyline: curves flattened into `CURVE_STEPS` pieces, no two
+/// consecutive points equal; a closed subpath ends where it started.
+pub fn flatten(sub: &[Seg]) -> Vec<DVec2> {
+    let mut points = Vec::new();
+    let mut last = DVec2::ZERO;
+    let mut start = DVec2::ZERO;
+    for s in sub {
+        match *s {
+            Seg::Move(p) => {
+                push(&mut points, p);
+                last = p;
+                start = p;
+            }
+            Seg::Line(p) => {
+                push(&mut points, p);
+                last = p;
+            }
+            Seg::Quad(c, p) => {
+                for k in 1..=CURVE_STEPS {
+                    let s = k as f64 / CURVE_STEPS as f64;
+                    let u = 1.0 - s;
+                    push(&mut points, u * u * last + 2.0 * u * s * c + s * s * p);
+                }
+                last = p;
+            }
+            Seg::Cubic(c1, c2, p) => {
+                for k in 1..=CURVE_STEPS {
+                    let s = k as f64 / CURVE_STEPS as f64;
+                    let u = 1.0 - s;
+                    let (a, b, c, d) = (u * u * u, 3.0 * u * u * s, 3.0 * u * s * s, s * s * s);
+                    push(&mut points, a * last + b * c1 + c * c2 + d * p);
+                }
+                last = p;
+            }
+            Seg::Close => {
+                push(&mut points, start);
+                last = start;
+            }
+        }
+    }
+    points
+}
+
+/// Appends `p` unless it repeats the last point.
+fn push(points: &mut Vec<DVec2>, q: DVec2) {
     if points.last().is_none_or(|l| l.distance(q) > 1e-9) {
         points.push(q);
     }

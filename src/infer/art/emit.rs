@@ -1,0 +1,610 @@
+//! The inferred grammar as an `ast::File`: a comment header, the element
+//! kinds as `element` items, named constants for the counts and transforms of
+//! the repeated structures, and one lsystem.
+//!
+//! Owns: names (elements `A`, `B`, … without `F`; sequence rules `P1`, `P2`, …,
+//! branchings `R1`, …, pairs `Q1`, …), the paper's post-processing (no `t0`
+//! parameter unless the turns change along a sequence, `+(0)`, `f(0)` and
+//! `*(1)` dropped, a sequence used only with m = 1 written as `P -> A T A`,
+//! pair transforms inlined), rounding every number to the shortest decimal
+//! that keeps the drawing within the tolerance, and the `derive` count that
+//! expands everything. Must not print text: `fmt::format_file` does.
+
+use super::read::Element;
+use super::rules::{Body, Grammar, Sym};
+use super::shape::{Frame, Instancing, rotate};
+use super::space::Tr;
+use crate::ast::{
+    BinOp, Block, ConstDecl, Element as ElementItem, Expr, ExprKind, File, Ident, Item, Lsystem,
+    ModName, Module, ModuleDecl, Node, Prop, PropValue, Rule, Stmt,
+};
+use crate::infer::emit::{comment, node, sym, var};
+use crate::infer::strokes::Seg;
+use crate::span::Span;
+use glam::DVec2;
+
+/// What the emitter needs besides the grammar.
+pub struct Settings<'a> {
+    /// The drawing's file name, for the header.
+    pub source: &'a str,
+    /// The lsystem's name.
+    pub name: String,
+}
+
+/// The shortest decimal within `tol` of `v` (at most 6 decimals).
+pub fn nice(v: f64, tol: f64) -> f64 {
+    for digits in 0..=6 {
+        let k = 10f64.powi(digits);
+        let r = (v * k).round() / k;
+        if (r - v).abs() <= tol {
+            return r + 0.0;
+        }
+    }
+    let k = 1e6;
+    (v * k).round() / k + 0.0
+}
+
+fn bin(op: BinOp, a: Expr, b: Expr) -> Expr {
+    Expr::new(ExprKind::Binary(op, Box::new(a), Box::new(b)))
+}
+
+fn element_name(k: usize) -> String {
+    const LETTERS: &str = "ABCDEGHIJKLMNOSTUVWXYZ";
+    match LETTERS.chars().nth(k) {
+        Some(c) => c.to_string(),
+        None => format!("E{}", k + 1),
+    }
+}
+
+struct Names {
+    elements: Vec<String>,
+    rules: Vec<String>,
+}
+
+impl Names {
+    fn new(kinds: usize, g: &Grammar) -> Names {
+        let (mut p, mut r, mut q) = (0, 0, 0);
+        let rules = g
+            .rules
+            .iter()
+            .map(|rule| match rule.body {
+                Body::Seq { .. } if rule.counts.iter().all(|&m| m == 1) => {
+                    q += 1;
+                    format!("Q{q}")
+                }
+                Body::Seq { .. } => {
+                    p += 1;
+                    format!("P{p}")
+                }
+                Body::Branch { .. } => {
+                    r += 1;
+                    format!("R{r}")
+                }
+                Body::Pair { .. } => {
+                    q += 1;
+                    format!("Q{q}")
+                }
+            })
+            .collect();
+        Names {
+            elements: (0..kinds).map(element_name).collect(),
+            rules,
+        }
+    }
+}
+
+/// Whether a rule takes the count `m` (sequences longer than a pair, branchings).
+fn counted(g: &Grammar, r: usize) -> bool {
+    match g.rules[r].body {
+        Body::Seq { .. } => !g.rules[r].counts.iter().all(|&m| m == 1),
+        Body::Branch { .. } => true,
+        Body::Pair { .. } => false,
+    }
+}
+
+/// Derivation steps to expand `s` completely.
+fn steps(g: &Grammar, s: Sym) -> u64 {
+    match s {
+        Sym::Element(_) => 0,
+        Sym::Rule(r, m) => match &g.rules[r].body {
+            Body::Seq { a, .. } | Body::Branch { a, .. } => {
+                if counted(g, r) {
+                    u64::from(m) + 1 + steps(g, *a)
+                } else {
+                    1 + steps(g, *a)
+                }
+            }
+            Body::Pair { a, b, .. } => 1 + steps(g, *a).max(steps(g, *b)),
+        },
+    }
+}
+
+/// How long a rule's transform is applied in a row, at most.
+fn run(g: &Grammar, r: usize) -> f64 {
+    g.rules[r].counts.iter().copied().max().unwrap_or(1).max(1) as f64
+}
+
+struct Consts {
+    items: Vec<Node<Item>>,
+}
+
+impl Consts {
+    fn add(&mut self, name: &str, value: f64, note: &str) -> Expr {
+        let mut n = node(Item::Const(ConstDecl {
+            name: Ident::new(name),
+            value: Expr::num(value),
+        }));
+        n.trivia.trailing = Some(comment(note));
+        self.items.push(n);
+        var(name)
+    }
+}
+
+/// The turtle commands of a transform `+(α) f(d) *(s) +(β)`, identity parts
+/// dropped. Each part is a fixed number or a named constant.
+enum Part {
+    Value(f64),
+    Expr(Expr),
+}
+
+fn transform(alpha: Part, d: Part, s: Part, beta: Part) -> Vec<Module> {
+    let mut out = Vec::new();
+    let turn = |p: Part, out: &mut Vec<Module>| match p {
+        Part::Value(0.0) => {}
+        Part::Value(v) => out.push(sym(
+            if v > 0.0 { '+' } else { '-' },
+            Some(Expr::num(v.abs())),
+        )),
+        Part::Expr(e) => out.push(sym('+', Some(e))),
+    };
+    turn(alpha, &mut out);
+    match d {
+        Part::Value(0.0) => {}
+        Part::Value(v) => out.push(sym('f', Some(Expr::num(v)))),
+        Part::Expr(e) => out.push(sym('f', Some(e))),
+    }
+    match s {
+        Part::Value(1.0) => {}
+        Part::Value(v) => out.push(sym('*', Some(Expr::num(v)))),
+        Part::Expr(e) => out.push(sym('*', Some(e))),
+    }
+    turn(beta, &mut out);
+    out
+}
+
+/// Rounding tolerances for a transform applied `n` times in a row, in a
+/// drawing whose size is `size` (in the transform's units).
+struct Round {
+    angle: f64,
+    d: f64,
+    s: f64,
+}
+
+impl Round {
+    fn new(n: f64, d: f64) -> Round {
+        Round {
+            angle: 0.002 / n,
+            d: (d * 2e-5).max(1e-6) / n,
+            s: 2e-6 / n,
+        }
+    }
+
+    fn values(&self, t: &Tr) -> (f64, f64, f64, f64) {
+        (
+            nice(t.alpha.to_degrees(), self.angle),
+            nice(t.d, self.d),
+            nice(t.s, self.s),
+            nice(t.beta.to_degrees(), self.angle),
+        )
+    }
+}
+
+fn module_of(names: &Names, g: &Grammar, s: Sym, count: Option<Expr>) -> Module {
+    match s {
+        Sym::Element(k) => Module::new(ModName::Name(names.elements[k].clone()), None),
+        Sym::Rule(r, m) => {
+            let args = counted(g, r).then(|| vec![count.unwrap_or_else(|| Expr::num(m as f64))]);
+            Module::new(ModName::Name(names.rules[r].clone()), args)
+        }
+    }
+}
+
+/// `[X]` for a rule instance (its drawing moves the turtle), `A` for an element.
+fn placed(names: &Names, g: &Grammar, s: Sym, count: Option<Expr>) -> Vec<Module> {
+    let m = module_of(names, g, s, count);
+    match s {
+        Sym::Element(_) => vec![m],
+        Sym::Rule(..) => vec![sym('[', None), m, sym(']', None)],
+    }
+}
+
+fn path_data(subpaths: &[Vec<Seg>], origin: DVec2, radius: f64) -> String {
+    let decimals = (3.0 - radius.max(1e-9).log10().floor()).clamp(0.0, 8.0) as i32;
+    let k = 10f64.powi(decimals);
+    let num = |v: f64| {
+        let r = (v * k).round() / k + 0.0;
+        format!("{r}")
+    };
+    let pt = |p: DVec2| {
+        let q = p - origin;
+        format!("{} {}", num(q.x), num(q.y))
+    };
+    let mut out: Vec<String> = Vec::new();
+    for sub in subpaths {
+        for s in sub {
+            out.push(match *s {
+                Seg::Move(p) => format!("M{}", pt(p)),
+                Seg::Line(p) => format!("L{}", pt(p)),
+                Seg::Quad(c, p) => format!("Q{} {}", pt(c), pt(p)),
+                Seg::Cubic(a, b, p) => format!("C{} {} {}", pt(a), pt(b), pt(p)),
+                Seg::Close => "Z".to_string(),
+            });
+        }
+    }
+    out.join(" ")
+}
+
+fn string_prop(key: &str, value: String) -> Node<Prop> {
+    node(Prop {
+        key: Ident::new(key),
+        value: PropValue::Str(value, Span::default()),
+    })
+}
+
+/// Counts of each symbol's uses, for the rule comments.
+fn describe(names: &Names, s: Sym) -> String {
+    match s {
+        Sym::Element(k) => names.elements[k].clone(),
+        Sym::Rule(r, _) => names.rules[r].clone(),
+    }
+}
+
+/// The program for a grammar.
+pub fn program(
+    elements: &[Element],
+    inst: &Instancing,
+    g: &Grammar,
+    s: &Settings,
+    seconds: Option<f64>,
+) -> File {
+    let _ = seconds;
+    let names = Names::new(inst.kinds.len(), g);
+    let mut consts = Consts { items: Vec::new() };
+    let mut items: Vec<Node<Item>> = Vec::new();
+
+    // Elements.
+    let mut element_items = Vec::new();
+    for (k, kind) in inst.kinds.iter().enumerate() {
+        let e = &elements[kind.representative];
+        let sh = &inst.shapes[kind.representative];
+        let mut props = vec![string_prop(
+            "path",
+            path_data(&e.subpaths, sh.centroid, sh.radius),
+        )];
+        props.push(string_prop(
+            "fill",
+            e.style.fill.clone().unwrap_or_else(|| "none".into()),
+        ));
+        if let Some(st) = &e.style.stroke {
+            props.push(string_prop("stroke", st.clone()));
+            if let Some(w) = e.style.width {
+                props.push(node(Prop {
+                    key: Ident::new("width"),
+                    value: PropValue::Expr(Expr::num(nice(w, w * 1e-3))),
+                }));
+            }
+        }
+        let count = inst.of.iter().filter(|(kk, _)| *kk == k).count();
+        let mut item = node(Item::Element(ElementItem {
+            name: Ident::new(names.elements[k].clone()),
+            props: Block {
+                stmts: props,
+                end_comments: Vec::new(),
+            },
+        }));
+        let sym_note = match kind.symmetry {
+            0 => ", round".to_string(),
+            1 => String::new(),
+            n => format!(", {n}-fold symmetric"),
+        };
+        item.trivia.leading.push(comment(format!(
+            "{}: {count} in the drawing{sym_note}; drawn as element {}{} of the drawing, centred.",
+            names.elements[k],
+            e.number,
+            if e.id.is_empty() {
+                String::new()
+            } else {
+                format!(" (id `{}`)", e.id)
+            }
+        )));
+        element_items.push(item);
+    }
+
+    // Rules.
+    let mut decls: Vec<Node<Stmt>> = Vec::new();
+    let mut rules: Vec<Node<Stmt>> = Vec::new();
+    let m = || var("m");
+    let m_minus_1 = || bin(BinOp::Sub, var("m"), Expr::num(1.0));
+    let cond = |op: BinOp| Some(bin(op, var("m"), Expr::num(0.0)));
+    // A count argument: a named constant when the rule is used with one count.
+    let mut count_of: Vec<Option<Expr>> = vec![None; g.rules.len()];
+    for (r, rule) in g.rules.iter().enumerate() {
+        if counted(g, r) && rule.counts.len() == 1 {
+            let n = *rule.counts.iter().next().unwrap_or(&0);
+            let what = match rule.body {
+                Body::Branch { .. } => "levels of branching below the first",
+                _ => "repeats after the first",
+            };
+            count_of[r] = Some(consts.add(
+                &format!("{}_N", names.rules[r]),
+                n as f64,
+                &format!("{}: {what}", names.rules[r]),
+            ));
+        }
+    }
+    for (r, rule) in g.rules.iter().enumerate() {
+        let name = names.rules[r].clone();
+        let counted_r = counted(g, r);
+        decls.push(node(Stmt::Module(ModuleDecl {
+            name: Ident::new(name.clone()),
+            params: if counted_r {
+                vec![Ident::new("m")]
+            } else {
+                Vec::new()
+            },
+        })));
+        let child_count = |s: Sym| match s {
+            Sym::Rule(c, _) => count_of[c].clone(),
+            Sym::Element(_) => None,
+        };
+        let scale_units = |t: &Tr| t.d.max(1e-9);
+        let pred = Module::new(
+            ModName::Name(name.clone()),
+            counted_r.then(|| vec![var("m")]),
+        );
+        let mut add_rule = |cond: Option<Expr>, succ: Vec<Module>, note: Option<String>| {
+            let mut n = node(Stmt::Rule(Rule {
+                label: None,
+                interpret: false,
+                left: None,
+                pred: pred.clone(),
+                right: None,
+                cond,
+                weight: None,
+                succ,
+            }));
+            if let Some(note) = note {
+                n.trivia.leading.push(comment(note));
+                n.trivia.blank_before = true;
+            }
+            rules.push(n);
+        };
+        let named_parts = |consts: &mut Consts, t: &Tr, suffix: &str, n: f64| {
+            let (a, d, sc, b) = Round::new(n, scale_units(t)).values(t);
+            let mut part = |v: f64, trivial: f64, what: &str, note: &str| {
+                if v == trivial {
+                    Part::Value(v)
+                } else {
+                    Part::Expr(consts.add(&format!("{name}_{what}{suffix}"), v, note))
+                }
+            };
+            (
+                part(a, 0.0, "TURN", "degrees, left positive, before the step"),
+                part(d, 0.0, "STEP", "distance, in the current scale"),
+                part(sc, 1.0, "SCALE", "scale factor per step"),
+                part(b, 0.0, "TWIST", "degrees, left positive, after the step"),
+            )
+        };
+        match &rule.body {
+            Body::Seq { a, t, delta } if counted_r => {
+                let (pa, pd, ps, pb) = named_parts(&mut consts, t, "", run(g, r));
+                let (pa, pb) = match delta {
+                    Some(dl) => {
+                        let n = run(g, r);
+                        let tol = 0.002 / (n * n);
+                        let linear = |consts: &mut Consts, base: Part, step: f64, what: &str| {
+                            let step = nice(step.to_degrees(), tol);
+                            let base = match base {
+                                Part::Value(v) => Expr::num(v),
+                                Part::Expr(e) => e,
+                            };
+                            if step == 0.0 {
+                                return Part::Expr(base);
+                            }
+                            let c = consts.add(
+                                &format!("{name}_D{what}"),
+                                step,
+                                "change of the turn per step of m",
+                            );
+                            Part::Expr(bin(BinOp::Add, base, bin(BinOp::Mul, c, m())))
+                        };
+                        (
+                            linear(&mut consts, pa, dl.alpha, "TURN"),
+                            linear(&mut consts, pb, dl.beta, "TWIST"),
+                        )
+                    }
+                    None => (pa, pb),
+                };
+                let mut succ = placed(&names, g, *a, child_count(*a));
+                succ.extend(transform(pa, pd, ps, pb));
+                succ.push(Module::new(
+                    ModName::Name(name.clone()),
+                    Some(vec![m_minus_1()]),
+                ));
+                add_rule(
+                    cond(BinOp::Gt),
+                    succ,
+                    Some(format!(
+                        "{name}(m): a sequence of m + 1 {}{}",
+                        describe(&names, *a),
+                        if delta.is_some() {
+                            ", turning by a changing angle"
+                        } else {
+                            ""
+                        }
+                    )),
+                );
+                add_rule(
+                    cond(BinOp::Eq),
+                    placed(&names, g, *a, child_count(*a)),
+                    None,
+                );
+            }
+            Body::Seq { a, t, .. } => {
+                // Used only as a pair: P -> A T A.
+                let (va, vd, vs, vb) = Round::new(1.0, scale_units(t)).values(t);
+                let mut succ = placed(&names, g, *a, child_count(*a));
+                succ.extend(transform(
+                    Part::Value(va),
+                    Part::Value(vd),
+                    Part::Value(vs),
+                    Part::Value(vb),
+                ));
+                succ.push(module_of(&names, g, *a, child_count(*a)));
+                add_rule(
+                    None,
+                    succ,
+                    Some(format!("{name}: two {} (a pair)", describe(&names, *a))),
+                );
+            }
+            Body::Branch { a, t, u } => {
+                let n = run(g, r);
+                let (ta, td, ts, tb) = named_parts(&mut consts, t, "1", n);
+                let (ua, ud, us, ub) = named_parts(&mut consts, u, "2", n);
+                let mut succ = placed(&names, g, *a, child_count(*a));
+                for (pa, pd, ps, pb) in [(ta, td, ts, tb), (ua, ud, us, ub)] {
+                    succ.push(sym('[', None));
+                    succ.extend(transform(pa, pd, ps, pb));
+                    succ.push(Module::new(
+                        ModName::Name(name.clone()),
+                        Some(vec![m_minus_1()]),
+                    ));
+                    succ.push(sym(']', None));
+                }
+                add_rule(
+                    cond(BinOp::Gt),
+                    succ,
+                    Some(format!(
+                        "{name}(m): {} branching in two, m levels deep",
+                        describe(&names, *a)
+                    )),
+                );
+                add_rule(
+                    cond(BinOp::Eq),
+                    placed(&names, g, *a, child_count(*a)),
+                    None,
+                );
+            }
+            Body::Pair { a, t, b } => {
+                let (va, vd, vs, vb) = Round::new(1.0, scale_units(t)).values(t);
+                let mut succ = placed(&names, g, *a, child_count(*a));
+                succ.extend(transform(
+                    Part::Value(va),
+                    Part::Value(vd),
+                    Part::Value(vs),
+                    Part::Value(vb),
+                ));
+                succ.push(module_of(&names, g, *b, child_count(*b)));
+                add_rule(
+                    None,
+                    succ,
+                    Some(format!(
+                        "{name}: {} and {} (a pair)",
+                        describe(&names, *a),
+                        describe(&names, *b)
+                    )),
+                );
+            }
+        }
+    }
+    let _ = m;
+
+    // Axiom: from the origin, heading up, to the last instance's frame.
+    let mut axiom = Vec::new();
+    let mut derive = 1;
+    if let Some((frame, s)) = g.axiom {
+        let origin = Frame {
+            pos: DVec2::ZERO,
+            rot: 0.0,
+            scale: 1.0,
+        };
+        let t = Tr::between(&origin, &frame, 1.0);
+        let size = frame.pos.length().max(1.0);
+        let (a, d, sc, b) = Round::new(1.0, size).values(&t);
+        axiom.extend(transform(
+            Part::Value(a),
+            Part::Value(d),
+            Part::Value(sc),
+            Part::Value(b),
+        ));
+        axiom.push(module_of(&names, g, s, {
+            match s {
+                Sym::Rule(c, _) => count_of[c].clone(),
+                Sym::Element(_) => None,
+            }
+        }));
+        derive = steps(g, s).max(1);
+    }
+    let _ = rotate;
+
+    let mut stmts: Vec<Node<Stmt>> = Vec::new();
+    stmts.push(node(Stmt::Derive(Expr::num(derive as f64))));
+    stmts.push(node(Stmt::Axiom(axiom)));
+    for (k, mut d) in decls.into_iter().enumerate() {
+        d.trivia.blank_before = k == 0;
+        stmts.push(d);
+    }
+    stmts.extend(rules);
+
+    // Header on the first item.
+    let header = [
+        format!("Inferred by `lsyc infer` from {}.", s.source),
+        format!(
+            "{} elements of {} kind{}; {} rule{} found in {} round{}.",
+            elements.len(),
+            inst.kinds.len(),
+            if inst.kinds.len() == 1 { "" } else { "s" },
+            g.rules.len(),
+            if g.rules.len() == 1 { "" } else { "s" },
+            g.rounds,
+            if g.rounds == 1 { "" } else { "s" },
+        ),
+        "Edit the constants (or override them: lsyc run -D P1_N=10) to change counts and".into(),
+        "transforms; replace an element's path to draw something else in its place.".into(),
+    ];
+    let mut first = true;
+    let mut push_item = |mut item: Node<Item>, items: &mut Vec<Node<Item>>| {
+        if first {
+            let mut lead: Vec<_> = header.iter().map(comment).collect();
+            lead.append(&mut item.trivia.leading);
+            item.trivia.leading = lead;
+            item.trivia.blank_after_leading = item.trivia.leading.len() == header.len();
+            first = false;
+        }
+        items.push(item);
+    };
+    for (k, mut e) in element_items.into_iter().enumerate() {
+        e.trivia.blank_before = k > 0;
+        push_item(e, &mut items);
+    }
+    for (k, mut c) in consts.items.into_iter().enumerate() {
+        c.trivia.blank_before = k == 0;
+        push_item(c, &mut items);
+    }
+    let mut sys = node(Item::Lsystem(Lsystem {
+        name: Ident::new(s.name.clone()),
+        params: Vec::new(),
+        body: Block {
+            stmts,
+            end_comments: Vec::new(),
+        },
+    }));
+    sys.trivia.blank_before = true;
+    push_item(sys, &mut items);
+    File {
+        items: Block {
+            stmts: items,
+            end_comments: Vec::new(),
+        },
+    }
+}

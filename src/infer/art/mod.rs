@@ -1,0 +1,162 @@
+//! `lsyc infer ART.svg`: a drawing of repeated elements to an L-system that
+//! draws it back, after Šťava, Beneš, Měch, Aliaga & Krištof, *Inverse
+//! Procedural Modeling by Automatic Generation of L-systems* (CGF 2010).
+//!
+//! Owns: the pipeline and its options and statistics: elements (`read`),
+//! kinds and frames (`shape`), transformation spaces and clustering (`space`),
+//! rules level by level (`rules`) and the program (`emit`). Must not write
+//! files or print (the CLI does), and must not panic on any input.
+
+pub mod emit;
+pub mod read;
+pub mod rules;
+pub mod shape;
+pub mod space;
+
+use super::{InferError, MAX_SVG_BYTES};
+use crate::ast::File;
+use rules::{Inst, Sym, Tolerance, Weights};
+use std::time::Instant;
+
+/// The most elements a drawing may have.
+pub const MAX_ELEMENTS: usize = 200_000;
+
+/// Options of `lsyc infer ART.svg`.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Importance weights of clusters.
+    pub weights: Weights,
+    /// Relaxed tolerances: a noisy drawing comes out regular.
+    pub symmetrize: bool,
+    /// Largest mean misfit of alike elements, relative to their size.
+    pub similarity: f64,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            weights: Weights::default(),
+            symmetrize: false,
+            similarity: 0.02,
+        }
+    }
+}
+
+/// What inference found and how long each phase took.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Stats {
+    pub elements: usize,
+    pub skipped: usize,
+    pub kinds: usize,
+    pub clusters: usize,
+    pub rules: usize,
+    pub rounds: usize,
+    pub read_ms: f64,
+    pub instancing_ms: f64,
+    pub rules_ms: f64,
+    pub emit_ms: f64,
+}
+
+/// A drawing and the program inferred from it.
+pub struct Inferred {
+    pub file: File,
+    pub text: String,
+    /// Things of the drawing that were skipped, one line each.
+    pub skipped: Vec<String>,
+    pub stats: Stats,
+}
+
+fn ms(t: Instant) -> f64 {
+    (t.elapsed().as_secs_f64() * 1e5).round() / 100.0
+}
+
+/// Infers a program from the bytes of an SVG drawing named `name`;
+/// `progress` is told how many instances are left as rules are found.
+pub fn from_svg(
+    data: &[u8],
+    name: &str,
+    opts: &Options,
+    progress: &mut dyn FnMut(usize),
+) -> Result<Inferred, InferError> {
+    if data.len() > MAX_SVG_BYTES {
+        return Err(InferError::TooLarge { file: name.into() });
+    }
+    let t = Instant::now();
+    let drawing = read::read(data).map_err(|why| InferError::NotSvg {
+        file: name.into(),
+        why,
+    })?;
+    if drawing.largest > read::MAX_COORDINATE || !drawing.largest.is_finite() {
+        return Err(InferError::Huge {
+            file: name.into(),
+            largest: drawing.largest,
+        });
+    }
+    if drawing.elements.is_empty() {
+        return Err(InferError::NoElements {
+            file: name.into(),
+            skipped: drawing.skipped.len(),
+        });
+    }
+    if drawing.elements.len() > MAX_ELEMENTS {
+        return Err(InferError::TooManyElements {
+            file: name.into(),
+            elements: drawing.elements.len(),
+        });
+    }
+    let mut stats = Stats {
+        elements: drawing.elements.len(),
+        skipped: drawing.skipped.len(),
+        read_ms: ms(t),
+        ..Stats::default()
+    };
+    let t = Instant::now();
+    let tol = if opts.symmetrize {
+        Tolerance::RELAXED
+    } else {
+        Tolerance::EXACT
+    };
+    let similarity = if opts.symmetrize {
+        opts.similarity * 3.0
+    } else {
+        opts.similarity
+    };
+    let inst = shape::instancing(&drawing.elements, similarity);
+    stats.kinds = inst.kinds.len();
+    stats.instancing_ms = ms(t);
+    let t = Instant::now();
+    let insts: Vec<Inst> = drawing
+        .elements
+        .iter()
+        .zip(&inst.of)
+        .map(|(e, (k, f))| Inst::new(Sym::Element(*k), *f, e.min, e.max))
+        .collect();
+    let grammar = rules::infer(insts, opts.weights, tol, progress);
+    stats.rules = grammar.rules.len();
+    stats.rounds = grammar.rounds;
+    stats.clusters = grammar.clusters;
+    stats.rules_ms = ms(t);
+    let t = Instant::now();
+    let path = std::path::Path::new(name);
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let source = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| name.to_string());
+    let settings = emit::Settings {
+        source: &source,
+        name: super::emit::system_name(&stem),
+    };
+    let file = emit::program(&drawing.elements, &inst, &grammar, &settings, None);
+    let text = crate::fmt::format_file(&file);
+    stats.emit_ms = ms(t);
+    Ok(Inferred {
+        file,
+        text,
+        skipped: drawing.skipped,
+        stats,
+    })
+}

@@ -1,0 +1,262 @@
+//! The elements of a drawing: every connected drawable of an SVG, in document
+//! order, with its exact outline in world coordinates and its style.
+//!
+//! Owns: what counts as one element (a path, or each group of its subpaths
+//! whose bounding boxes overlap: separate shapes in one path are separate
+//! elements, a ring's hole stays with its ring), the style key that keeps
+//! differently painted shapes apart, and what is skipped (text, images,
+//! shapes with no extent), with warnings. usvg resolves groups, `<use>`,
+//! transforms and turns rects, circles, ellipses, lines, polylines and
+//! polygons into paths. Must not decide which elements are alike.
+
+use crate::infer::strokes::{self, Seg};
+use glam::DVec2;
+use usvg::tiny_skia_path::Transform;
+
+/// Coordinates beyond this (in user units) are refused: usvg works in 32-bit
+/// floats, which cannot place such points precisely.
+pub const MAX_COORDINATE: f64 = 1.0e7;
+
+/// How an element is painted; elements with different styles never share a kind.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Style {
+    /// `#rrggbb`, or `None` for no fill.
+    pub fill: Option<String>,
+    /// `#rrggbb`, or `None` for no stroke.
+    pub stroke: Option<String>,
+    /// Stroke width in world units.
+    pub width: Option<f64>,
+}
+
+impl Style {
+    /// The part of the style that must match for two elements to be alike
+    /// (widths scale with the element, so they are compared relatively later).
+    pub fn key(&self) -> (Option<&str>, Option<&str>) {
+        (self.fill.as_deref(), self.stroke.as_deref())
+    }
+}
+
+/// One element of the drawing.
+#[derive(Clone, Debug)]
+pub struct Element {
+    /// 1-based position in the document, for messages.
+    pub number: usize,
+    /// The SVG `id` of the shape it came from (may be empty).
+    pub id: String,
+    /// Its subpaths, exactly, in world coordinates (y up).
+    pub subpaths: Vec<Vec<Seg>>,
+    /// The subpaths flattened to polylines.
+    pub outline: Vec<Vec<DVec2>>,
+    pub style: Style,
+    pub min: DVec2,
+    pub max: DVec2,
+}
+
+/// The elements of a drawing and what was left out.
+#[derive(Debug, Default)]
+pub struct Drawing {
+    pub elements: Vec<Element>,
+    /// One line per skipped thing, for warnings.
+    pub skipped: Vec<String>,
+    /// The largest coordinate magnitude met.
+    pub largest: f64,
+}
+
+/// Reads the elements of an SVG document. The error is usvg's reason.
+pub fn read(data: &[u8]) -> Result<Drawing, String> {
+    let tree = usvg::Tree::from_data(data, &usvg::Options::default()).map_err(|e| e.to_string())?;
+    let mut d = Drawing::default();
+    let user = strokes::user_space(data, &tree);
+    walk(tree.root(), user, &mut d);
+    d.skipped.extend(skipped_in_xml(data));
+    Ok(d)
+}
+
+/// Text, images and shapes with no size, found in the document itself (usvg
+/// drops text without fonts and empty shapes without a word).
+fn skipped_in_xml(data: &[u8]) -> Vec<String> {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return Vec::new();
+    };
+    let Ok(doc) = usvg::roxmltree::Document::parse(text) else {
+        return Vec::new();
+    };
+    let num = |n: &usvg::roxmltree::Node, a: &str| {
+        n.attribute(a)
+            .map(|v| v.trim().trim_end_matches("px").parse::<f64>().unwrap_or(f64::NAN))
+    };
+    let mut out = Vec::new();
+    for n in doc.descendants().filter(|n| n.is_element()) {
+        if n.ancestors().any(|a| {
+            matches!(
+                a.tag_name().name(),
+                "defs" | "symbol" | "clipPath" | "mask" | "pattern" | "marker"
+            )
+        }) {
+            continue;
+        }
+        let id = id_note(n.attribute("id").unwrap_or(""));
+        let zero = |v: Option<f64>| v.is_some_and(|x| x == 0.0);
+        match n.tag_name().name() {
+            "text" => out.push(format!("a text{id}")),
+            "image" => out.push(format!("an image{id}")),
+            "rect" if zero(num(&n, "width")) || zero(num(&n, "height")) => {
+                out.push(format!("an empty rect{id}"))
+            }
+            "circle" if zero(num(&n, "r")) => out.push(format!("an empty circle{id}")),
+            "ellipse" if zero(num(&n, "rx")) || zero(num(&n, "ry")) => {
+                out.push(format!("an empty ellipse{id}"))
+            }
+            "path" if n.attribute("d").is_none_or(|d| d.trim().is_empty()) => {
+                out.push(format!("an empty path{id}"))
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+fn walk(group: &usvg::Group, user: Transform, d: &mut Drawing) {
+    for node in group.children() {
+        match node {
+            usvg::Node::Group(g) => walk(g, user, d),
+            usvg::Node::Path(p) => path_elements(p, user, d),
+            // Reported from the document (see `skipped_in_xml`).
+            usvg::Node::Image(_) | usvg::Node::Text(_) => {}
+        }
+    }
+}
+
+fn id_note(id: &str) -> String {
+    if id.is_empty() {
+        String::new()
+    } else {
+        format!(" (id `{id}`)")
+    }
+}
+
+fn color(paint: &usvg::Paint) -> String {
+    match paint {
+        usvg::Paint::Color(c) => format!("#{:02x}{:02x}{:02x}", c.red, c.green, c.blue),
+        // Gradients and patterns are drawn back as a neutral grey.
+        _ => "#808080".to_string(),
+    }
+}
+
+fn bounds(points: impl IntoIterator<Item = DVec2>) -> (DVec2, DVec2) {
+    points.into_iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    )
+}
+
+fn overlaps(a: &(DVec2, DVec2), b: &(DVec2, DVec2)) -> bool {
+    a.0.x <= b.1.x && b.0.x <= a.1.x && a.0.y <= b.1.y && b.0.y <= a.1.y
+}
+
+fn path_elements(path: &usvg::Path, user: Transform, d: &mut Drawing) {
+    if !path.is_visible() {
+        return;
+    }
+    let t = user.pre_concat(path.abs_transform());
+    let scale = f64::from((t.sx * t.sy - t.kx * t.ky).abs()).sqrt();
+    let style = Style {
+        fill: path.fill().map(|f| color(f.paint())),
+        stroke: path.stroke().map(|s| color(s.paint())),
+        width: path
+            .stroke()
+            .map(|s| f64::from(s.width().get()) * scale)
+            .filter(|w| w.is_finite() && *w > 0.0),
+    };
+    let subs = strokes::subpaths(path, user);
+    // Each subpath with its polyline and box.
+    type Part = (Vec<Seg>, Vec<DVec2>, (DVec2, DVec2));
+    let mut parts: Vec<Part> = Vec::new();
+    for sub in subs {
+        let flat = strokes::flatten(&sub);
+        for p in &flat {
+            d.largest = d.largest.max(p.x.abs()).max(p.y.abs());
+        }
+        if flat.len() < 2 {
+            continue;
+        }
+        let b = bounds(flat.iter().copied());
+        parts.push((sub, flat, b));
+    }
+    if parts.is_empty() {
+        return;
+    }
+    // Union subpaths whose boxes overlap (a hole with its ring).
+    let n = parts.len();
+    let mut group: Vec<usize> = (0..n).collect();
+    fn find(g: &mut [usize], mut i: usize) -> usize {
+        while g[i] != i {
+            g[i] = g[g[i]];
+            i = g[i];
+        }
+        i
+    }
+    for i in 0..n {
+        for j in i + 1..n {
+            if overlaps(&parts[i].2, &parts[j].2) {
+                let (a, b) = (find(&mut group, i), find(&mut group, j));
+                if a != b {
+                    group[a.max(b)] = a.min(b);
+                }
+            }
+        }
+    }
+    let mut order: Vec<usize> = Vec::new();
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for i in 0..n {
+        let r = find(&mut group, i);
+        if members[r].is_empty() {
+            order.push(r);
+        }
+        members[r].push(i);
+    }
+    for r in order {
+        let mut subpaths = Vec::new();
+        let mut outline = Vec::new();
+        for &i in &members[r] {
+            subpaths.push(parts[i].0.clone());
+            outline.push(parts[i].1.clone());
+        }
+        let (min, max) = bounds(outline.iter().flatten().copied());
+        d.elements.push(Element {
+            number: d.elements.len() + 1,
+            id: path.id().to_string(),
+            subpaths,
+            outline,
+            style: style.clone(),
+            min,
+            max,
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn separate_subpaths_split_and_holes_stay() {
+        let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100">
+            <path d="M0 0 H10 V10 H0 Z M20 0 H30 V10 H20 Z" fill="#ff0000"/>
+            <path id="ring" d="M50 50 m-10 0 a10 10 0 1 0 20 0 a10 10 0 1 0 -20 0 M50 50 m-4 0 a4 4 0 1 0 8 0 a4 4 0 1 0 -8 0" fill="black" fill-rule="evenodd"/>
+            <text x="0" y="90">hi</text>
+            <rect x="1" y="1" width="5" height="5" stroke="blue" fill="none" stroke-width="2"/>
+        </svg>"##;
+        let d = read(svg.as_bytes()).expect("reads");
+        assert_eq!(d.elements.len(), 4, "{:?}", d.elements);
+        assert_eq!(d.elements[0].style.fill.as_deref(), Some("#ff0000"));
+        assert_eq!(d.elements[0].max, DVec2::new(10.0, 0.0));
+        assert_eq!(d.elements[1].min, DVec2::new(20.0, -10.0));
+        assert_eq!(d.elements[2].id, "ring");
+        assert_eq!(d.elements[2].subpaths.len(), 2);
+        assert_eq!(d.elements[3].style.stroke.as_deref(), Some("#0000ff"));
+        assert_eq!(d.elements[3].style.fill, None);
+        assert_eq!(d.elements[3].style.width, Some(2.0));
+        assert_eq!(d.skipped.len(), 1, "{:?}", d.skipped);
+    }
+}

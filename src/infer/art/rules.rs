@@ -1,0 +1,890 @@
+//! Rule generation: placed instances become sequence, branching and pair rules,
+//! level by level, until one instance is left (the axiom).
+//!
+//! Owns: the paper's loop (§5). Each round compares every live instance with
+//! its nearest neighbours (transforms in one space per pair of kinds), clusters
+//! each space, and proposes candidates: *sequences* (chains of one kind linked
+//! by the same transform, rule r1/r2), *linear sequences* (chains whose turns
+//! change by a constant step, found in the (d, s) subspace: t(m) = t0 + tΔ·m),
+//! *branchings* (complete binary trees whose two child transforms come from two
+//! clusters, r3/r4) and, when nothing repeats, *pairs* (r1 with m = 1). The
+//! candidate with the largest importance w = w_n·n + w_h·h + w_φ·φ + w_l·l is
+//! made a rule; its instances are replaced by one new instance each, in the
+//! frame of their first element, and the round repeats. A chain is cut where
+//! redrawing it with the rule's averaged transform would leave the tolerance,
+//! so what is drawn back stays on the input. Must not print or build syntax.
+
+use super::shape::{Frame, wrap};
+use super::space::{Grid, Point, Tr, cluster};
+use glam::DVec2;
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
+
+/// A symbol of the inferred grammar: an element kind, or a rule with its count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Sym {
+    Element(usize),
+    Rule(usize, u32),
+}
+
+/// What a rule draws.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Body {
+    /// `P(m) : m > 0 -> [a] T(t(m)) P(m - 1); P(m) : m == 0 -> [a]` with
+    /// t(m) = t + delta·m (delta only for linear sequences).
+    Seq { a: Sym, t: Tr, delta: Option<Tr> },
+    /// `R(m) : m > 0 -> [a] [T R(m - 1)] [U R(m - 1)]; R(m) : m == 0 -> [a]`.
+    Branch { a: Sym, t: Tr, u: Tr },
+    /// `Q -> [a] T [b]`.
+    Pair { a: Sym, t: Tr, b: Sym },
+}
+
+#[derive(Clone, Debug)]
+pub struct Rule {
+    pub body: Body,
+    /// The counts it is used with.
+    pub counts: BTreeSet<u32>,
+}
+
+/// The weights of the cluster importance w = w_n·n + w_h·h + w_φ·φ + w_l·l.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Weights {
+    pub n: f64,
+    pub h: f64,
+    pub phi: f64,
+    pub l: f64,
+}
+
+impl Default for Weights {
+    fn default() -> Weights {
+        Weights {
+            n: 1.0,
+            h: 1.0,
+            phi: 0.5,
+            l: 1.0,
+        }
+    }
+}
+
+/// How different two transforms may be and still be one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerance {
+    /// Angles, radians.
+    pub angle: f64,
+    /// Distances, relative (0.01 is 1 %).
+    pub distance: f64,
+    /// Scales, relative.
+    pub scale: f64,
+}
+
+impl Tolerance {
+    pub const EXACT: Tolerance = Tolerance {
+        angle: 0.5 * std::f64::consts::PI / 180.0,
+        distance: 0.005,
+        scale: 0.005,
+    };
+    pub const RELAXED: Tolerance = Tolerance {
+        angle: 6.0 * std::f64::consts::PI / 180.0,
+        distance: 0.08,
+        scale: 0.08,
+    };
+}
+
+/// A placed thing: an element or an instance of a rule.
+#[derive(Clone, Debug)]
+pub struct Inst {
+    pub sym: Sym,
+    pub frame: Frame,
+    pub min: DVec2,
+    pub max: DVec2,
+    alive: bool,
+}
+
+impl Inst {
+    pub fn new(sym: Sym, frame: Frame, min: DVec2, max: DVec2) -> Inst {
+        Inst {
+            sym,
+            frame,
+            min,
+            max,
+            alive: true,
+        }
+    }
+
+    fn centre(&self) -> DVec2 {
+        (self.min + self.max) * 0.5
+    }
+
+    fn size(&self) -> f64 {
+        (self.max - self.min).length().max(1e-12)
+    }
+}
+
+/// The inferred grammar.
+#[derive(Clone, Debug)]
+pub struct Grammar {
+    pub rules: Vec<Rule>,
+    /// The last instance: where it is and what it is.
+    pub axiom: Option<(Frame, Sym)>,
+    /// Rounds of the loop.
+    pub rounds: usize,
+    /// Clusters met, over all rounds.
+    pub clusters: usize,
+}
+
+struct Edge {
+    from: usize,
+    to: usize,
+    t: Tr,
+    /// Gap between the two boxes, relative to the drawing's diagonal.
+    gap: f64,
+}
+
+#[derive(Debug)]
+enum Plan {
+    Seq {
+        chains: Vec<Vec<usize>>,
+        t: Tr,
+        delta: Option<Tr>,
+    },
+    Branch {
+        trees: Vec<(usize, u32)>,
+        child: [HashMap<usize, usize>; 2],
+        t: Tr,
+        u: Tr,
+    },
+    Pair {
+        pairs: Vec<(usize, usize)>,
+        t: Tr,
+    },
+}
+
+struct Candidate {
+    plan: Plan,
+    /// Pairs of instances it codes.
+    pairs: usize,
+    /// Mean number of instances per chain (or per root-to-leaf path).
+    length: f64,
+    /// Mean proximity, 1 − gap.
+    h: f64,
+    /// Similarity of the two kinds.
+    phi: f64,
+}
+
+/// Neighbours compared per instance.
+const NEIGHBOURS: usize = 8;
+
+/// Runs the loop over `insts`; `progress` is told how many are left.
+pub fn infer(
+    mut insts: Vec<Inst>,
+    weights: Weights,
+    tol: Tolerance,
+    progress: &mut dyn FnMut(usize),
+) -> Grammar {
+    let (lo, hi) = insts.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), i| (lo.min(i.min), hi.max(i.max)),
+    );
+    let diagonal = (hi - lo).length().max(1e-12);
+    let mut g = Grammar {
+        rules: Vec::new(),
+        axiom: None,
+        rounds: 0,
+        clusters: 0,
+    };
+    loop {
+        let live: Vec<usize> = (0..insts.len()).filter(|&i| insts[i].alive).collect();
+        progress(live.len());
+        if live.len() <= 1 {
+            g.axiom = live.first().map(|&i| (insts[i].frame, insts[i].sym));
+            return g;
+        }
+        g.rounds += 1;
+        let edges = edges(&insts, &live, diagonal);
+        let (mut candidates, clusters) = candidates(&insts, &edges, tol);
+        g.clusters += clusters;
+        let best = choose(&mut candidates, weights);
+        match best {
+            Some(c) if c.pairs >= 2 => apply(&mut g, &mut insts, c.plan),
+            _ => pair_up(&mut g, &mut insts, &edges),
+        }
+    }
+}
+
+/// Directed edges between each live instance and its nearest neighbours.
+fn edges(insts: &[Inst], live: &[usize], diagonal: f64) -> Vec<Edge> {
+    let centres: Vec<DVec2> = live.iter().map(|&i| insts[i].centre()).collect();
+    let grid = Grid::new(&centres);
+    let mut pairs: BTreeSet<(usize, usize)> = BTreeSet::new();
+    for (a, c) in centres.iter().enumerate() {
+        for b in grid.nearest(*c, NEIGHBOURS + 1) {
+            if a != b {
+                pairs.insert((a.min(b), a.max(b)));
+            }
+        }
+    }
+    let mut out = Vec::with_capacity(pairs.len() * 2);
+    for (a, b) in pairs {
+        let (i, j) = (live[a], live[b]);
+        let gap = {
+            let (p, q) = (&insts[i], &insts[j]);
+            let dx = (q.min.x - p.max.x).max(p.min.x - q.max.x).max(0.0);
+            let dy = (q.min.y - p.max.y).max(p.min.y - q.max.y).max(0.0);
+            (dx * dx + dy * dy).sqrt() / diagonal
+        };
+        for (from, to) in [(i, j), (j, i)] {
+            let size = insts[from].size() / insts[from].frame.scale;
+            out.push(Edge {
+                from,
+                to,
+                t: Tr::between(&insts[from].frame, &insts[to].frame, size),
+                gap,
+            });
+        }
+    }
+    out
+}
+
+fn point(t: &Tr, tol: Tolerance) -> Point {
+    [
+        t.alpha / tol.angle,
+        t.d.max(1e-12).ln() / tol.distance,
+        t.s.ln() / tol.scale,
+        t.beta / tol.angle,
+    ]
+}
+
+/// The mean of transforms (angles averaged around the first).
+fn mean(ts: &[Tr]) -> Tr {
+    let n = ts.len().max(1) as f64;
+    let first = ts.first().copied().unwrap_or(Tr::IDENTITY);
+    let mut m = Tr {
+        alpha: 0.0,
+        d: 0.0,
+        s: 0.0,
+        beta: 0.0,
+    };
+    for t in ts {
+        m.alpha += wrap(t.alpha - first.alpha);
+        m.d += t.d;
+        m.s += t.s;
+        m.beta += wrap(t.beta - first.beta);
+    }
+    Tr {
+        alpha: wrap(first.alpha + m.alpha / n),
+        d: m.d / n,
+        s: m.s / n,
+        beta: wrap(first.beta + m.beta / n),
+    }
+}
+
+/// Whether `f` is where `want` is, within the tolerance (relative to `step`,
+/// the distance moved to get there, and the frame's scale).
+fn close(f: &Frame, want: &Frame, step: f64, size: f64, tol: Tolerance) -> bool {
+    f.pos.distance(want.pos) <= tol.distance * step.max(size * 0.05) * 2.0 + size * 1e-6
+        && wrap(f.rot - want.rot).abs() <= tol.angle * 2.0
+        && (f.scale / want.scale).ln().abs() <= tol.scale * 2.0
+}
+
+/// All candidates of a round, and the number of clusters.
+fn candidates(insts: &[Inst], edges: &[Edge], tol: Tolerance) -> (Vec<Candidate>, usize) {
+    let mut spaces: BTreeMap<(Sym, Sym), Vec<usize>> = BTreeMap::new();
+    for (k, e) in edges.iter().enumerate() {
+        spaces
+            .entry((insts[e.from].sym, insts[e.to].sym))
+            .or_default()
+            .push(k);
+    }
+    let turn = std::f64::consts::TAU / tol.angle;
+    let mut out = Vec::new();
+    let mut count = 0;
+    for ((a, b), ks) in &spaces {
+        let points: Vec<Point> = ks.iter().map(|&k| point(&edges[k].t, tol)).collect();
+        let (label, centres) = cluster(&points, turn);
+        count += centres.len();
+        let mut groups: Vec<Vec<usize>> = vec![Vec::new(); centres.len()];
+        for (i, &k) in ks.iter().enumerate() {
+            groups[label[i]].push(k);
+        }
+        let phi = if a == b { 1.0 } else { 0.5 };
+        for group in &groups {
+            if let Some(c) = sequence(insts, edges, group, a == b, tol, phi) {
+                out.push(c);
+            }
+        }
+        if a == b {
+            // Branchings: two clusters of one kind, each node with a child in both.
+            let mut big: Vec<&Vec<usize>> = groups.iter().filter(|g| g.len() >= 2).collect();
+            big.sort_by_key(|g| std::cmp::Reverse(g.len()));
+            big.truncate(6);
+            for x in 0..big.len() {
+                for y in x + 1..big.len() {
+                    if let Some(c) = branching(insts, edges, big[x], big[y], tol) {
+                        out.push(c);
+                    }
+                }
+            }
+            out.extend(linear(insts, edges, ks, tol));
+        }
+    }
+    (out, count)
+}
+
+/// Chains (or pairs, across kinds) of one cluster.
+fn sequence(
+    insts: &[Inst],
+    edges: &[Edge],
+    group: &[usize],
+    same: bool,
+    tol: Tolerance,
+    phi: f64,
+) -> Option<Candidate> {
+    let ts: Vec<Tr> = group.iter().map(|&k| edges[k].t).collect();
+    let centre = mean(&ts);
+    let mut order: Vec<usize> = group.to_vec();
+    let dev = |k: usize| {
+        let p = point(&edges[k].t, tol);
+        let c = point(&centre, tol);
+        (0..4).map(|i| (p[i] - c[i]).powi(2)).sum::<f64>()
+    };
+    order.sort_by(|&x, &y| {
+        dev(x)
+            .total_cmp(&dev(y))
+            .then(edges[x].from.cmp(&edges[y].from))
+            .then(edges[x].to.cmp(&edges[y].to))
+    });
+    let mut next: HashMap<usize, usize> = HashMap::new();
+    let mut prev: HashMap<usize, usize> = HashMap::new();
+    let mut root: HashMap<usize, usize> = HashMap::new();
+    fn find(root: &mut HashMap<usize, usize>, mut i: usize) -> usize {
+        while let Some(&r) = root.get(&i) {
+            if r == i {
+                break;
+            }
+            i = r;
+        }
+        i
+    }
+    for k in order {
+        let e = &edges[k];
+        if next.contains_key(&e.from) || prev.contains_key(&e.to) {
+            continue;
+        }
+        if !same && (prev.contains_key(&e.from) || next.contains_key(&e.to)) {
+            continue;
+        }
+        let (ra, rb) = (find(&mut root, e.from), find(&mut root, e.to));
+        if ra == rb {
+            continue;
+        }
+        root.insert(ra.max(rb), ra.min(rb));
+        root.entry(ra.min(rb)).or_insert(ra.min(rb));
+        next.insert(e.from, e.to);
+        prev.insert(e.to, e.from);
+    }
+    let mut starts: Vec<usize> = next
+        .keys()
+        .copied()
+        .filter(|s| !prev.contains_key(s))
+        .collect();
+    starts.sort_unstable();
+    let mut chains: Vec<Vec<usize>> = Vec::new();
+    for s in starts {
+        let mut chain = vec![s];
+        let mut at = s;
+        while let Some(&n) = next.get(&at) {
+            chain.push(n);
+            at = n;
+        }
+        chains.push(chain);
+    }
+    // The transform from the edges used, then chains cut where it drifts.
+    let used: Vec<Tr> = chains
+        .iter()
+        .flat_map(|c| c.windows(2))
+        .filter_map(|w| {
+            group
+                .iter()
+                .find(|&&k| edges[k].from == w[0] && edges[k].to == w[1])
+                .map(|&k| edges[k].t)
+        })
+        .collect();
+    let t = mean(&used);
+    let chains = cut_drift(insts, chains, |_, _| t, tol);
+    seq_candidate(insts, edges, chains, t, None, phi)
+}
+
+/// Splits chains where redrawing with `step(chain position, chain length)`
+/// leaves the tolerance; drops pieces of one instance.
+fn cut_drift(
+    insts: &[Inst],
+    chains: Vec<Vec<usize>>,
+    step: impl Fn(usize, usize) -> Tr,
+    tol: Tolerance,
+) -> Vec<Vec<usize>> {
+    let mut out = Vec::new();
+    for chain in chains {
+        let mut piece = vec![chain[0]];
+        let mut at = insts[chain[0]].frame;
+        for (q, &i) in chain.iter().enumerate().skip(1) {
+            let t = step(piece.len() - 1, chain.len() - q + piece.len() - 1);
+            let want = t.apply(&at);
+            let f = insts[i].frame;
+            let size = insts[i].size();
+            if close(&want, &f, t.d * at.scale, size, tol) {
+                piece.push(i);
+                at = want;
+            } else {
+                if piece.len() >= 2 {
+                    out.push(std::mem::take(&mut piece));
+                }
+                piece = vec![i];
+                at = f;
+            }
+        }
+        if piece.len() >= 2 {
+            out.push(piece);
+        }
+    }
+    out
+}
+
+fn seq_candidate(
+    insts: &[Inst],
+    edges: &[Edge],
+    chains: Vec<Vec<usize>>,
+    t: Tr,
+    delta: Option<Tr>,
+    phi: f64,
+) -> Option<Candidate> {
+    if chains.is_empty() {
+        return None;
+    }
+    let pairs: usize = chains.iter().map(|c| c.len() - 1).sum();
+    let gaps: HashMap<(usize, usize), f64> =
+        edges.iter().map(|e| ((e.from, e.to), e.gap)).collect();
+    let gap_sum: f64 = chains
+        .iter()
+        .flat_map(|c| c.windows(2))
+        .map(|w| gaps.get(&(w[0], w[1])).copied().unwrap_or(1.0))
+        .sum();
+    let _ = insts;
+    Some(Candidate {
+        length: (pairs + chains.len()) as f64 / chains.len() as f64,
+        h: 1.0 - gap_sum / pairs as f64,
+        phi,
+        pairs,
+        plan: Plan::Seq { chains, t, delta },
+    })
+}
+
+/// Chains whose turns change by a constant step: the (d, s) subspace.
+fn linear(insts: &[Inst], edges: &[Edge], ks: &[usize], tol: Tolerance) -> Option<Candidate> {
+    let points: Vec<Point> = ks
+        .iter()
+        .map(|&k| {
+            let p = point(&edges[k].t, tol);
+            [0.0, p[1], p[2], 0.0]
+        })
+        .collect();
+    let (label, centres) = cluster(&points, 0.0);
+    let mut best: Option<Candidate> = None;
+    for c in 0..centres.len() {
+        let group: Vec<usize> = ks
+            .iter()
+            .zip(&label)
+            .filter(|(_, l)| **l == c)
+            .map(|(k, _)| *k)
+            .collect();
+        if group.len() < 3 {
+            continue;
+        }
+        let mut out_of: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+        for &k in &group {
+            out_of.entry(edges[k].from).or_default().push(k);
+        }
+        // Steps between consecutive edges.
+        let mut links: Vec<(usize, usize)> = Vec::new();
+        let mut deltas: Vec<Point> = Vec::new();
+        for &k in &group {
+            for &f in out_of.get(&edges[k].to).into_iter().flatten() {
+                if edges[f].to == edges[k].from {
+                    continue;
+                }
+                let (a, b) = (&edges[k].t, &edges[f].t);
+                let da = wrap(b.alpha - a.alpha) / tol.angle;
+                let db = wrap(b.beta - a.beta) / tol.angle;
+                links.push((k, f));
+                deltas.push([da, 0.0, 0.0, db]);
+            }
+        }
+        if links.len() < 2 {
+            continue;
+        }
+        let (dl, dc) = cluster(&deltas, 0.0);
+        let mut sizes = vec![0usize; dc.len()];
+        for l in &dl {
+            sizes[*l] += 1;
+        }
+        // The most common step that actually turns.
+        let Some(top) = (0..dc.len())
+            .filter(|&i| dc[i][0].abs() > 1.5 || dc[i][3].abs() > 1.5)
+            .max_by(|&x, &y| sizes[x].cmp(&sizes[y]).then(y.cmp(&x)))
+        else {
+            continue;
+        };
+        if sizes[top] < 2 {
+            continue;
+        }
+        let mut next: BTreeMap<usize, usize> = BTreeMap::new();
+        let mut has_prev: HashSet<usize> = HashSet::new();
+        let mut used_nodes: HashSet<usize> = HashSet::new();
+        for (i, &(k, f)) in links.iter().enumerate() {
+            if dl[i] != top || next.contains_key(&k) || has_prev.contains(&f) {
+                continue;
+            }
+            next.insert(k, f);
+            has_prev.insert(f);
+        }
+        // Edge chains to instance chains, node-disjoint.
+        let mut chains: Vec<(Vec<usize>, Vec<Tr>)> = Vec::new();
+        let starts: Vec<usize> = next
+            .keys()
+            .copied()
+            .filter(|k| !has_prev.contains(k))
+            .collect();
+        for s in starts {
+            let mut nodes = vec![edges[s].from];
+            let mut ts = Vec::new();
+            let mut k = s;
+            let mut seen = HashSet::new();
+            loop {
+                let e = &edges[k];
+                if used_nodes.contains(&e.to) || !seen.insert(k) || nodes.contains(&e.to) {
+                    break;
+                }
+                nodes.push(e.to);
+                ts.push(e.t);
+                match next.get(&k) {
+                    Some(&f) => k = f,
+                    None => break,
+                }
+            }
+            if ts.len() >= 2 && !used_nodes.contains(&nodes[0]) {
+                used_nodes.extend(nodes.iter().copied());
+                chains.push((nodes, ts));
+            }
+        }
+        if chains.is_empty() {
+            continue;
+        }
+        // One rule for chains that share t0: the longest one's.
+        chains.sort_by_key(|c| std::cmp::Reverse(c.0.len()));
+        let step = |ts: &[Tr]| {
+            let n = (ts.len() - 1) as f64;
+            Tr {
+                alpha: wrap(ts.last().map_or(0.0, |t| t.alpha) - ts[0].alpha) / n,
+                d: 0.0,
+                s: 0.0,
+                beta: wrap(ts.last().map_or(0.0, |t| t.beta) - ts[0].beta) / n,
+            }
+        };
+        let d0 = step(&chains[0].1);
+        // t(m) = t0 + tΔ·m with m counting down: tΔ = −step, t0 = first − tΔ·M.
+        let t0_of = |ts: &[Tr]| {
+            let m = ts.len() as f64;
+            let avg = mean(ts);
+            Tr {
+                alpha: wrap(ts[0].alpha + d0.alpha * m),
+                d: avg.d,
+                s: avg.s,
+                beta: wrap(ts[0].beta + d0.beta * m),
+            }
+        };
+        let t0 = t0_of(&chains[0].1);
+        let delta = Tr {
+            alpha: -d0.alpha,
+            d: 0.0,
+            s: 0.0,
+            beta: -d0.beta,
+        };
+        let at = |m: usize| Tr {
+            alpha: wrap(t0.alpha + delta.alpha * m as f64),
+            d: t0.d,
+            s: t0.s,
+            beta: wrap(t0.beta + delta.beta * m as f64),
+        };
+        let keep: Vec<Vec<usize>> = chains
+            .into_iter()
+            .filter(|(_, ts)| {
+                let t = t0_of(ts);
+                wrap(t.alpha - t0.alpha).abs() <= tol.angle * 2.0
+                    && wrap(t.beta - t0.beta).abs() <= tol.angle * 2.0
+            })
+            .map(|(n, _)| n)
+            .collect();
+        // Redraw check: the q-th step of a chain of n uses m = n - 1 - q.
+        let mut cut = Vec::new();
+        for chain in keep {
+            let n = chain.len();
+            let pieces = cut_drift(insts, vec![chain], |q, _| at(n - 1 - q), tol);
+            // Only whole chains keep the count right for t(m).
+            if pieces.len() == 1 && pieces[0].len() == n {
+                cut.extend(pieces);
+            }
+        }
+        if let Some(cand) = seq_candidate(insts, edges, cut, t0, Some(delta), 1.0)
+            && best.as_ref().is_none_or(|b| cand.pairs > b.pairs)
+        {
+            best = Some(cand);
+        }
+    }
+    best
+}
+
+/// Complete binary trees whose children come from clusters `x` and `y`.
+fn branching(
+    insts: &[Inst],
+    edges: &[Edge],
+    x: &[usize],
+    y: &[usize],
+    tol: Tolerance,
+) -> Option<Candidate> {
+    let child_map = |g: &[usize]| {
+        let mut m: HashMap<usize, usize> = HashMap::new();
+        let mut sorted = g.to_vec();
+        sorted.sort_unstable();
+        for k in sorted {
+            m.entry(edges[k].from).or_insert(edges[k].to);
+        }
+        m
+    };
+    let (cx, cy) = (child_map(x), child_map(y));
+    let both: Vec<usize> = {
+        let mut v: Vec<usize> = cx.keys().copied().filter(|k| cy.contains_key(k)).collect();
+        v.sort_unstable();
+        v
+    };
+    if both.is_empty() {
+        return None;
+    }
+    // Depth of the complete tree below each node.
+    let mut depth: HashMap<usize, u32> = HashMap::new();
+    fn depth_of(
+        v: usize,
+        cx: &HashMap<usize, usize>,
+        cy: &HashMap<usize, usize>,
+        memo: &mut HashMap<usize, u32>,
+        stack: &mut HashSet<usize>,
+    ) -> u32 {
+        if let Some(&d) = memo.get(&v) {
+            return d;
+        }
+        let d = match (cx.get(&v), cy.get(&v)) {
+            (Some(&a), Some(&b)) if a != b && stack.insert(v) => {
+                let d = 1 + depth_of(a, cx, cy, memo, stack).min(depth_of(b, cx, cy, memo, stack));
+                stack.remove(&v);
+                d
+            }
+            _ => 0,
+        };
+        memo.insert(v, d);
+        d
+    }
+    let mut stack = HashSet::new();
+    for &v in &both {
+        depth_of(v, &cx, &cy, &mut depth, &mut stack);
+    }
+    let mut roots: Vec<(usize, u32)> = both
+        .iter()
+        .map(|&v| (v, depth[&v]))
+        .filter(|&(_, d)| d >= 1)
+        .collect();
+    roots.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    let t = mean(&x.iter().map(|&k| edges[k].t).collect::<Vec<_>>());
+    let u = mean(&y.iter().map(|&k| edges[k].t).collect::<Vec<_>>());
+    let mut claimed: HashSet<usize> = HashSet::new();
+    let mut trees = Vec::new();
+    let mut pairs = 0;
+    let mut gap = 0.0;
+    let gaps: HashMap<(usize, usize), f64> =
+        edges.iter().map(|e| ((e.from, e.to), e.gap)).collect();
+    for (r, d) in roots {
+        // The tree's nodes, level by level, redrawn from the root.
+        let mut nodes = vec![(r, insts[r].frame)];
+        let mut level = vec![(r, insts[r].frame)];
+        let mut ok = !claimed.contains(&r);
+        let mut tree_gap = 0.0;
+        for _ in 0..d {
+            let mut below = Vec::new();
+            for &(v, f) in &level {
+                for (map, tr) in [(&cx, &t), (&cy, &u)] {
+                    let c = map[&v];
+                    let want = tr.apply(&f);
+                    if claimed.contains(&c)
+                        || nodes.iter().any(|n| n.0 == c)
+                        || !close(&want, &insts[c].frame, tr.d * f.scale, insts[c].size(), tol)
+                    {
+                        ok = false;
+                    }
+                    tree_gap += gaps.get(&(v, c)).copied().unwrap_or(1.0);
+                    below.push((c, want));
+                    nodes.push((c, want));
+                }
+            }
+            if !ok {
+                break;
+            }
+            level = below;
+        }
+        if !ok {
+            continue;
+        }
+        claimed.extend(nodes.iter().map(|n| n.0));
+        pairs += nodes.len() - 1;
+        gap += tree_gap;
+        trees.push((r, d));
+    }
+    if trees.is_empty() {
+        return None;
+    }
+    let length = trees.iter().map(|t| t.1 as f64 + 1.0).sum::<f64>() / trees.len() as f64;
+    Some(Candidate {
+        h: 1.0 - gap / pairs as f64,
+        phi: 1.0,
+        length,
+        pairs,
+        plan: Plan::Branch {
+            trees,
+            child: [cx, cy],
+            t,
+            u,
+        },
+    })
+}
+
+/// The most important candidate.
+fn choose(cands: &mut Vec<Candidate>, w: Weights) -> Option<Candidate> {
+    let max_n = cands.iter().map(|c| c.pairs).max()? as f64;
+    let max_l = cands.iter().map(|c| c.length).fold(0.0, f64::max);
+    let score = |c: &Candidate| {
+        w.n * c.pairs as f64 / max_n + w.h * c.h + w.phi * c.phi + w.l * c.length / max_l
+    };
+    let mut best = 0;
+    for i in 1..cands.len() {
+        if score(&cands[i]) > score(&cands[best]) + 1e-12 {
+            best = i;
+        }
+    }
+    Some(cands.swap_remove(best))
+}
+
+fn union_box(insts: &[Inst], ids: impl IntoIterator<Item = usize>) -> (DVec2, DVec2) {
+    ids.into_iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), i| (lo.min(insts[i].min), hi.max(insts[i].max)),
+    )
+}
+
+fn replace(insts: &mut Vec<Inst>, first: usize, members: &[usize], sym: Sym) {
+    let (min, max) = union_box(insts, members.iter().copied());
+    for &i in members {
+        insts[i].alive = false;
+    }
+    let frame = insts[first].frame;
+    insts.push(Inst::new(sym, frame, min, max));
+}
+
+fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan) {
+    let r = g.rules.len();
+    match plan {
+        Plan::Seq { chains, t, delta } => {
+            let a = insts[chains[0][0]].sym;
+            let mut counts = BTreeSet::new();
+            for c in &chains {
+                let m = (c.len() - 1) as u32;
+                counts.insert(m);
+                replace(insts, c[0], c, Sym::Rule(r, m));
+            }
+            g.rules.push(Rule {
+                body: Body::Seq { a, t, delta },
+                counts,
+            });
+        }
+        Plan::Branch { trees, child, t, u } => {
+            let a = insts[trees[0].0].sym;
+            let mut counts = BTreeSet::new();
+            for (root, d) in trees {
+                let mut members = vec![root];
+                let mut level = vec![root];
+                for _ in 0..d {
+                    level = level
+                        .iter()
+                        .flat_map(|v| [child[0][v], child[1][v]])
+                        .collect();
+                    members.extend(level.iter().copied());
+                }
+                counts.insert(d);
+                replace(insts, root, &members, Sym::Rule(r, d));
+            }
+            g.rules.push(Rule {
+                body: Body::Branch { a, t, u },
+                counts,
+            });
+        }
+        Plan::Pair { pairs, t } => {
+            let (a, b) = (insts[pairs[0].0].sym, insts[pairs[0].1].sym);
+            for &(x, y) in &pairs {
+                replace(insts, x, &[x, y], Sym::Rule(r, 0));
+            }
+            g.rules.push(Rule {
+                body: Body::Pair { a, t, b },
+                counts: BTreeSet::from([0]),
+            });
+        }
+    }
+}
+
+/// Nothing repeats: the closest pairs become pair rules, as many at once as
+/// do not share an instance.
+fn pair_up(g: &mut Grammar, insts: &mut Vec<Inst>, edges: &[Edge]) {
+    let mut order: Vec<&Edge> = edges.iter().collect();
+    order.sort_by(|a, b| {
+        a.gap
+            .total_cmp(&b.gap)
+            .then(a.t.d.total_cmp(&b.t.d))
+            .then(a.from.cmp(&b.from))
+            .then(a.to.cmp(&b.to))
+    });
+    let mut taken: HashSet<usize> = HashSet::new();
+    let mut any = false;
+    for e in order {
+        if taken.contains(&e.from) || taken.contains(&e.to) {
+            continue;
+        }
+        // Read left to right: the pair starts at the earlier instance.
+        if e.from > e.to {
+            continue;
+        }
+        taken.insert(e.from);
+        taken.insert(e.to);
+        apply(
+            g,
+            insts,
+            Plan::Pair {
+                pairs: vec![(e.from, e.to)],
+                t: e.t,
+            },
+        );
+        any = true;
+    }
+    if !any && let Some(e) = edges.first() {
+        apply(
+            g,
+            insts,
+            Plan::Pair {
+                pairs: vec![(e.from, e.to)],
+                t: e.t,
+            },
+        );
+    }
+}

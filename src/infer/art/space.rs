@@ -1,0 +1,336 @@
+//! Transformation spaces: the transform between two placed things as a point
+//! (α, d, s, β), nearest neighbours in the plane, and clustering.
+//!
+//! Owns: the paper's transform T = +(α) f(d) *(s) +(β) between two frames
+//! (α the turn from the first frame's heading to the second's origin, d the
+//! distance in the first frame's scale, s the scale ratio, β the remaining
+//! turn), a uniform grid for nearest neighbours (so only nearby pairs are
+//! compared, not all n²), and a clustering that replaces the paper's mean shift:
+//! points are visited densest first and join the nearest cluster centre within
+//! the tolerance box, else start one (one flat-kernel mean-shift step from every
+//! point, found through a hash grid, so it runs in linear time). Must not know
+//! what the points mean for rules.
+
+use super::shape::{Frame, rotate, wrap};
+use glam::DVec2;
+use std::collections::HashMap;
+
+/// A transform from one frame to another, as turtle commands
+/// `+(alpha) f(d) *(s) +(beta)` (angles in radians).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tr {
+    pub alpha: f64,
+    pub d: f64,
+    pub s: f64,
+    pub beta: f64,
+}
+
+/// Below this distance (relative to the first frame's size) two origins
+/// coincide and α is taken as 0.
+const COINCIDE: f64 = 1e-6;
+
+impl Tr {
+    pub const IDENTITY: Tr = Tr {
+        alpha: 0.0,
+        d: 0.0,
+        s: 1.0,
+        beta: 0.0,
+    };
+
+    /// The transform that takes the turtle from frame `a` to frame `b`;
+    /// `size` is a length in `a`'s units under which origins coincide.
+    pub fn between(a: &Frame, b: &Frame, size: f64) -> Tr {
+        let v = b.pos - a.pos;
+        let d = v.length() / a.scale;
+        let s = b.scale / a.scale;
+        let turn = wrap(b.rot - a.rot);
+        if d <= size * COINCIDE {
+            return Tr {
+                alpha: 0.0,
+                d: 0.0,
+                s,
+                beta: turn,
+            };
+        }
+        let heading = (-v.x).atan2(v.y);
+        let alpha = wrap(heading - a.rot);
+        Tr {
+            alpha,
+            d,
+            s,
+            beta: wrap(turn - alpha),
+        }
+    }
+
+    /// The frame reached from `a` by this transform.
+    pub fn apply(&self, a: &Frame) -> Frame {
+        let dir = rotate(DVec2::Y, a.rot + self.alpha);
+        Frame {
+            pos: a.pos + dir * self.d * a.scale,
+            rot: wrap(a.rot + self.alpha + self.beta),
+            scale: a.scale * self.s,
+        }
+    }
+}
+
+/// A uniform grid over points for nearest-neighbour queries.
+pub struct Grid {
+    points: Vec<DVec2>,
+    min: DVec2,
+    cell: f64,
+    cols: i64,
+    rows: i64,
+    cells: HashMap<(i64, i64), Vec<usize>>,
+}
+
+impl Grid {
+    pub fn new(points: &[DVec2]) -> Grid {
+        let (min, max) = points.iter().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let size = if points.is_empty() {
+            DVec2::ONE
+        } else {
+            (max - min).max(DVec2::splat(1e-9))
+        };
+        // About two points per cell, also when the points lie on a line.
+        let n = points.len().max(1) as f64;
+        let cell = (2.0 * size.x * size.y / n)
+            .sqrt()
+            .max(2.0 * size.x.max(size.y) / n)
+            .max(1e-12);
+        let cols = (size.x / cell).floor() as i64 + 1;
+        let rows = (size.y / cell).floor() as i64 + 1;
+        let mut g = Grid {
+            points: points.to_vec(),
+            min: if points.is_empty() { DVec2::ZERO } else { min },
+            cell,
+            cols,
+            rows,
+            cells: HashMap::new(),
+        };
+        for (i, p) in points.iter().enumerate() {
+            let k = g.key(*p);
+            g.cells.entry(k).or_default().push(i);
+        }
+        g
+    }
+
+    fn key(&self, p: DVec2) -> (i64, i64) {
+        let q = (p - self.min) / self.cell;
+        (
+            (q.x.floor() as i64).clamp(0, self.cols - 1),
+            (q.y.floor() as i64).clamp(0, self.rows - 1),
+        )
+    }
+
+    /// The `k` points nearest to `p` (including any at `p` itself), nearest
+    /// first, ties by index.
+    pub fn nearest(&self, p: DVec2, k: usize) -> Vec<usize> {
+        let k = k.min(self.points.len());
+        if k == 0 {
+            return Vec::new();
+        }
+        let (cx, cy) = self.key(p);
+        let mut found: Vec<(f64, usize)> = Vec::new();
+        let mut ring = 0i64;
+        loop {
+            let (x0, x1) = ((cx - ring).max(0), (cx + ring).min(self.cols - 1));
+            let (y0, y1) = ((cy - ring).max(0), (cy + ring).min(self.rows - 1));
+            for x in x0..=x1 {
+                // Only the ring's border: all of a column at its two ends.
+                let border = (x - cx).abs() == ring;
+                let mut y = y0;
+                while y <= y1 {
+                    if border || (y - cy).abs() == ring {
+                        if let Some(c) = self.cells.get(&(x, y)) {
+                            for &i in c {
+                                found.push((self.points[i].distance_squared(p), i));
+                            }
+                        }
+                        y += 1;
+                    } else {
+                        // Jump to the bottom edge of the ring.
+                        y = (cy + ring).max(y + 1);
+                    }
+                }
+            }
+            // Every point within `ring` cells of p's cell has been seen; a
+            // point outside is at least `ring` cells away.
+            if found.len() >= k {
+                found.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                let reach = ring as f64 * self.cell;
+                if found[k - 1].0 <= reach * reach {
+                    break;
+                }
+            }
+            if ring > self.cols.max(self.rows) {
+                found.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                break;
+            }
+            ring += 1;
+        }
+        found.truncate(k);
+        found.into_iter().map(|(_, i)| i).collect()
+    }
+}
+
+/// A point of a transformation space in tolerance units: α/tol, ln d/tol,
+/// ln s/tol, β/tol. Angles wrap with period `turn` (2π over the angle tolerance).
+pub type Point = [f64; 4];
+
+/// The clusters of `points`: a label per point and the centres. `turn` is the
+/// period of the two angle coordinates (0 or less: no wrapping).
+pub fn cluster(points: &[Point], turn: f64) -> (Vec<usize>, Vec<Point>) {
+    let key = |p: &Point| -> [i64; 4] { [0, 1, 2, 3].map(|k| p[k].floor() as i64) };
+    let cells_per_turn = if turn > 0.0 { turn.floor() as i64 } else { 0 };
+    let wrap_key = |mut k: [i64; 4]| {
+        if cells_per_turn > 0 {
+            k[0] = k[0].rem_euclid(cells_per_turn);
+            k[3] = k[3].rem_euclid(cells_per_turn);
+        }
+        k
+    };
+    let diff = |a: f64, b: f64, angle: bool| {
+        let d = a - b;
+        if angle && turn > 0.0 {
+            d - turn * (d / turn).round()
+        } else {
+            d
+        }
+    };
+    let close =
+        |a: &Point, b: &Point| (0..4).all(|k| diff(a[k], b[k], k == 0 || k == 3).abs() <= 1.0);
+    let neighbours = |k: [i64; 4]| {
+        let mut out = Vec::with_capacity(81);
+        for a in -1..=1 {
+            for b in -1..=1 {
+                for c in -1..=1 {
+                    for d in -1..=1 {
+                        out.push(wrap_key([k[0] + a, k[1] + b, k[2] + c, k[3] + d]));
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    };
+    let mut grid: HashMap<[i64; 4], Vec<usize>> = HashMap::new();
+    for (i, p) in points.iter().enumerate() {
+        grid.entry(wrap_key(key(p))).or_default().push(i);
+    }
+    let density: Vec<usize> = points
+        .iter()
+        .map(|p| {
+            neighbours(key(p))
+                .iter()
+                .filter_map(|k| grid.get(k))
+                .flatten()
+                .filter(|&&j| close(p, &points[j]))
+                .count()
+        })
+        .collect();
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&a, &b| density[b].cmp(&density[a]).then(a.cmp(&b)));
+    let mut leaders: HashMap<[i64; 4], Vec<usize>> = HashMap::new();
+    let mut centres: Vec<Point> = Vec::new();
+    let mut label = vec![0; points.len()];
+    for i in order {
+        let p = &points[i];
+        let mut best: Option<(f64, usize)> = None;
+        for k in neighbours(key(p)) {
+            for &c in leaders.get(&k).into_iter().flatten() {
+                if close(p, &centres[c]) {
+                    let d: f64 = (0..4)
+                        .map(|k| diff(p[k], centres[c][k], k == 0 || k == 3).powi(2))
+                        .sum();
+                    if best.is_none_or(|(bd, bc)| d < bd || (d == bd && c < bc)) {
+                        best = Some((d, c));
+                    }
+                }
+            }
+        }
+        match best {
+            Some((_, c)) => label[i] = c,
+            None => {
+                label[i] = centres.len();
+                leaders
+                    .entry(wrap_key(key(p)))
+                    .or_default()
+                    .push(centres.len());
+                centres.push(*p);
+            }
+        }
+    }
+    // Centres as the means of their members (angles relative to the leader).
+    let mut sums = vec![([0.0; 4], 0usize); centres.len()];
+    for (i, p) in points.iter().enumerate() {
+        let c = label[i];
+        for k in 0..4 {
+            sums[c].0[k] += diff(p[k], centres[c][k], k == 0 || k == 3);
+        }
+        sums[c].1 += 1;
+    }
+    for (c, (s, n)) in sums.iter().enumerate() {
+        for k in 0..4 {
+            centres[c][k] += s[k] / *n as f64;
+        }
+    }
+    (label, centres)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transforms_compose_back() {
+        let a = Frame {
+            pos: DVec2::new(3.0, 4.0),
+            rot: 0.3,
+            scale: 2.0,
+        };
+        let b = Frame {
+            pos: DVec2::new(-5.0, 9.0),
+            rot: -1.2,
+            scale: 0.5,
+        };
+        let t = Tr::between(&a, &b, 1.0);
+        let c = t.apply(&a);
+        assert!(c.pos.distance(b.pos) < 1e-9, "{c:?}");
+        assert!(wrap(c.rot - b.rot).abs() < 1e-12);
+        assert!((c.scale - b.scale).abs() < 1e-12);
+        assert!((t.s - 0.25).abs() < 1e-12);
+    }
+
+    #[test]
+    fn nearest_points_in_order() {
+        let pts: Vec<DVec2> = (0..100)
+            .map(|i| DVec2::new((i % 10) as f64, (i / 10) as f64 * 1.5))
+            .collect();
+        let g = Grid::new(&pts);
+        let n = g.nearest(DVec2::new(4.1, 3.0), 3);
+        assert_eq!(n, vec![24, 25, 23]);
+        assert_eq!(g.nearest(DVec2::new(100.0, 100.0), 1), vec![99]);
+    }
+
+    #[test]
+    fn clusters_wrap_around_the_turn() {
+        let turn = 360.0;
+        let pts = vec![
+            [179.6, 0.0, 0.0, 0.0],
+            [-179.8 + 360.0, 0.0, 0.0, 0.0],
+            [0.2 - 0.5, 0.1, 0.0, 0.0],
+            [10.0, 0.0, 0.0, 0.0],
+            [359.9, 0.0, 0.0, 0.3],
+        ];
+        let (label, centres) = cluster(&pts, turn);
+        assert_eq!(label[0], label[1]);
+        assert_eq!(label[2], label[4]);
+        assert_ne!(label[0], label[2]);
+        assert_ne!(label[3], label[0]);
+        assert_eq!(centres.len(), 3);
+    }
+}
