@@ -8,6 +8,7 @@
 //! and geometry helpers. Must not parse or print programs.
 
 pub mod geometry;
+pub mod index;
 pub mod scene;
 
 pub use scene::{Outcome, Scene, build, run};

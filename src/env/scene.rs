@@ -4,6 +4,7 @@
 //! edges into messages that seed the end guide's system.
 
 use super::geometry::{closest_on_segment, crossing, inside, ray_hit, signed_angle};
+use super::index::Grid;
 use crate::ast::{File, GuideStmt, Item, LinkStmt, SceneStmt};
 use crate::check::Checked;
 use crate::compile::{self, ExprCompiler, Program};
@@ -13,6 +14,7 @@ use crate::query::QUERIES;
 use crate::run::runtime_diagnostic;
 use crate::turtle::{self, Sink, State};
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// The most derivation steps a scene runs, whatever its systems say.
@@ -273,58 +275,94 @@ fn answer(scene: &mut Scene, out: &mut Outcome, seed: u64) -> Result<(), Diagnos
 }
 
 /// Answers the queries of instances `from..` (all instances' geometry counts).
+/// Instances are interpreted and answered in parallel; answers and messages
+/// are gathered in instance order, so the thread count changes nothing.
 fn answer_from(
     scene: &mut Scene,
     out: &mut Outcome,
     seed: u64,
     from: usize,
 ) -> Result<(), Diagnostic> {
-    let mut probes = Vec::with_capacity(out.instances.len());
-    for inst in &out.instances {
-        let prog = &scene.programs[scene.guides[inst.guide].program];
-        let mut probe = Probe::default();
-        turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut probe)
-            .map_err(|e| runtime_diagnostic(&e, prog))?;
-        probes.push(probe);
-    }
+    let sc: &Scene = scene;
+    let probes: Vec<Result<Probe, Diagnostic>> = out
+        .instances
+        .par_iter()
+        .map(|inst| {
+            let prog = &sc.programs[sc.guides[inst.guide].program];
+            let mut probe = Probe::default();
+            turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut probe)
+                .map_err(|e| runtime_diagnostic(&e, prog))?;
+            Ok(probe)
+        })
+        .collect();
+    let probes = probes.into_iter().collect::<Result<Vec<_>, _>>()?;
     // Everything drawn in each guide, for element queries and collisions.
-    let mut drawn: Vec<Vec<(DVec2, DVec2)>> = vec![Vec::new(); scene.guides.len()];
+    let mut drawn: Vec<Vec<(DVec2, DVec2)>> = vec![Vec::new(); sc.guides.len()];
     for (inst, probe) in out.instances.iter().zip(&probes) {
         drawn[inst.guide].extend_from_slice(&probe.segments);
     }
-    let mut spawned = Vec::new();
+    // A spatial index per guide that has questions about its drawing; it also
+    // covers the asking points.
+    let mut asked: Vec<Vec<DVec2>> = vec![Vec::new(); sc.guides.len()];
     for (k, probe) in probes.iter().enumerate().skip(from) {
-        if probe.queries.is_empty() {
-            continue;
-        }
         let gi = out.instances[k].guide;
-        let prog = &scene.programs[scene.guides[gi].program];
-        let offsets = param_offsets(prog, &out.instances[k].string);
-        for &(module, kind, state) in &probe.queries {
-            out.queries += 1;
-            let q = &QUERIES[kind as usize];
-            let at = offsets[module] as usize;
-            let arity = prog.symbols.arity(out.instances[k].string.syms[module]);
-            let own = &mut out.instances[k].string.params[at..at + arity];
-            let answers = match q.name {
-                "?X" => {
-                    let delta = own.get(q.outputs.len()).copied().unwrap_or(0.0);
-                    // A message passes all of ?X's pass-through parameters, Δ first.
-                    let pass: Vec<f64> = own
-                        .get(q.outputs.len()..)
-                        .map_or(Vec::new(), <[f64]>::to_vec);
-                    let (ans, msg) = collide(scene, &drawn[gi], gi, &state, delta);
-                    if let Some((link, point)) = msg {
-                        spawned.push((link, point, pass));
-                    }
-                    ans
-                }
-                name => query(scene, &drawn[gi], gi, name, &state),
-            };
-            for (slot, v) in own.iter_mut().zip(answers) {
-                *slot = v;
+        for (_, kind, st) in &probe.queries {
+            if matches!(QUERIES[*kind as usize].name, "?X" | "?D_A" | "?N_A") {
+                asked[gi].push(st.pos.truncate());
             }
         }
+    }
+    let grids: Vec<Option<Grid>> = drawn
+        .par_iter()
+        .zip(asked.par_iter())
+        .map(|(d, a)| (!a.is_empty()).then(|| Grid::new(d, a)))
+        .collect();
+    type Answered = (Vec<(usize, usize, Answer)>, Vec<(usize, DVec2, Vec<f64>)>);
+    let answered: Vec<Answered> = out.instances[from..]
+        .par_iter()
+        .zip(probes[from..].par_iter())
+        .map(|(inst, probe)| {
+            let gi = inst.guide;
+            let prog = &sc.programs[sc.guides[gi].program];
+            let offsets = param_offsets(prog, &inst.string);
+            let mut answers = Vec::with_capacity(probe.queries.len());
+            let mut spawned = Vec::new();
+            for &(module, kind, state) in &probe.queries {
+                let q = &QUERIES[kind as usize];
+                let at = offsets[module] as usize;
+                let arity = prog.symbols.arity(inst.string.syms[module]);
+                let own = &inst.string.params[at..at + arity];
+                let grid = grids[gi].as_ref();
+                let ans = match q.name {
+                    "?X" => {
+                        let delta = own.get(q.outputs.len()).copied().unwrap_or(0.0);
+                        let (ans, msg) = collide(sc, grid, gi, &state, delta);
+                        if let Some((link, point)) = msg {
+                            // A message passes all of ?X's pass-through parameters, Δ first.
+                            let pass = own
+                                .get(q.outputs.len()..)
+                                .map_or(Vec::new(), <[f64]>::to_vec);
+                            spawned.push((link, point, pass));
+                        }
+                        ans
+                    }
+                    name => query(sc, grid, gi, name, &state),
+                };
+                answers.push((at, arity, ans));
+            }
+            (answers, spawned)
+        })
+        .collect();
+    let mut spawned = Vec::new();
+    for (inst, (answers, sp)) in out.instances[from..].iter_mut().zip(answered) {
+        for (at, arity, ans) in answers {
+            out.queries += 1;
+            let own = &mut inst.string.params[at..at + arity];
+            for (slot, v) in own.iter_mut().zip(ans.values()) {
+                *slot = *v;
+            }
+        }
+        spawned.extend(sp);
     }
     for (link, point, pass) in spawned {
         let l = &mut scene.links[link];
@@ -362,21 +400,35 @@ fn param_offsets(prog: &Program, s: &ModString) -> Vec<u32> {
     off
 }
 
+/// The outputs of one query module (at most four numbers).
+#[derive(Clone, Copy)]
+struct Answer {
+    values: [f64; 4],
+    len: usize,
+}
+
+impl Answer {
+    fn new(v: &[f64]) -> Answer {
+        let mut values = [0.0; 4];
+        values[..v.len()].copy_from_slice(v);
+        Answer {
+            values,
+            len: v.len(),
+        }
+    }
+
+    fn values(&self) -> &[f64] {
+        &self.values[..self.len]
+    }
+}
+
 fn found(b: bool) -> f64 {
     f64::from(u8::from(b))
 }
 
-/// Segments not touching `p` (a turtle's own last segment touches it).
-fn others(drawn: &[(DVec2, DVec2)], p: DVec2) -> impl Iterator<Item = (usize, &(DVec2, DVec2))> {
-    let eps = 1e-9;
-    drawn
-        .iter()
-        .enumerate()
-        .filter(move |(_, (a, b))| (*a - p).length() > eps && (*b - p).length() > eps)
-}
-
-/// Answers ?P ?H ?D_* ?N_* for a turtle in guide `gi`.
-fn query(scene: &Scene, drawn: &[(DVec2, DVec2)], gi: usize, name: &str, st: &State) -> Vec<f64> {
+/// Answers ?P ?H ?D_* ?N_* for a turtle in guide `gi`; `grid` indexes what is
+/// drawn in the guide (None when nothing asks about it).
+fn query(scene: &Scene, grid: Option<&Grid>, gi: usize, name: &str, st: &State) -> Answer {
     let p = st.pos.truncate();
     let h = st.h.truncate();
     let dir = if h.length_squared() > 0.0 {
@@ -385,20 +437,27 @@ fn query(scene: &Scene, drawn: &[(DVec2, DVec2)], gi: usize, name: &str, st: &St
         DVec2::Y
     };
     let poly = &scene.guides[gi].polygon;
-    let link_edges: Vec<(usize, DVec2, DVec2)> = scene
-        .links
-        .iter()
-        .enumerate()
-        .filter(|(_, l)| l.from.0 == gi)
-        .map(|(i, l)| {
-            let e = l.from.1 % poly.len().max(1);
-            (i, poly[e], poly[(e + 1) % poly.len()])
-        })
-        .collect();
-    let guide_edges: Vec<(usize, DVec2, DVec2)> = edges(poly).collect();
-    let element_edges: Vec<(usize, DVec2, DVec2)> =
-        others(drawn, p).map(|(i, &(a, b))| (i, a, b)).collect();
-    let nearest = |set: &[(usize, DVec2, DVec2)]| -> Vec<f64> {
+    let link_edges = || -> Vec<(usize, DVec2, DVec2)> {
+        scene
+            .links
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.from.0 == gi)
+            .map(|(i, l)| {
+                let e = l.from.1 % poly.len().max(1);
+                (i, poly[e], poly[(e + 1) % poly.len()])
+            })
+            .collect()
+    };
+    let closest = |d: f64, c: DVec2, id: usize| -> Answer {
+        let beta = if d > 0.0 {
+            signed_angle(dir, c - p)
+        } else {
+            0.0
+        };
+        Answer::new(&[1.0, d, beta, id as f64])
+    };
+    let nearest = |set: &[(usize, DVec2, DVec2)]| -> Answer {
         let best = set
             .iter()
             .map(|&(id, a, b)| {
@@ -407,45 +466,47 @@ fn query(scene: &Scene, drawn: &[(DVec2, DVec2)], gi: usize, name: &str, st: &St
             })
             .min_by(|x, y| x.0.total_cmp(&y.0));
         match best {
-            Some((d, c, id)) => {
-                let beta = if d > 0.0 {
-                    signed_angle(dir, c - p)
-                } else {
-                    0.0
-                };
-                vec![1.0, d, beta, id as f64]
-            }
-            None => vec![0.0, 0.0, 0.0, 0.0],
+            Some((d, c, id)) => closest(d, c, id),
+            None => Answer::new(&[0.0; 4]),
         }
     };
-    let ahead = |set: &[(usize, DVec2, DVec2)]| -> Vec<f64> {
-        let best = set
-            .iter()
+    let first_ahead = |set: &[(usize, DVec2, DVec2)]| -> Option<(f64, usize)> {
+        set.iter()
             .filter_map(|&(id, a, b)| ray_hit(p, dir, a, b).map(|t| (t, id)))
-            .min_by(|x, y| x.0.total_cmp(&y.0));
+            .min_by(|x, y| x.0.total_cmp(&y.0))
+    };
+    let ahead = |best: Option<(f64, usize)>| -> Answer {
         match best {
-            Some((t, id)) => vec![1.0, t, id as f64],
-            None => vec![0.0, 0.0, 0.0],
+            Some((t, id)) => Answer::new(&[1.0, t, id as f64]),
+            None => Answer::new(&[0.0; 3]),
         }
     };
+    let guide_edges = || -> Vec<(usize, DVec2, DVec2)> { edges(poly).collect() };
     match name {
-        "?P" => vec![st.pos.x, st.pos.y, st.pos.z],
-        "?H" => vec![st.h.x, st.h.y, st.h.z],
-        "?D_L" => nearest(&link_edges),
-        "?D_G" => nearest(&guide_edges),
-        "?D_A" => nearest(&element_edges),
-        "?N_L" => ahead(&link_edges),
-        "?N_G" => ahead(&guide_edges),
+        "?P" => Answer::new(&[st.pos.x, st.pos.y, st.pos.z]),
+        "?H" => Answer::new(&[st.h.x, st.h.y, st.h.z]),
+        "?D_L" => nearest(&link_edges()),
+        "?D_G" => nearest(&guide_edges()),
+        "?D_A" => match grid.and_then(|g| g.nearest(p)) {
+            Some((d, c, i)) => closest(d, c, i),
+            None => Answer::new(&[0.0; 4]),
+        },
+        "?N_L" => ahead(first_ahead(&link_edges())),
+        "?N_G" => ahead(first_ahead(&guide_edges())),
         "?N_A" => {
-            let mut all = guide_edges.clone();
-            all.extend(
-                element_edges
-                    .iter()
-                    .map(|&(i, a, b)| (poly.len() + i, a, b)),
-            );
-            ahead(&all)
+            // Guide edges come first (ids 0..n), so they win ties.
+            let edge = first_ahead(&guide_edges());
+            let limit = edge.map_or(f64::INFINITY, |e| e.0);
+            let element = grid
+                .and_then(|g| g.ray(p, dir, limit))
+                .map(|(t, i)| (t, poly.len() + i));
+            ahead(match (edge, element) {
+                (Some(e), Some(x)) if x.0.total_cmp(&e.0).is_lt() => Some(x),
+                (Some(e), _) => Some(e),
+                (None, x) => x,
+            })
         }
-        _ => vec![found(false)],
+        _ => Answer::new(&[found(false)]),
     }
 }
 
@@ -454,11 +515,11 @@ fn query(scene: &Scene, drawn: &[(DVec2, DVec2)], gi: usize, name: &str, st: &St
 /// and the crossing point.
 fn collide(
     scene: &Scene,
-    drawn: &[(DVec2, DVec2)],
+    grid: Option<&Grid>,
     gi: usize,
     st: &State,
     delta: f64,
-) -> (Vec<f64>, Option<(usize, DVec2)>) {
+) -> (Answer, Option<(usize, DVec2)>) {
     let p = st.pos.truncate();
     let q = (st.pos + st.h * delta * st.scale).truncate();
     let poly = &scene.guides[gi].polygon;
@@ -477,14 +538,12 @@ fn collide(
             .links
             .iter()
             .position(|l| l.from == (gi, edge) && l.used < l.tokens);
-        return (vec![1.0, edge as f64], link.map(|l| (l, point)));
+        return (Answer::new(&[1.0, edge as f64]), link.map(|l| (l, point)));
     }
-    for (i, &(a, b)) in others(drawn, p) {
-        if crossing(p, q, a, b).is_some_and(|t| t > 1e-6) {
-            return (vec![1.0, (poly.len() + i) as f64], None);
-        }
+    if let Some(i) = grid.and_then(|g| g.first_crossing(p, q)) {
+        return (Answer::new(&[1.0, (poly.len() + i) as f64]), None);
     }
-    (vec![0.0, 0.0], None)
+    (Answer::new(&[0.0, 0.0]), None)
 }
 
 /// Forwards to `inner` only what lies inside the guide by the centre rule: a
