@@ -3,10 +3,13 @@
 //! answers to query modules.
 //!
 //! Owns: building a runnable scene from a checked file (`scene::build`), the
-//! derive–interpret–answer loop of Měch & Prusinkiewicz (1996) over all active
-//! L-systems (`scene::run`), the centre rule that clips each guide's drawing,
-//! and geometry helpers. Must not parse or print programs.
+//! answers to queries and the centre rule that clips each guide's drawing
+//! (`scene`), the derive–interpret–answer loop of Měch & Prusinkiewicz (1996)
+//! over all active L-systems with token states, messages and incremental reruns
+//! (`engine`, run through `scene::run`), the spatial index of drawn segments
+//! (`index`), and geometry helpers. Must not parse or print programs.
 
+pub mod engine;
 pub mod geometry;
 pub mod index;
 pub mod scene;

@@ -1,20 +1,18 @@
-//! A scene at run time: guides with their compiled systems, links with tokens,
-//! and the loop that derives every active L-system, interprets it, answers its
-//! query modules from the guide's geometry, and turns `?X` crossings of linked
-//! edges into messages that seed the end guide's system.
+//! A scene: guides with their compiled systems and links with tokens, built
+//! from a checked file; the answers to query modules from a guide's geometry
+//! (`query`, `collide`); and the centre rule (`Clip`). The loop that runs the
+//! systems is in `engine`.
 
+use super::engine::{self, Cache, Config, GuideRun, Token};
 use super::geometry::{closest_on_segment, crossing, inside, ray_hit, signed_angle};
 use super::index::Grid;
 use crate::ast::{File, GuideStmt, Item, LinkStmt, SceneStmt};
 use crate::check::Checked;
 use crate::compile::{self, ExprCompiler, Program};
-use crate::derive::{self, Limits, ModString};
+use crate::derive::{Limits, ModString};
 use crate::diagnostic::{Code, Diagnostic};
-use crate::query::QUERIES;
-use crate::run::runtime_diagnostic;
-use crate::turtle::{self, Sink, State};
+use crate::turtle::{Sink, State};
 use glam::{DVec2, DVec3};
-use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// The most derivation steps a scene runs, whatever its systems say.
@@ -52,6 +50,7 @@ pub struct Scene {
 }
 
 /// One running L-system: a seed in a guide and its string.
+#[derive(Clone)]
 pub struct Instance {
     pub guide: usize,
     pub start: State,
@@ -65,6 +64,9 @@ pub struct Outcome {
     pub steps: u32,
     pub queries: u64,
     pub messages: u64,
+    /// Per guide: its messages, token events and counts (its systems are in
+    /// `instances`, not repeated here).
+    pub guides: Vec<GuideRun>,
 }
 
 fn value(e: &crate::ast::Expr, checked: &Checked) -> f64 {
@@ -185,9 +187,9 @@ pub fn seed_state(at: DVec2, deg: f64) -> State {
 
 /// Collects one instance's segments and query requests.
 #[derive(Default)]
-struct Probe {
-    segments: Vec<(DVec2, DVec2)>,
-    queries: Vec<(usize, u8, State)>,
+pub(crate) struct Probe {
+    pub(crate) segments: Vec<(DVec2, DVec2)>,
+    pub(crate) queries: Vec<(usize, u8, State)>,
 }
 
 impl Sink for Probe {
@@ -209,200 +211,43 @@ fn edges(poly: &[DVec2]) -> impl Iterator<Item = (usize, DVec2, DVec2)> + '_ {
     (0..poly.len()).map(move |i| (i, poly[i], poly[(i + 1) % poly.len()]))
 }
 
-/// Runs a scene to the end: until no system is still deriving.
+/// Runs a scene to the end: until no system is still deriving (see
+/// `engine` for the order of events). The links' `used` counts are filled in.
 pub fn run(
     scene: &mut Scene,
     seed: u64,
     limits: Limits,
     max_steps: Option<u32>,
 ) -> Result<Outcome, Diagnostic> {
-    let mut instances = Vec::new();
-    for (gi, g) in scene.guides.iter().enumerate() {
-        let prog = &scene.programs[g.program];
-        for s in &g.seeds {
-            let string =
-                derive::axiom(prog, &s.args, seed).map_err(|e| runtime_diagnostic(&e, prog))?;
-            instances.push(Instance {
-                guide: gi,
-                start: seed_state(s.at, s.heading),
-                string,
-                steps: 0,
-            });
-        }
-    }
-    let mut out = Outcome {
-        instances,
-        steps: 0,
-        queries: 0,
-        messages: 0,
+    let cfg = Config {
+        seed,
+        limits,
+        cap: max_steps.unwrap_or(MAX_SCENE_STEPS).min(MAX_SCENE_STEPS),
     };
-    answer(scene, &mut out, seed)?;
-    let cap = max_steps.unwrap_or(MAX_SCENE_STEPS).min(MAX_SCENE_STEPS);
-    for step in 1..=cap {
-        let mut any = false;
-        for inst in out.instances.iter_mut() {
-            let prog = &scene.programs[scene.guides[inst.guide].program];
-            if inst.steps >= prog.derive {
-                continue;
-            }
-            inst.steps += 1;
-            any = true;
-            inst.string = derive::step(prog, &inst.string, inst.steps, seed, limits)
-                .map_err(|e| runtime_diagnostic(&e, prog))?;
-        }
-        if !any {
-            break;
-        }
-        out.steps = step;
-        answer(scene, &mut out, seed)?;
-    }
+    let (out, _) = engine::execute(scene, cfg, &[], &mut Cache::default())?;
+    out.count_used(&mut scene.links);
     Ok(out)
 }
 
-/// Interprets every instance and writes the environment's answers into its
-/// query modules; crossings of linked edges with free tokens send messages.
-/// A system seeded by a message has its queries answered before it derives.
-fn answer(scene: &mut Scene, out: &mut Outcome, seed: u64) -> Result<(), Diagnostic> {
-    let mut from = 0;
-    loop {
-        let before = out.instances.len();
-        answer_from(scene, out, seed, from)?;
-        if out.instances.len() == before {
-            return Ok(());
+impl Outcome {
+    /// Writes into each link how many of its tokens were used.
+    pub fn count_used(&self, links: &mut [Link]) {
+        for l in links.iter_mut() {
+            l.used = 0;
         }
-        from = before;
-    }
-}
-
-/// Answers the queries of instances `from..` (all instances' geometry counts).
-/// Instances are interpreted and answered in parallel; answers and messages
-/// are gathered in instance order, so the thread count changes nothing.
-fn answer_from(
-    scene: &mut Scene,
-    out: &mut Outcome,
-    seed: u64,
-    from: usize,
-) -> Result<(), Diagnostic> {
-    let sc: &Scene = scene;
-    let probes: Vec<Result<Probe, Diagnostic>> = out
-        .instances
-        .par_iter()
-        .map(|inst| {
-            let prog = &sc.programs[sc.guides[inst.guide].program];
-            let mut probe = Probe::default();
-            turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut probe)
-                .map_err(|e| runtime_diagnostic(&e, prog))?;
-            Ok(probe)
-        })
-        .collect();
-    let probes = probes.into_iter().collect::<Result<Vec<_>, _>>()?;
-    // Everything drawn in each guide, for element queries and collisions.
-    let mut drawn: Vec<Vec<(DVec2, DVec2)>> = vec![Vec::new(); sc.guides.len()];
-    for (inst, probe) in out.instances.iter().zip(&probes) {
-        drawn[inst.guide].extend_from_slice(&probe.segments);
-    }
-    // A spatial index per guide that has questions about its drawing; it also
-    // covers the asking points.
-    let mut asked: Vec<Vec<DVec2>> = vec![Vec::new(); sc.guides.len()];
-    for (k, probe) in probes.iter().enumerate().skip(from) {
-        let gi = out.instances[k].guide;
-        for (_, kind, st) in &probe.queries {
-            if matches!(QUERIES[*kind as usize].name, "?X" | "?D_A" | "?N_A") {
-                asked[gi].push(st.pos.truncate());
+        for e in self.guides.iter().flat_map(|g| &g.tokens) {
+            if e.token == Token::Used
+                && let Some(l) = links.get_mut(e.link)
+            {
+                l.used += 1;
             }
         }
     }
-    let grids: Vec<Option<Grid>> = drawn
-        .par_iter()
-        .zip(asked.par_iter())
-        .map(|(d, a)| (!a.is_empty()).then(|| Grid::new(d, a)))
-        .collect();
-    type Answered = (Vec<(usize, usize, Answer)>, Vec<(usize, DVec2, Vec<f64>)>);
-    let answered: Vec<Answered> = out.instances[from..]
-        .par_iter()
-        .zip(probes[from..].par_iter())
-        .map(|(inst, probe)| {
-            let gi = inst.guide;
-            let prog = &sc.programs[sc.guides[gi].program];
-            let offsets = param_offsets(prog, &inst.string);
-            let mut answers = Vec::with_capacity(probe.queries.len());
-            let mut spawned = Vec::new();
-            for &(module, kind, state) in &probe.queries {
-                let q = &QUERIES[kind as usize];
-                let at = offsets[module] as usize;
-                let arity = prog.symbols.arity(inst.string.syms[module]);
-                let own = &inst.string.params[at..at + arity];
-                let grid = grids[gi].as_ref();
-                let ans = match q.name {
-                    "?X" => {
-                        let delta = own.get(q.outputs.len()).copied().unwrap_or(0.0);
-                        let (ans, msg) = collide(sc, grid, gi, &state, delta);
-                        if let Some((link, point)) = msg {
-                            // A message passes all of ?X's pass-through parameters, Δ first.
-                            let pass = own
-                                .get(q.outputs.len()..)
-                                .map_or(Vec::new(), <[f64]>::to_vec);
-                            spawned.push((link, point, pass));
-                        }
-                        ans
-                    }
-                    name => query(sc, grid, gi, name, &state),
-                };
-                answers.push((at, arity, ans));
-            }
-            (answers, spawned)
-        })
-        .collect();
-    let mut spawned = Vec::new();
-    for (inst, (answers, sp)) in out.instances[from..].iter_mut().zip(answered) {
-        for (at, arity, ans) in answers {
-            out.queries += 1;
-            let own = &mut inst.string.params[at..at + arity];
-            for (slot, v) in own.iter_mut().zip(ans.values()) {
-                *slot = *v;
-            }
-        }
-        spawned.extend(sp);
-    }
-    for (link, point, pass) in spawned {
-        let l = &mut scene.links[link];
-        if l.used >= l.tokens {
-            continue;
-        }
-        l.used += 1;
-        let (tg, te) = l.to;
-        let heading = l.heading;
-        let poly = &scene.guides[tg].polygon;
-        let (a, b) = (poly[te % poly.len()], poly[(te + 1) % poly.len()]);
-        let at = closest_on_segment(point, a, b);
-        let prog = &scene.programs[scene.guides[tg].program];
-        let mut args = pass;
-        args.resize(prog.params.len(), 0.0);
-        let string = derive::axiom(prog, &args, seed).map_err(|e| runtime_diagnostic(&e, prog))?;
-        out.messages += 1;
-        out.instances.push(Instance {
-            guide: tg,
-            start: seed_state(at, heading),
-            string,
-            steps: 0,
-        });
-    }
-    Ok(())
-}
-
-fn param_offsets(prog: &Program, s: &ModString) -> Vec<u32> {
-    let mut off = Vec::with_capacity(s.len());
-    let mut p = 0u32;
-    for &x in &s.syms {
-        off.push(p);
-        p += prog.symbols.arity(x) as u32;
-    }
-    off
 }
 
 /// The outputs of one query module (at most four numbers).
 #[derive(Clone, Copy)]
-struct Answer {
+pub(crate) struct Answer {
     values: [f64; 4],
     len: usize,
 }
@@ -417,7 +262,7 @@ impl Answer {
         }
     }
 
-    fn values(&self) -> &[f64] {
+    pub(crate) fn values(&self) -> &[f64] {
         &self.values[..self.len]
     }
 }
@@ -428,7 +273,13 @@ fn found(b: bool) -> f64 {
 
 /// Answers ?P ?H ?D_* ?N_* for a turtle in guide `gi`; `grid` indexes what is
 /// drawn in the guide (None when nothing asks about it).
-fn query(scene: &Scene, grid: Option<&Grid>, gi: usize, name: &str, st: &State) -> Answer {
+pub(crate) fn query(
+    scene: &Scene,
+    grid: Option<&Grid>,
+    gi: usize,
+    name: &str,
+    st: &State,
+) -> Answer {
     let p = st.pos.truncate();
     let h = st.h.truncate();
     let dir = if h.length_squared() > 0.0 {
@@ -511,15 +362,15 @@ fn query(scene: &Scene, grid: Option<&Grid>, gi: usize, name: &str, st: &State) 
 }
 
 /// ?X: does the next element of length `delta` leave the guide or hit an
-/// element? Returns the answer (found, id) and, for a linked edge, the link
-/// and the crossing point.
-fn collide(
+/// element? Returns the answer (found, id) and the guide edge it would cross
+/// (where a link may hold a token to reserve).
+pub(crate) fn collide(
     scene: &Scene,
     grid: Option<&Grid>,
     gi: usize,
     st: &State,
     delta: f64,
-) -> (Answer, Option<(usize, DVec2)>) {
+) -> (Answer, Option<usize>) {
     let p = st.pos.truncate();
     let q = (st.pos + st.h * delta * st.scale).truncate();
     let poly = &scene.guides[gi].polygon;
@@ -532,13 +383,8 @@ fn collide(
             best = Some((t, i));
         }
     }
-    if let Some((t, edge)) = best {
-        let point = p + (q - p) * t;
-        let link = scene
-            .links
-            .iter()
-            .position(|l| l.from == (gi, edge) && l.used < l.tokens);
-        return (Answer::new(&[1.0, edge as f64]), link.map(|l| (l, point)));
+    if let Some((_, edge)) = best {
+        return (Answer::new(&[1.0, edge as f64]), Some(edge));
     }
     if let Some(i) = grid.and_then(|g| g.first_crossing(p, q)) {
         return (Answer::new(&[1.0, (poly.len() + i) as f64]), None);

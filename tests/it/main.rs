@@ -4,6 +4,7 @@ mod cli;
 mod corpus;
 mod diagnostics;
 mod edit;
+mod guided;
 mod run;
 mod scene;
 mod sketch;

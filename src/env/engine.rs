@@ -1,0 +1,810 @@
+//! Running a scene: the Open L-system loop over every seeded system, tokens
+//! that are reserved, used or released, messages, and the incremental rerun.
+//!
+//! Owns: grouping guides into *units* (guides that reach each other through
+//! links with tokens; a unit runs as one), running units in link order so that
+//! every unit knows the messages it receives, the derive → interpret → answer
+//! loop of one unit, the token states of Guided Procedural Modeling §3.3.2,
+//! and the cache of unit results keyed on everything a unit reads (its
+//! guides' polygons, programs, seeds and links, and its incoming messages),
+//! so that `Runner::run` after an edit recomputes only the changed guides and
+//! those downstream of them whose incoming messages changed.
+//!
+//! One step of a unit, for step t ≥ 1:
+//! 1. every system with steps left derives once;
+//! 2. systems are interpreted, and each reservation made at step t − 1 is
+//!    settled: if the reserving system now draws a segment from where its `?X`
+//!    stood across the linked edge, the token is *used* and a message sent;
+//!    otherwise it is *released* (free again);
+//! 3. messages of step t (from this unit and from units before it) seed the
+//!    end guides' systems, in the order of the sending guide, then sending order;
+//! 4. the query modules of systems that derived at t or were just seeded are
+//!    answered; a `?X` whose segment would cross an edge holding a link with a
+//!    free token *reserves* it (systems with steps left only; first come, in
+//!    instance then string order).
+//!
+//! Seeds start at step 0 (answered before the first derivation). A unit ends
+//! when none of its systems derives and no message is still to come.
+
+use super::geometry::{closest_on_segment, crossing};
+use super::index::Grid;
+use super::scene::{Answer, Instance, Outcome, Probe, Scene, collide, query, seed_state};
+use crate::derive::{self, Limits, ModString};
+use crate::diagnostic::Diagnostic;
+use crate::query::QUERIES;
+use crate::run::runtime_diagnostic;
+use crate::turtle;
+use glam::DVec2;
+use rayon::prelude::*;
+use std::collections::HashMap;
+
+/// A message over a link, sent at `step` by guide `from_guide`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Message {
+    pub step: u32,
+    pub link: usize,
+    pub from_guide: usize,
+    /// Its place in the sending guide's messages.
+    pub seq: usize,
+    /// Where the crossing segment met the start edge.
+    pub at: DVec2,
+    /// The pass-through parameters of the `?X` that reserved the token (Δ first).
+    pub pass: Vec<f64>,
+}
+
+/// What happened to a token.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Token {
+    /// A free token was taken by a `?X` that would cross its edge.
+    Reserved,
+    /// The reserving system crossed the edge: the message was sent.
+    Used,
+    /// The reserving system did not cross: the token is free again.
+    Released,
+}
+
+/// One change of a token's state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TokenEvent {
+    pub step: u32,
+    pub link: usize,
+    pub token: Token,
+    /// The reserving system (index in its guide's systems) and its `?X` module
+    /// (position in the string when it reserved).
+    pub instance: usize,
+    pub module: usize,
+}
+
+/// One guide's share of a run.
+#[derive(Clone, Default)]
+pub struct GuideRun {
+    /// Its systems: explicit seeds first, then those seeded by messages.
+    pub instances: Vec<Instance>,
+    pub sent: Vec<Message>,
+    /// Token events of the links starting at this guide.
+    pub tokens: Vec<TokenEvent>,
+    /// Derivation steps performed (of all its systems).
+    pub derivations: u64,
+    pub queries: u64,
+    /// The last step at which one of its systems derived.
+    pub last_step: u32,
+}
+
+/// What a run does not read from the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct Config {
+    pub seed: u64,
+    pub limits: Limits,
+    /// The most steps (`MAX_SCENE_STEPS` at most).
+    pub cap: u32,
+}
+
+/// Unit results by their guides, with the key they were computed from.
+#[derive(Default)]
+pub struct Cache {
+    units: HashMap<Vec<usize>, (Vec<u64>, Vec<GuideRun>)>,
+}
+
+/// A reservation waiting for the next step.
+struct Reservation {
+    link: usize,
+    instance: usize,
+    module: usize,
+    /// Where the reserving turtle stood, and its heading.
+    from: DVec2,
+    dir: DVec2,
+    pass: Vec<f64>,
+}
+
+/// A unit's guide while it runs.
+struct Live {
+    guide: usize,
+    run: GuideRun,
+    probes: Vec<Option<Probe>>,
+    /// Answer this system's queries in this step.
+    fresh: Vec<bool>,
+    reserved: Vec<Reservation>,
+}
+
+/// The units of a scene (guides joined both ways by links with tokens), in an
+/// order where every unit comes after the units that send it messages.
+pub fn units(scene: &Scene) -> Vec<Vec<usize>> {
+    let n = scene.guides.len();
+    let mut out_edges = vec![Vec::new(); n];
+    let mut in_edges = vec![Vec::new(); n];
+    for l in scene.links.iter().filter(|l| l.tokens > 0) {
+        if l.from.0 < n && l.to.0 < n {
+            out_edges[l.from.0].push(l.to.0);
+            in_edges[l.to.0].push(l.from.0);
+        }
+    }
+    // Kosaraju, without recursion: finishing order on the graph, then
+    // components on the reversed graph in reverse finishing order (which comes
+    // out in topological order of the components).
+    let mut seen = vec![false; n];
+    let mut finished = Vec::with_capacity(n);
+    for s in 0..n {
+        if seen[s] {
+            continue;
+        }
+        seen[s] = true;
+        let mut stack = vec![(s, 0usize)];
+        while let Some((v, i)) = stack.pop() {
+            if i < out_edges[v].len() {
+                stack.push((v, i + 1));
+                let w = out_edges[v][i];
+                if !seen[w] {
+                    seen[w] = true;
+                    stack.push((w, 0));
+                }
+            } else {
+                finished.push(v);
+            }
+        }
+    }
+    let mut comp = vec![usize::MAX; n];
+    let mut units = Vec::new();
+    for &s in finished.iter().rev() {
+        if comp[s] != usize::MAX {
+            continue;
+        }
+        let id = units.len();
+        let mut members = vec![s];
+        comp[s] = id;
+        let mut k = 0;
+        while k < members.len() {
+            let v = members[k];
+            k += 1;
+            for &w in &in_edges[v] {
+                if comp[w] == usize::MAX {
+                    comp[w] = id;
+                    members.push(w);
+                }
+            }
+        }
+        members.sort_unstable();
+        units.push(members);
+    }
+    units
+}
+
+/// Runs every unit of the scene, reusing cached unit results whose key is
+/// unchanged. `revs` are revision numbers of the programs (part of the key).
+/// Returns the outcome and, per guide, whether it was computed afresh.
+pub fn execute(
+    scene: &Scene,
+    cfg: Config,
+    revs: &[u64],
+    cache: &mut Cache,
+) -> Result<(Outcome, Vec<bool>), Diagnostic> {
+    let n = scene.guides.len();
+    let mut runs: Vec<Option<GuideRun>> = vec![None; n];
+    let mut fresh = vec![false; n];
+    let mut keep = HashMap::new();
+    for unit in units(scene) {
+        // Messages into this unit from the units before it.
+        let mut inbox: Vec<Message> = unit
+            .iter()
+            .flat_map(|&g| {
+                scene
+                    .links
+                    .iter()
+                    .enumerate()
+                    .filter(move |(_, l)| l.to.0 == g)
+                    .map(|(i, l)| (i, l.from.0))
+            })
+            .filter(|(_, from)| unit.binary_search(from).is_err())
+            .flat_map(|(li, from)| {
+                runs[from]
+                    .as_ref()
+                    .map_or(&[][..], |r| &r.sent[..])
+                    .iter()
+                    .filter(move |m| m.link == li)
+                    .cloned()
+            })
+            .collect();
+        inbox.sort_by_key(|m| (m.step, m.from_guide, m.seq));
+        let key = unit_key(scene, cfg, revs, &unit, &inbox);
+        let result = match cache.units.remove(&unit) {
+            Some((k, r)) if k == key => r,
+            _ => {
+                for &g in &unit {
+                    fresh[g] = true;
+                }
+                run_unit(scene, cfg, &unit, &inbox)?
+            }
+        };
+        for (&g, r) in unit.iter().zip(&result) {
+            runs[g] = Some(r.clone());
+        }
+        keep.insert(unit, (key, result));
+    }
+    cache.units = keep;
+    let mut out = Outcome {
+        instances: Vec::new(),
+        steps: 0,
+        queries: 0,
+        messages: 0,
+        guides: Vec::with_capacity(n),
+    };
+    for r in runs.into_iter().flatten() {
+        out.steps = out.steps.max(r.last_step);
+        out.queries += r.queries;
+        out.messages += r.sent.len() as u64;
+        out.instances.extend(r.instances.iter().cloned());
+        out.guides.push(GuideRun {
+            instances: Vec::new(),
+            ..r
+        });
+    }
+    Ok((out, fresh))
+}
+
+/// Everything a unit's run reads, as numbers: equal keys, equal results.
+fn unit_key(
+    scene: &Scene,
+    cfg: Config,
+    revs: &[u64],
+    unit: &[usize],
+    inbox: &[Message],
+) -> Vec<u64> {
+    let mut k = vec![
+        cfg.seed,
+        u64::from(cfg.cap),
+        cfg.limits.max_modules as u64,
+        cfg.limits.max_bytes as u64,
+    ];
+    let pt = |k: &mut Vec<u64>, p: DVec2| k.extend([p.x.to_bits(), p.y.to_bits()]);
+    for &g in unit {
+        let guide = &scene.guides[g];
+        k.extend([g as u64, guide.polygon.len() as u64]);
+        for &p in &guide.polygon {
+            pt(&mut k, p);
+        }
+        k.extend([
+            guide.program as u64,
+            revs.get(guide.program).copied().unwrap_or(0),
+            guide.seeds.len() as u64,
+        ]);
+        for s in &guide.seeds {
+            pt(&mut k, s.at);
+            k.extend([s.heading.to_bits(), s.args.len() as u64]);
+            k.extend(s.args.iter().map(|a| a.to_bits()));
+        }
+    }
+    for (i, l) in scene.links.iter().enumerate() {
+        let from = unit.binary_search(&l.from.0).is_ok();
+        let to = unit.binary_search(&l.to.0).is_ok();
+        if from || to {
+            k.extend([
+                i as u64,
+                l.from.0 as u64,
+                l.from.1 as u64,
+                l.to.0 as u64,
+                l.to.1 as u64,
+                u64::from(l.tokens),
+                l.heading.to_bits(),
+            ]);
+        }
+    }
+    for m in inbox {
+        k.extend([
+            u64::from(m.step),
+            m.link as u64,
+            m.from_guide as u64,
+            m.seq as u64,
+        ]);
+        pt(&mut k, m.at);
+        k.push(m.pass.len() as u64);
+        k.extend(m.pass.iter().map(|a| a.to_bits()));
+    }
+    k
+}
+
+/// Runs one unit to its end, receiving `inbox` (sorted by step, sender, order).
+fn run_unit(
+    scene: &Scene,
+    cfg: Config,
+    unit: &[usize],
+    inbox: &[Message],
+) -> Result<Vec<GuideRun>, Diagnostic> {
+    let mut live: Vec<Live> = Vec::with_capacity(unit.len());
+    for &g in unit {
+        let guide = &scene.guides[g];
+        let prog = &scene.programs[guide.program];
+        let mut l = Live {
+            guide: g,
+            run: GuideRun::default(),
+            probes: Vec::new(),
+            fresh: Vec::new(),
+            reserved: Vec::new(),
+        };
+        for s in &guide.seeds {
+            let string =
+                derive::axiom(prog, &s.args, cfg.seed).map_err(|e| runtime_diagnostic(&e, prog))?;
+            l.add(Instance {
+                guide: g,
+                start: seed_state(s.at, s.heading),
+                string,
+                steps: 0,
+            });
+        }
+        live.push(l);
+    }
+    let mut used = vec![0u32; scene.links.len()];
+    answer(scene, cfg, &mut live, &used, 0)?;
+    let mut next = 0; // the first message of `inbox` not yet delivered
+    let mut t = 1;
+    while t <= cfg.cap {
+        let any = derive_all(scene, cfg, &mut live, t)?;
+        if !any {
+            // Idle: wait for the next message from outside, if any.
+            match inbox.get(next) {
+                None => break,
+                Some(m) if m.step > t => {
+                    t = m.step;
+                    continue;
+                }
+                Some(_) => {}
+            }
+        }
+        interpret(scene, cfg, &mut live)?;
+        let mut outgoing = Vec::new();
+        for l in &mut live {
+            settle(scene, l, &mut used, t, &mut outgoing);
+        }
+        // This step's messages into the unit: from outside, then from inside,
+        // ordered by sending guide and sending order.
+        let mut arriving: Vec<Message> = Vec::new();
+        while next < inbox.len() && inbox[next].step <= t {
+            if inbox[next].step == t {
+                arriving.push(inbox[next].clone());
+            }
+            next += 1;
+        }
+        arriving.extend(
+            outgoing
+                .into_iter()
+                .filter(|m| unit.binary_search(&scene.links[m.link].to.0).is_ok()),
+        );
+        arriving.sort_by_key(|m| (m.from_guide, m.seq));
+        for m in &arriving {
+            deliver(scene, cfg, unit, &mut live, m)?;
+        }
+        answer(scene, cfg, &mut live, &used, t)?;
+        t += 1;
+    }
+    // Reservations nobody will settle: the tokens are free again.
+    for l in &mut live {
+        for r in std::mem::take(&mut l.reserved) {
+            l.run.tokens.push(TokenEvent {
+                step: t.min(cfg.cap),
+                link: r.link,
+                token: Token::Released,
+                instance: r.instance,
+                module: r.module,
+            });
+        }
+    }
+    Ok(live.into_iter().map(|l| l.run).collect())
+}
+
+impl Live {
+    fn add(&mut self, inst: Instance) {
+        self.run.instances.push(inst);
+        self.probes.push(None);
+        self.fresh.push(true);
+    }
+}
+
+/// Derives every system with steps left, once; whether any did.
+fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<bool, Diagnostic> {
+    let mut jobs: Vec<(&mut Instance, &mut Option<Probe>, &mut bool)> = Vec::new();
+    for l in live.iter_mut() {
+        let prog = &scene.programs[scene.guides[l.guide].program];
+        let mut n = 0;
+        for ((inst, probe), fresh) in l
+            .run
+            .instances
+            .iter_mut()
+            .zip(&mut l.probes)
+            .zip(&mut l.fresh)
+        {
+            if inst.steps < prog.derive {
+                jobs.push((inst, probe, fresh));
+                n += 1;
+            }
+        }
+        if n > 0 {
+            l.run.derivations += n;
+            l.run.last_step = t;
+        }
+    }
+    let any = !jobs.is_empty();
+    let results: Vec<Result<(), Diagnostic>> = jobs
+        .into_par_iter()
+        .map(|(inst, probe, fresh)| {
+            let prog = &scene.programs[scene.guides[inst.guide].program];
+            inst.steps += 1;
+            inst.string = derive::step(prog, &inst.string, inst.steps, cfg.seed, cfg.limits)
+                .map_err(|e| runtime_diagnostic(&e, prog))?;
+            *probe = None;
+            *fresh = true;
+            Ok(())
+        })
+        .collect();
+    results.into_iter().collect::<Result<(), _>>()?;
+    let modules: usize = live
+        .iter()
+        .flat_map(|l| &l.run.instances)
+        .map(|i| i.string.len())
+        .sum();
+    if modules > cfg.limits.max_modules {
+        return Err(Diagnostic::error(
+            crate::diagnostic::Code::TooManyModules,
+            format!(
+                "step {t} of the scene would hold {modules} modules in all its systems, more than the limit of {}",
+                cfg.limits.max_modules
+            ),
+        )
+        .help("derive fewer steps with -n, give the links fewer tokens, or raise the limit with --max-modules"));
+    }
+    Ok(any)
+}
+
+/// Interprets every system whose string changed since it was last interpreted.
+fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagnostic> {
+    let mut jobs = Vec::new();
+    for l in live.iter_mut() {
+        for (inst, probe) in l.run.instances.iter().zip(&mut l.probes) {
+            if probe.is_none() {
+                jobs.push((inst, probe));
+            }
+        }
+    }
+    let results: Vec<Result<(), Diagnostic>> = jobs
+        .into_par_iter()
+        .map(|(inst, probe)| {
+            let prog = &scene.programs[scene.guides[inst.guide].program];
+            let mut p = Probe::default();
+            turtle::interpret_from(prog, &inst.string, cfg.seed, inst.start, &mut p)
+                .map_err(|e| runtime_diagnostic(&e, prog))?;
+            *probe = Some(p);
+            Ok(())
+        })
+        .collect();
+    results.into_iter().collect()
+}
+
+/// Settles the reservations of guide `l` made in the step before `t`.
+fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<Message>) {
+    for r in std::mem::take(&mut l.reserved) {
+        let link = &scene.links[r.link];
+        let poly = &scene.guides[l.guide].polygon;
+        let e = link.from.1 % poly.len();
+        let (a, b) = (poly[e], poly[(e + 1) % poly.len()]);
+        let tol = 1e-6 * (1.0 + r.from.abs().max_element());
+        // Of the segments drawn from where the ?X stood across the edge, the one
+        // closest to its heading (the first of equals): several branches may
+        // start at one point.
+        let mut hit: Option<(f64, DVec2)> = None;
+        for &(s0, s1) in l.probes[r.instance].iter().flat_map(|p| &p.segments) {
+            if (s0 - r.from).length() > tol {
+                continue;
+            }
+            if let Some(c) = crossing(s0, s1, a, b).filter(|&c| c > 1e-6) {
+                let along = (s1 - s0).normalize_or_zero().dot(r.dir);
+                if hit.is_none_or(|(best, _)| along > best) {
+                    hit = Some((along, s0 + (s1 - s0) * c));
+                }
+            }
+        }
+        let hit = hit.map(|h| h.1);
+        let token = if hit.is_some() {
+            Token::Used
+        } else {
+            Token::Released
+        };
+        l.run.tokens.push(TokenEvent {
+            step: t,
+            link: r.link,
+            token,
+            instance: r.instance,
+            module: r.module,
+        });
+        if let Some(at) = hit {
+            used[r.link] += 1;
+            let m = Message {
+                step: t,
+                link: r.link,
+                from_guide: l.guide,
+                seq: l.run.sent.len(),
+                at,
+                pass: r.pass,
+            };
+            l.run.sent.push(m.clone());
+            out.push(m);
+        }
+    }
+}
+
+/// Seeds the end guide's system with a message.
+fn deliver(
+    scene: &Scene,
+    cfg: Config,
+    unit: &[usize],
+    live: &mut [Live],
+    m: &Message,
+) -> Result<(), Diagnostic> {
+    let link = &scene.links[m.link];
+    let (tg, te) = link.to;
+    let Ok(k) = unit.binary_search(&tg) else {
+        return Ok(());
+    };
+    let poly = &scene.guides[tg].polygon;
+    let (a, b) = (poly[te % poly.len()], poly[(te + 1) % poly.len()]);
+    let at = closest_on_segment(m.at, a, b);
+    let prog = &scene.programs[scene.guides[tg].program];
+    let mut args = m.pass.clone();
+    args.resize(prog.params.len(), 0.0);
+    let string = derive::axiom(prog, &args, cfg.seed).map_err(|e| runtime_diagnostic(&e, prog))?;
+    live[k].add(Instance {
+        guide: tg,
+        start: seed_state(at, link.heading),
+        string,
+        steps: 0,
+    });
+    Ok(())
+}
+
+/// A `?X` whose segment would cross a guide edge: its place and parameters.
+struct Crossing {
+    module: usize,
+    edge: usize,
+    from: DVec2,
+    dir: DVec2,
+    pass: Vec<f64>,
+}
+
+/// Answers the queries of the fresh systems (derived at `t` or just seeded)
+/// and makes reservations.
+fn answer(
+    scene: &Scene,
+    cfg: Config,
+    live: &mut [Live],
+    used: &[u32],
+    t: u32,
+) -> Result<(), Diagnostic> {
+    interpret(scene, cfg, live)?;
+    let _ = t;
+    // Per guide: what is drawn, and a grid when something asks about it.
+    let drawn: Vec<Vec<(DVec2, DVec2)>> = live
+        .iter()
+        .map(|l| {
+            let mut d = Vec::new();
+            for p in l.probes.iter().flatten() {
+                d.extend_from_slice(&p.segments);
+            }
+            d
+        })
+        .collect();
+    let asked: Vec<Vec<DVec2>> = live
+        .iter()
+        .map(|l| {
+            let mut a = Vec::new();
+            for (p, &f) in l.probes.iter().zip(&l.fresh) {
+                if let (Some(p), true) = (p, f) {
+                    for (_, kind, st) in &p.queries {
+                        if matches!(QUERIES[*kind as usize].name, "?X" | "?D_A" | "?N_A") {
+                            a.push(st.pos.truncate());
+                        }
+                    }
+                }
+            }
+            a
+        })
+        .collect();
+    let grids: Vec<Option<Grid>> = drawn
+        .par_iter()
+        .zip(asked.par_iter())
+        .map(|(d, a)| (!a.is_empty()).then(|| Grid::new(d, a)))
+        .collect();
+    type Answered = (usize, usize, Vec<(usize, usize, Answer)>, Vec<Crossing>);
+    let mut jobs = Vec::new();
+    for (li, l) in live.iter().enumerate() {
+        for (k, (p, &f)) in l.probes.iter().zip(&l.fresh).enumerate() {
+            if let (Some(p), true) = (p, f)
+                && !p.queries.is_empty()
+            {
+                jobs.push((li, k, p));
+            }
+        }
+    }
+    let answered: Vec<Answered> = jobs
+        .into_par_iter()
+        .map(|(li, k, probe)| {
+            let l = &live[li];
+            let gi = l.guide;
+            let inst = &l.run.instances[k];
+            let prog = &scene.programs[scene.guides[gi].program];
+            let offsets = param_offsets(prog, &inst.string);
+            let grid = grids[li].as_ref();
+            let mut answers = Vec::with_capacity(probe.queries.len());
+            let mut crossings = Vec::new();
+            for &(module, kind, state) in &probe.queries {
+                let q = &QUERIES[kind as usize];
+                let at = offsets[module] as usize;
+                let arity = prog.symbols.arity(inst.string.syms[module]);
+                let own = &inst.string.params[at..at + arity];
+                let ans = match q.name {
+                    "?X" => {
+                        let delta = own.get(q.outputs.len()).copied().unwrap_or(0.0);
+                        let (ans, edge) = collide(scene, grid, gi, &state, delta);
+                        if let Some(edge) = edge {
+                            crossings.push(Crossing {
+                                module,
+                                edge,
+                                from: state.pos.truncate(),
+                                dir: state.h.truncate().normalize_or_zero(),
+                                pass: own
+                                    .get(q.outputs.len()..)
+                                    .map_or(Vec::new(), <[f64]>::to_vec),
+                            });
+                        }
+                        ans
+                    }
+                    name => query(scene, grid, gi, name, &state),
+                };
+                answers.push((at, arity, ans));
+            }
+            (li, k, answers, crossings)
+        })
+        .collect();
+    for (li, k, answers, crossings) in answered {
+        let l = &mut live[li];
+        let prog = &scene.programs[scene.guides[l.guide].program];
+        let inst = &mut l.run.instances[k];
+        l.run.queries += answers.len() as u64;
+        for (at, arity, ans) in answers {
+            for (slot, v) in inst.string.params[at..at + arity]
+                .iter_mut()
+                .zip(ans.values())
+            {
+                *slot = *v;
+            }
+        }
+        if queries_interpreted(prog) {
+            // Its drawing may read the answers: draw it again when needed.
+            l.probes[k] = None;
+        }
+        if inst.steps >= prog.derive {
+            continue; // it will not draw again: no reservation
+        }
+        for c in crossings {
+            let free = scene.links.iter().enumerate().position(|(i, link)| {
+                link.from == (l.guide, c.edge)
+                    && used[i] as usize + l.reserved.iter().filter(|r| r.link == i).count()
+                        < link.tokens as usize
+            });
+            if let Some(link) = free {
+                l.run.tokens.push(TokenEvent {
+                    step: t,
+                    link,
+                    token: Token::Reserved,
+                    instance: k,
+                    module: c.module,
+                });
+                l.reserved.push(Reservation {
+                    link,
+                    instance: k,
+                    module: c.module,
+                    from: c.from,
+                    dir: c.dir,
+                    pass: c.pass,
+                });
+            }
+        }
+    }
+    for l in live.iter_mut() {
+        l.fresh.iter_mut().for_each(|f| *f = false);
+    }
+    Ok(())
+}
+
+/// Whether an interpretation rule rewrites a query module (then a system's
+/// drawing may depend on its answers).
+fn queries_interpreted(prog: &crate::compile::Program) -> bool {
+    prog.symbols.info.iter().enumerate().any(|(i, info)| {
+        matches!(info.action, crate::compile::Action::Query(_))
+            && prog.interpret.get(i).is_some_and(|r| !r.is_empty())
+    })
+}
+
+fn param_offsets(prog: &crate::compile::Program, s: &ModString) -> Vec<u32> {
+    let mut off = Vec::with_capacity(s.len());
+    let mut p = 0u32;
+    for &x in &s.syms {
+        off.push(p);
+        p += prog.symbols.arity(x) as u32;
+    }
+    off
+}
+
+/// A scene with its cache: `run` recomputes only what changed since the last
+/// run (guides whose polygon, seeds, program or links changed, and the guides
+/// downstream whose incoming messages changed).
+pub struct Runner {
+    pub scene: Scene,
+    pub cfg: Config,
+    /// Revision of each program; `replace_program` bumps it.
+    revs: Vec<u64>,
+    cache: Cache,
+    /// Derivation steps performed per guide, over all runs.
+    pub derivations: Vec<u64>,
+    /// Per guide: whether the last run computed it afresh.
+    pub recomputed: Vec<bool>,
+}
+
+impl Runner {
+    pub fn new(scene: Scene, cfg: Config) -> Runner {
+        let n = scene.guides.len();
+        let p = scene.programs.len();
+        Runner {
+            scene,
+            cfg,
+            revs: vec![0; p],
+            cache: Cache::default(),
+            derivations: vec![0; n],
+            recomputed: vec![false; n],
+        }
+    }
+
+    /// Replaces program `i` (its guides rerun at the next `run`).
+    pub fn replace_program(&mut self, i: usize, prog: crate::compile::Program) {
+        if let Some(p) = self.scene.programs.get_mut(i) {
+            *p = prog;
+            self.revs[i] += 1;
+        }
+    }
+
+    /// Runs the scene, reusing every unit whose inputs did not change.
+    pub fn run(&mut self) -> Result<Outcome, Diagnostic> {
+        let (out, fresh) = execute(&self.scene, self.cfg, &self.revs, &mut self.cache)?;
+        self.derivations.resize(self.scene.guides.len(), 0);
+        for (g, r) in out.guides.iter().enumerate() {
+            if fresh[g] {
+                self.derivations[g] += r.derivations;
+            }
+        }
+        for (l, link) in self.scene.links.iter_mut().enumerate() {
+            link.used = out
+                .guides
+                .iter()
+                .flat_map(|r| &r.tokens)
+                .filter(|e| e.link == l && e.token == Token::Used)
+                .count() as u32;
+        }
+        self.recomputed = fresh;
+        Ok(out)
+    }
+}

@@ -1,0 +1,263 @@
+//! The scene engine beyond single answers: token states (free → reserved →
+//! used, reserved → free), competing modules, and the incremental rerun that
+//! recomputes only changed guides and those downstream.
+
+use glam::{DVec2, DVec3};
+use lsyc::env::engine::{Config, Runner, Token, TokenEvent};
+use lsyc::env::scene::{MAX_SCENE_STEPS, Outcome, Scene};
+use lsyc::frontend;
+
+fn build(text: &str) -> Scene {
+    let fe = frontend::run(text, Vec::new(), &[]);
+    assert!(
+        !fe.has_errors(),
+        "{}",
+        crate::support::render_plain(&fe.diagnostics, "scene.lsy", text)
+    );
+    let checked = fe.checked.as_ref().expect("checked");
+    lsyc::env::build(&fe.file, checked, None).expect("builds")
+}
+
+fn config() -> Config {
+    Config {
+        seed: 0,
+        limits: Default::default(),
+        cap: MAX_SCENE_STEPS,
+    }
+}
+
+fn run(text: &str) -> (Scene, Outcome) {
+    let mut scene = build(text);
+    let out = lsyc::env::run(&mut scene, 0, Default::default(), None).expect("runs");
+    (scene, out)
+}
+
+/// Token events of the links from guide `g`, as (step, link, event, module).
+fn events(out: &Outcome, g: usize) -> Vec<(u32, usize, Token, usize)> {
+    out.guides[g]
+        .tokens
+        .iter()
+        .map(|e: &TokenEvent| (e.step, e.link, e.token, e.module))
+        .collect()
+}
+
+/// A trunk grows up a 10 × 10 guide in steps of 4; the first ?X is 12 long and
+/// would leave through the linked top edge, but the rule for it (k = 1)
+/// replaces it by a shorter ?X that does not reach the edge.
+const RETREAT: &str = "
+lsystem Up {
+    derive 20;
+    axiom ?X(12, 1);
+    ?X(found, _, d, k) : found && k == 1 -> ?X(4, 2);
+    ?X(found, _, d, k) : found -> F(d) cut;
+    ?X(_, _, d, k) -> F(d) ?X(d, k);
+}
+lsystem Side(d, v) { derive 0; axiom F(v); }
+scene S {
+    guide a { polygon (0, 0) (10, 0) (10, 10) (0, 10); system Up; seed (5, 0) heading 0; }
+    guide b { polygon (0, 10) (10, 10) (10, 20) (0, 20); system Side; }
+    link a.edge(2) -> b.edge(0) { tokens 1; heading 90; }
+}
+";
+
+#[test]
+fn a_token_is_reserved_then_released_then_reserved_and_used() {
+    let (scene, out) = run(RETREAT);
+    // Step 0: ?X(12) would cross the top edge: the free token is reserved.
+    // Step 1: the module became ?X(4, 2) and drew nothing across: released.
+    // Step 3: the ?X(4) standing at y = 8 would cross: reserved again.
+    // Step 4: it became F(4) from y = 8 to 12, across the edge: used.
+    assert_eq!(
+        events(&out, 0),
+        vec![
+            (0, 0, Token::Reserved, 0),
+            (1, 0, Token::Released, 0),
+            (3, 0, Token::Reserved, 2),
+            (4, 0, Token::Used, 2),
+        ]
+    );
+    assert_eq!(out.messages, 1);
+    assert_eq!(scene.links[0].used, 1);
+    // The message went out when the segment crossed, at the crossing point,
+    // with the parameters of the ?X that reserved it.
+    let m = &out.guides[0].sent[0];
+    assert_eq!((m.step, m.link, m.pass.clone()), (4, 0, vec![4.0, 2.0]));
+    assert!((m.at - DVec2::new(5.0, 10.0)).length() < 1e-9, "{}", m.at);
+    let seeded = out.instances.iter().find(|i| i.guide == 1).expect("seeded");
+    assert!((seeded.start.pos - DVec3::new(5.0, 10.0, 0.0)).length() < 1e-9);
+    assert_eq!(seeded.string.params, vec![2.0], "F(v) with v = 2");
+}
+
+#[test]
+fn only_systems_with_steps_left_reserve() {
+    // With derive 0 the ?X is answered at the system's last step: it will never
+    // draw, so it reserves nothing. With derive 1 it reserves, then becomes a
+    // ?X again instead of a segment: released.
+    let text = |derive: u32| {
+        format!(
+            "lsystem Up {{ derive {derive}; axiom ?X(12); ?X(found, _, d) : found -> ?X(d); }}
+             lsystem Side {{ derive 0; axiom F; }}
+             scene S {{
+                 guide a {{ polygon (0, 0) (10, 0) (10, 10) (0, 10); system Up; seed (5, 0) heading 0; }}
+                 guide b {{ polygon (0, 10) (10, 10) (10, 20) (0, 20); system Side; }}
+                 link a.edge(2) -> b.edge(0) {{ tokens 1; }}
+             }}"
+        )
+    };
+    let (_, out) = run(&text(0));
+    assert_eq!(events(&out, 0), vec![]);
+    let (scene, out) = run(&text(1));
+    assert_eq!(
+        events(&out, 0),
+        vec![(0, 0, Token::Reserved, 0), (1, 0, Token::Released, 0)]
+    );
+    assert_eq!((out.messages, scene.links[0].used), (0, 0));
+}
+
+/// Two branches race for the tokens of one link.
+const RACE: &str = "
+lsystem Up {
+    derive 5;
+    axiom [-(10) ?X(12, 1)] [+(10) ?X(12, 2)];
+    ?X(found, _, d, k) : found -> F(d) cut;
+}
+lsystem Side(d, k) { derive 0; axiom F(k); }
+scene S {
+    guide a { polygon (0, 0) (10, 0) (10, 10) (0, 10); system Up; seed (5, 0) heading 0; }
+    guide b { polygon (-10, 10) (20, 10) (20, 20) (-10, 20); system Side; }
+    link a.edge(2) -> b.edge(0) { tokens TOKENS; }
+}
+";
+
+#[test]
+fn competing_modules_take_tokens_in_string_order() {
+    // One token: the first branch in the string reserves it, the second finds
+    // none; both cross the edge, one message is sent, from the first.
+    let (_, out) = run(&RACE.replace("TOKENS", "1"));
+    assert_eq!(
+        events(&out, 0),
+        vec![(0, 0, Token::Reserved, 2), (1, 0, Token::Used, 2)]
+    );
+    assert_eq!(out.messages, 1);
+    let seeded = out.instances.iter().find(|i| i.guide == 1).expect("seeded");
+    assert_eq!(seeded.string.params, vec![1.0]);
+    // Two tokens: both, in string order; the seeded systems follow it.
+    let (_, out) = run(&RACE.replace("TOKENS", "2"));
+    assert_eq!(
+        events(&out, 0),
+        vec![
+            (0, 0, Token::Reserved, 2),
+            (0, 0, Token::Reserved, 6),
+            (1, 0, Token::Used, 2),
+            (1, 0, Token::Used, 6),
+        ]
+    );
+    let ks: Vec<f64> = out
+        .instances
+        .iter()
+        .filter(|i| i.guide == 1)
+        .map(|i| i.string.params[0])
+        .collect();
+    assert_eq!(ks, vec![1.0, 2.0]);
+    // The crossing points lie on the edge, right (-10°) and left (+10°) of the middle.
+    let xs: Vec<f64> = out.guides[0].sent.iter().map(|m| m.at.x).collect();
+    assert!(
+        xs[0] > 5.0 && xs[1] < 5.0 && out.guides[0].sent[0].at.y == 10.0,
+        "{xs:?}"
+    );
+}
+
+/// Three guides: `a` sends a message to `b`; `c` stands alone.
+const THREE: &str = "
+lsystem Up {
+    derive 30;
+    axiom ?X(2, 7);
+    ?X(found, _, d, v) : found -> F(d) cut;
+    ?X(_, _, d, v) -> F(d) ?X(d, v);
+}
+lsystem Side(d, v) {
+    derive 10;
+    axiom ?X(d, v);
+    ?X(found, _, d, v) : found -> cut;
+    ?X(_, _, d, v) -> F(d) ?X(d, v);
+}
+scene S {
+    guide a { polygon (0, 0) (10, 0) (10, 10) (0, 10); system Up; seed (5, 0) heading 0; }
+    guide b { polygon (0, 10) (10, 10) (10, 20) (0, 20); system Side; }
+    guide c { polygon (30, 0) (40, 0) (40, 10) (30, 10); system Up; seed (35, 0) heading 0; }
+    link a.edge(2) -> b.edge(0) { tokens 1; heading 90; }
+}
+";
+
+/// Each system: guide, symbols, parameters, start.
+type Systems = Vec<(usize, Vec<u16>, Vec<f64>, [f64; 3])>;
+
+fn strings(out: &Outcome) -> Systems {
+    out.instances
+        .iter()
+        .map(|i| {
+            (
+                i.guide,
+                i.string.syms.clone(),
+                i.string.params.clone(),
+                i.start.pos.to_array(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn a_rerun_recomputes_only_the_changed_guide_and_its_dependents() {
+    let mut runner = Runner::new(build(THREE), config());
+    let first = runner.run().expect("runs");
+    assert_eq!(runner.recomputed, vec![true, true, true]);
+    let work = runner.derivations.clone();
+    assert!(work.iter().all(|&d| d > 0), "{work:?}");
+    assert_eq!(first.messages, 1);
+
+    // Nothing changed: nothing is recomputed, the outcome is the same.
+    let again = runner.run().expect("runs");
+    assert_eq!(runner.recomputed, vec![false, false, false]);
+    assert_eq!(runner.derivations, work);
+    assert_eq!(strings(&again), strings(&first));
+
+    // Move the lone guide: only it runs again.
+    runner.scene.guides[2].polygon[2].y = 8.0;
+    runner.scene.guides[2].polygon[3].y = 8.0;
+    let moved = runner.run().expect("runs");
+    assert_eq!(runner.recomputed, vec![false, false, true]);
+    assert_eq!(runner.derivations[..2], work[..2]);
+    assert!(runner.derivations[2] > work[2]);
+    // The same as running the edited scene from scratch.
+    let mut fresh = build(THREE);
+    fresh.guides[2].polygon = runner.scene.guides[2].polygon.clone();
+    let scratch = lsyc::env::run(&mut fresh, 0, Default::default(), None).expect("runs");
+    assert_eq!(strings(&moved), strings(&scratch));
+    assert_ne!(strings(&moved), strings(&first), "c's trunk is shorter");
+
+    // Move b's far edge: b runs again, a (upstream) does not.
+    let work = runner.derivations.clone();
+    runner.scene.guides[1].polygon[2].y = 14.0;
+    runner.scene.guides[1].polygon[3].y = 14.0;
+    runner.run().expect("runs");
+    assert_eq!(runner.recomputed, vec![false, true, false]);
+    assert_eq!(runner.derivations[0], work[0]);
+
+    // Move a's linked edge down: a and b run again (b receives a message at
+    // another step and place); c does not.
+    let work = runner.derivations.clone();
+    runner.scene.guides[0].polygon[2].y = 8.0;
+    runner.scene.guides[0].polygon[3].y = 8.0;
+    runner.scene.guides[1].polygon[0].y = 8.0;
+    runner.scene.guides[1].polygon[1].y = 8.0;
+    let out = runner.run().expect("runs");
+    assert_eq!(runner.recomputed, vec![true, true, false]);
+    assert_eq!(runner.derivations[2], work[2]);
+    assert_eq!(out.guides[0].sent[0].at, DVec2::new(5.0, 8.0));
+
+    // Change a without changing what it sends (a side edge moves a little):
+    // a runs again, b receives the same message and is reused.
+    runner.scene.guides[0].polygon[1].x = 11.0;
+    runner.run().expect("runs");
+    assert_eq!(runner.recomputed, vec![true, false, false]);
+}
