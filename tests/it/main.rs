@@ -5,6 +5,7 @@ mod corpus;
 mod diagnostics;
 mod edit;
 mod guided;
+mod infer;
 mod run;
 mod scene;
 mod sketch;

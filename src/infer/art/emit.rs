@@ -149,6 +149,13 @@ enum Part {
 
 fn transform(alpha: Part, d: Part, s: Part, beta: Part) -> Vec<Module> {
     let mut out = Vec::new();
+    // Without a step, the two turns are one.
+    let (alpha, beta) = match (alpha, &d, beta) {
+        (Part::Value(a), Part::Value(0.0), Part::Value(b)) => {
+            (Part::Value(nice(a + b, 1e-9)), Part::Value(0.0))
+        }
+        (a, _, b) => (a, b),
+    };
     let turn = |p: Part, out: &mut Vec<Module>| match p {
         Part::Value(0.0) => {}
         Part::Value(v) => out.push(sym(
@@ -185,7 +192,7 @@ impl Round {
         Round {
             angle: 0.002 / n,
             d: (d * 2e-5).max(1e-6) / n,
-            s: 2e-6 / n,
+            s: 2e-5 / n,
         }
     }
 
@@ -279,7 +286,7 @@ pub fn program(
         let sh = &inst.shapes[kind.representative];
         let mut props = vec![string_prop(
             "path",
-            path_data(&e.subpaths, sh.centroid, sh.radius),
+            path_data(&e.subpaths, sh.centroid + kind.origin, sh.radius),
         )];
         props.push(string_prop(
             "fill",

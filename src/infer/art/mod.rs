@@ -3,11 +3,12 @@
 //! Procedural Modeling by Automatic Generation of L-systems* (CGF 2010).
 //!
 //! Owns: the pipeline and its options and statistics: elements (`read`),
-//! kinds and frames (`shape`), transformation spaces and clustering (`space`),
+//! kinds and frames (`shape`), the kinds' origins (`origin`), transformation spaces and clustering (`space`),
 //! rules level by level (`rules`) and the program (`emit`). Must not write
 //! files or print (the CLI does), and must not panic on any input.
 
 pub mod emit;
+pub mod origin;
 pub mod read;
 pub mod rules;
 pub mod shape;
@@ -121,7 +122,8 @@ pub fn from_svg(
     } else {
         opts.similarity
     };
-    let inst = shape::instancing(&drawing.elements, similarity);
+    let mut inst = shape::instancing(&drawing.elements, similarity);
+    origin::find(&mut inst, tol);
     stats.kinds = inst.kinds.len();
     stats.instancing_ms = ms(t);
     let t = Instant::now();

@@ -82,8 +82,12 @@ fn skipped_in_xml(data: &[u8]) -> Vec<String> {
         return Vec::new();
     };
     let num = |n: &usvg::roxmltree::Node, a: &str| {
-        n.attribute(a)
-            .map(|v| v.trim().trim_end_matches("px").parse::<f64>().unwrap_or(f64::NAN))
+        n.attribute(a).map(|v| {
+            v.trim()
+                .trim_end_matches("px")
+                .parse::<f64>()
+                .unwrap_or(f64::NAN)
+        })
     };
     let mut out = Vec::new();
     for n in doc.descendants().filter(|n| n.is_element()) {

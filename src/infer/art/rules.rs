@@ -170,6 +170,9 @@ struct Candidate {
     phi: f64,
 }
 
+/// Edges by their two ends.
+type Index = HashMap<(usize, usize), usize>;
+
 /// Neighbours compared per instance.
 const NEIGHBOURS: usize = 8;
 
@@ -295,6 +298,11 @@ fn candidates(insts: &[Inst], edges: &[Edge], tol: Tolerance) -> (Vec<Candidate>
             .push(k);
     }
     let turn = std::f64::consts::TAU / tol.angle;
+    let index: Index = edges
+        .iter()
+        .enumerate()
+        .map(|(k, e)| ((e.from, e.to), k))
+        .collect();
     let mut out = Vec::new();
     let mut count = 0;
     for ((a, b), ks) in &spaces {
@@ -307,7 +315,7 @@ fn candidates(insts: &[Inst], edges: &[Edge], tol: Tolerance) -> (Vec<Candidate>
         }
         let phi = if a == b { 1.0 } else { 0.5 };
         for group in &groups {
-            if let Some(c) = sequence(insts, edges, group, a == b, tol, phi) {
+            if let Some(c) = sequence(insts, edges, &index, group, a == b, tol, phi) {
                 out.push(c);
             }
         }
@@ -318,12 +326,12 @@ fn candidates(insts: &[Inst], edges: &[Edge], tol: Tolerance) -> (Vec<Candidate>
             big.truncate(6);
             for x in 0..big.len() {
                 for y in x + 1..big.len() {
-                    if let Some(c) = branching(insts, edges, big[x], big[y], tol) {
+                    if let Some(c) = branching(insts, edges, &index, big[x], big[y], tol) {
                         out.push(c);
                     }
                 }
             }
-            out.extend(linear(insts, edges, ks, tol));
+            out.extend(linear(insts, edges, &index, ks, tol));
         }
     }
     (out, count)
@@ -333,6 +341,7 @@ fn candidates(insts: &[Inst], edges: &[Edge], tol: Tolerance) -> (Vec<Candidate>
 fn sequence(
     insts: &[Inst],
     edges: &[Edge],
+    index: &Index,
     group: &[usize],
     same: bool,
     tol: Tolerance,
@@ -395,22 +404,30 @@ fn sequence(
             chain.push(n);
             at = n;
         }
+        // A closed ring (its closing edge is in the cluster) starts at the
+        // element turned least, so that equal rings get equal frames.
+        let closed = chain.len() > 2 && index.get(&(at, s)).is_some_and(|k| group.contains(k));
+        if closed {
+            let first = (0..chain.len())
+                .min_by(|&x, &y| {
+                    let (fx, fy) = (&insts[chain[x]].frame, &insts[chain[y]].frame);
+                    let key = |f: &Frame| (wrap(f.rot).abs() * 1e6).round();
+                    key(fx).total_cmp(&key(fy)).then(x.cmp(&y))
+                })
+                .unwrap_or(0);
+            chain.rotate_left(first);
+        }
         chains.push(chain);
     }
     // The transform from the edges used, then chains cut where it drifts.
     let used: Vec<Tr> = chains
         .iter()
         .flat_map(|c| c.windows(2))
-        .filter_map(|w| {
-            group
-                .iter()
-                .find(|&&k| edges[k].from == w[0] && edges[k].to == w[1])
-                .map(|&k| edges[k].t)
-        })
+        .filter_map(|w| index.get(&(w[0], w[1])).map(|&k| edges[k].t))
         .collect();
     let t = mean(&used);
     let chains = cut_drift(insts, chains, |_, _| t, tol);
-    seq_candidate(insts, edges, chains, t, None, phi)
+    seq_candidate(edges, index, chains, t, None, phi)
 }
 
 /// Splits chains where redrawing with `step(chain position, chain length)`
@@ -449,8 +466,8 @@ fn cut_drift(
 }
 
 fn seq_candidate(
-    insts: &[Inst],
     edges: &[Edge],
+    index: &Index,
     chains: Vec<Vec<usize>>,
     t: Tr,
     delta: Option<Tr>,
@@ -460,14 +477,11 @@ fn seq_candidate(
         return None;
     }
     let pairs: usize = chains.iter().map(|c| c.len() - 1).sum();
-    let gaps: HashMap<(usize, usize), f64> =
-        edges.iter().map(|e| ((e.from, e.to), e.gap)).collect();
     let gap_sum: f64 = chains
         .iter()
         .flat_map(|c| c.windows(2))
-        .map(|w| gaps.get(&(w[0], w[1])).copied().unwrap_or(1.0))
+        .map(|w| index.get(&(w[0], w[1])).map_or(1.0, |&k| edges[k].gap))
         .sum();
-    let _ = insts;
     Some(Candidate {
         length: (pairs + chains.len()) as f64 / chains.len() as f64,
         h: 1.0 - gap_sum / pairs as f64,
@@ -478,7 +492,13 @@ fn seq_candidate(
 }
 
 /// Chains whose turns change by a constant step: the (d, s) subspace.
-fn linear(insts: &[Inst], edges: &[Edge], ks: &[usize], tol: Tolerance) -> Option<Candidate> {
+fn linear(
+    insts: &[Inst],
+    edges: &[Edge],
+    index: &Index,
+    ks: &[usize],
+    tol: Tolerance,
+) -> Option<Candidate> {
     let points: Vec<Point> = ks
         .iter()
         .map(|&k| {
@@ -632,7 +652,7 @@ fn linear(insts: &[Inst], edges: &[Edge], ks: &[usize], tol: Tolerance) -> Optio
                 cut.extend(pieces);
             }
         }
-        if let Some(cand) = seq_candidate(insts, edges, cut, t0, Some(delta), 1.0)
+        if let Some(cand) = seq_candidate(edges, index, cut, t0, Some(delta), 1.0)
             && best.as_ref().is_none_or(|b| cand.pairs > b.pairs)
         {
             best = Some(cand);
@@ -645,6 +665,7 @@ fn linear(insts: &[Inst], edges: &[Edge], ks: &[usize], tol: Tolerance) -> Optio
 fn branching(
     insts: &[Inst],
     edges: &[Edge],
+    index: &Index,
     x: &[usize],
     y: &[usize],
     tol: Tolerance,
@@ -706,11 +727,10 @@ fn branching(
     let mut trees = Vec::new();
     let mut pairs = 0;
     let mut gap = 0.0;
-    let gaps: HashMap<(usize, usize), f64> =
-        edges.iter().map(|e| ((e.from, e.to), e.gap)).collect();
     for (r, d) in roots {
         // The tree's nodes, level by level, redrawn from the root.
         let mut nodes = vec![(r, insts[r].frame)];
+        let mut in_tree: HashSet<usize> = HashSet::from([r]);
         let mut level = vec![(r, insts[r].frame)];
         let mut ok = !claimed.contains(&r);
         let mut tree_gap = 0.0;
@@ -721,14 +741,15 @@ fn branching(
                     let c = map[&v];
                     let want = tr.apply(&f);
                     if claimed.contains(&c)
-                        || nodes.iter().any(|n| n.0 == c)
+                        || in_tree.contains(&c)
                         || !close(&want, &insts[c].frame, tr.d * f.scale, insts[c].size(), tol)
                     {
                         ok = false;
                     }
-                    tree_gap += gaps.get(&(v, c)).copied().unwrap_or(1.0);
+                    tree_gap += index.get(&(v, c)).map_or(1.0, |&k| edges[k].gap);
                     below.push((c, want));
                     nodes.push((c, want));
+                    in_tree.insert(c);
                 }
             }
             if !ok {

@@ -257,6 +257,9 @@ pub struct Kind {
     pub representative: usize,
     /// Rotational symmetry order: 1 for none, k for k-fold, 0 for round.
     pub symmetry: usize,
+    /// The local frame's origin relative to the representative's centroid
+    /// (see `origin`): zero unless the drawing shows a better one.
+    pub origin: DVec2,
 }
 
 /// Where an instance of a kind sits: its representative's frame mapped there.
@@ -349,6 +352,7 @@ pub fn instancing(elements: &[Element], tolerance: f64) -> Instancing {
                 kinds.push(Kind {
                     representative: i,
                     symmetry,
+                    origin: DVec2::ZERO,
                 });
                 of.push((
                     kinds.len() - 1,
