@@ -56,6 +56,10 @@ pub struct Args {
     )]
     pub similarity: f64,
 
+    /// Art: emit the transforms of repeated structures as random values, turns ±30·J degrees, steps and scales ±J (`lsyc run --seed` picks the variation).
+    #[arg(long, value_name = "J", conflicts_with = "skeleton")]
+    pub jitter: Option<f64>,
+
     /// Art: print what was found (elements, kinds, clusters, rules, time per phase) as JSON on stderr.
     #[arg(long)]
     pub stats: bool,
@@ -85,6 +89,15 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         return 2;
     }
     opts.similarity = args.similarity;
+    if let Some(j) = args.jitter {
+        if !(j.is_finite() && j > 0.0 && j < 1.0) {
+            reporter.say(&format!(
+                "error: --jitter must be between 0 and 1 (0.1: turns vary by ±3°, steps by ±10%), not {j}"
+            ));
+            return 2;
+        }
+        opts.jitter = Some(j);
+    }
     if let Some(w) = &args.weights {
         match parse_weights(w) {
             Ok(w) => opts.weights = w,

@@ -65,7 +65,7 @@ pub enum InferError {
     )]
     NoElements { file: String, skipped: usize },
     #[error(
-        "`{file}` has coordinates as large as {largest:e}; lsyc infers drawings whose coordinates stay within ±{:e} user units (scale the drawing down)",
+        "`{file}` has coordinates as large as {largest:.1e}; lsyc infers drawings whose coordinates stay within ±{:e} user units (scale the drawing down)",
         art::read::MAX_COORDINATE
     )]
     Huge { file: String, largest: f64 },

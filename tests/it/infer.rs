@@ -124,3 +124,157 @@ fn every_case_draws_back_on_its_input() {
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// The value of `const NAME = …;` in a program.
+fn constant(text: &str, name: &str) -> f64 {
+    let line = text
+        .lines()
+        .find(|l| l.starts_with(&format!("const {name} = ")))
+        .unwrap_or_else(|| panic!("no constant {name} in\n{text}"));
+    let v = line.split('=').nth(1).unwrap().split(';').next().unwrap();
+    v.trim().parse().unwrap_or_else(|_| panic!("{line}"))
+}
+
+fn case(name: &str) -> std::path::PathBuf {
+    root().join(format!("tests/data/infer/{name}.svg"))
+}
+
+#[test]
+fn recovered_counts_and_transforms_are_the_generators() {
+    let o = Options::default();
+    // Fig. 10's windows: rows of 5 at 13, 4 rows at 10.
+    let grid = infer(&case("grid"), &o).text;
+    assert_eq!(constant(&grid, "P1_N"), 4.0);
+    assert_eq!(constant(&grid, "P1_STEP"), 13.0);
+    assert_eq!(constant(&grid, "P2_N"), 3.0);
+    assert_eq!(constant(&grid, "P2_STEP"), 10.0);
+    // The helix (Fig. 9): 60 leaves, scale 0.993 and 8.5° per step.
+    let helix = infer(&case("helix"), &o).text;
+    assert_eq!(constant(&helix, "P1_N"), 59.0);
+    assert_eq!(constant(&helix, "P1_SCALE"), 0.993);
+    let turn = constant(&helix, "P1_TURN") + constant(&helix, "P1_TWIST");
+    assert!((turn - 8.5).abs() < 1e-3, "{turn}");
+    // A turn that grows by 3° per step (Fig. 5): the paper's t(m) = t0 + tΔ·m.
+    let lin = infer(&case("linear-angle"), &o).text;
+    assert_eq!(constant(&lin, "P1_N"), 14.0);
+    assert!((constant(&lin, "P1_DTURN") + 3.0).abs() < 0.05, "{lin}");
+    assert!((constant(&lin, "P1_STEP") - 26.0).abs() < 0.1, "{lin}");
+    // Fig. 1's scaled branching: one rule r3/r4, three levels, scales 0.8 and 0.6.
+    let br = infer(&case("branching"), &o).text;
+    assert!(br.contains("R1(m) : m > 0 -> A["), "{br}");
+    assert_eq!(constant(&br, "R1_N"), 3.0);
+    assert_eq!(constant(&br, "R1_SCALE1"), 0.8);
+    assert_eq!(constant(&br, "R1_SCALE2"), 0.6);
+    // A ring of 12 is one sequence; a scaled row of circles keeps its factor.
+    let ring = infer(&case("ring"), &o);
+    assert_eq!((ring.stats.rules, constant(&ring.text, "P1_N")), (1, 11.0));
+    assert_eq!(
+        constant(&infer(&case("circles"), &o).text, "P1_SCALE"),
+        1.25
+    );
+    // Stars turned by multiples of 72° are one kind on a plain grid.
+    let stars = infer(&case("stars-grid"), &o);
+    assert_eq!((stars.stats.kinds, stars.stats.rules), (1, 2));
+    // Clutter has no regularity: it is coded as pairs, one rule fewer than elements.
+    let clutter = infer(&case("clutter"), &o);
+    assert_eq!(clutter.stats.rules, clutter.stats.elements - 1);
+    // Separate squares in one path are separate elements; a ring with its hole is one.
+    let sub = infer(&case("subpaths"), &o).stats;
+    assert_eq!((sub.elements, sub.kinds), (6, 2));
+}
+
+#[test]
+fn symmetrize_makes_a_noisy_grid_regular() {
+    let exact = infer(&case("noisy-grid"), &Options::default());
+    assert!(
+        exact.stats.rules > 2,
+        "the noise is kept without --symmetrize"
+    );
+    let opts = Options {
+        symmetrize: true,
+        ..Options::default()
+    };
+    let sym = infer(&case("noisy-grid"), &opts);
+    let t = &sym.text;
+    assert_eq!(sym.stats.rules, 2, "{t}");
+    assert_eq!(constant(t, "P1_N"), 3.0);
+    assert_eq!(constant(t, "P1_STEP"), 13.0);
+    assert_eq!(constant(t, "P1_TURN"), -90.0);
+    assert_eq!(constant(t, "P1_TWIST"), 90.0);
+    assert_eq!(constant(t, "P2_N"), 2.0);
+}
+
+#[test]
+fn jitter_is_random_per_seed_and_repeatable() {
+    let opts = Options {
+        jitter: Some(0.1),
+        ..Options::default()
+    };
+    let text = infer(&case("grid"), &opts).text;
+    assert!(
+        text.contains("const P1_STEP = 13 * uniform(0.9, 1.1);"),
+        "{text}"
+    );
+    let dir = tempfile::tempdir().expect("tempdir");
+    let prog = dir.path().join("grid.lsy");
+    std::fs::write(&prog, &text).expect("write");
+    let run = |seed: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_lsyc"))
+            .args(["run", prog.to_str().unwrap(), "-o", "-", "--seed", seed])
+            .output()
+            .expect("runs");
+        let svg = dir.path().join(format!("{seed}.svg"));
+        let status = Command::new(env!("CARGO_BIN_EXE_lsyc"))
+            .args([
+                "run",
+                prog.to_str().unwrap(),
+                "-o",
+                svg.to_str().unwrap(),
+                "--seed",
+                seed,
+            ])
+            .status()
+            .expect("runs");
+        assert!(status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        std::fs::read(svg).expect("svg")
+    };
+    assert_eq!(run("1"), run("1"));
+    assert_ne!(run("1"), run("2"));
+}
+
+#[test]
+fn bad_drawings_are_clear_errors() {
+    let dir = root().join("tests/data/infer/bad");
+    for (file, says) in [
+        ("not-xml.svg", "is not an SVG drawing lsyc can read"),
+        ("truncated.svg", "is not an SVG drawing lsyc can read"),
+        ("empty.svg", "is not an SVG drawing lsyc can read"),
+        ("no-drawable.svg", "has nothing to infer from"),
+        ("nan.svg", "has nothing to infer from"),
+        ("huge.svg", "has coordinates as large as"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_lsyc"))
+            .arg("infer")
+            .arg(dir.join(file))
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{file}: {err}");
+        assert!(err.contains(file) && err.contains(says), "{file}: {err}");
+        assert!(out.stdout.is_empty(), "{file}");
+    }
+    // Skipped things are warnings naming the drawing; the rest is inferred.
+    let out = Command::new(env!("CARGO_BIN_EXE_lsyc"))
+        .arg("infer")
+        .arg(case("mixed-skip"))
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    for what in ["a text", "an image", "an empty rect"] {
+        assert!(
+            err.contains(&format!("mixed-skip.svg: skipped {what}")),
+            "{err}"
+        );
+    }
+}

@@ -29,6 +29,13 @@ pub struct Settings<'a> {
     pub source: &'a str,
     /// The lsystem's name.
     pub name: String,
+    /// `--symmetrize`: transforms of repeated structures round to whole
+    /// degrees and plain steps (within 1.5°, 2 % and 1 %).
+    pub symmetrize: bool,
+    /// `--jitter J`: the transforms of repeated structures vary at random
+    /// (turns by ±30·J degrees, steps and scales by ±J of their value), drawn
+    /// anew at each use from `lsyc run --seed`.
+    pub jitter: Option<f64>,
 }
 
 /// The shortest decimal within `tol` of `v` (at most 6 decimals).
@@ -128,11 +135,40 @@ struct Consts {
     items: Vec<Node<Item>>,
 }
 
+/// How a jittered constant varies.
+#[derive(Clone, Copy)]
+enum Jitter {
+    /// Plus or minus this many degrees.
+    Turn(f64),
+    /// Times 1 ± this.
+    Factor(f64),
+}
+
+fn uniform(lo: f64, hi: f64) -> Expr {
+    Expr::new(ExprKind::Call(
+        Ident::new("uniform"),
+        vec![Expr::num(lo), Expr::num(hi)],
+    ))
+}
+
 impl Consts {
     fn add(&mut self, name: &str, value: f64, note: &str) -> Expr {
+        self.add_jittered(name, value, None, note)
+    }
+
+    fn add_jittered(&mut self, name: &str, value: f64, jitter: Option<Jitter>, note: &str) -> Expr {
+        let init = match jitter {
+            Some(Jitter::Turn(d)) if d > 0.0 => bin(BinOp::Add, Expr::num(value), uniform(-d, d)),
+            Some(Jitter::Factor(f)) if f > 0.0 => bin(
+                BinOp::Mul,
+                Expr::num(value),
+                uniform(nice(1.0 - f, 1e-9), nice(1.0 + f, 1e-9)),
+            ),
+            _ => Expr::num(value),
+        };
         let mut n = node(Item::Const(ConstDecl {
             name: Ident::new(name),
-            value: Expr::num(value),
+            value: init,
         }));
         n.trivia.trailing = Some(comment(note));
         self.items.push(n);
@@ -197,11 +233,20 @@ impl Round {
     }
 
     fn values(&self, t: &Tr) -> (f64, f64, f64, f64) {
+        // Angles prefer round multiples (of 90°, 45°, 30°, 15°, 5°) when
+        // the tolerance allows one.
+        let angle = |v: f64| {
+            [90.0, 45.0, 30.0, 15.0, 5.0]
+                .iter()
+                .map(|k| (v / k).round() * k + 0.0)
+                .find(|r| (r - v).abs() <= self.angle)
+                .unwrap_or_else(|| nice(v, self.angle))
+        };
         (
-            nice(t.alpha.to_degrees(), self.angle),
+            angle(t.alpha.to_degrees()),
             nice(t.d, self.d),
             nice(t.s, self.s),
-            nice(t.beta.to_degrees(), self.angle),
+            angle(t.beta.to_degrees()),
         )
     }
 }
@@ -387,12 +432,29 @@ pub fn program(
             rules.push(n);
         };
         let named_parts = |consts: &mut Consts, t: &Tr, suffix: &str, n: f64| {
-            let (a, d, sc, b) = Round::new(n, scale_units(t)).values(t);
+            let round = if s.symmetrize {
+                Round {
+                    angle: 1.5,
+                    d: 0.02 * scale_units(t),
+                    s: 0.01,
+                }
+            } else {
+                Round::new(n, scale_units(t))
+            };
+            let (a, d, sc, b) = round.values(t);
+            let jitter = s.jitter;
             let mut part = |v: f64, trivial: f64, what: &str, note: &str| {
-                if v == trivial {
+                // A scale of 1 stays 1: random scales would compound.
+                let j = jitter
+                    .filter(|_| !(what == "SCALE" && v == 1.0))
+                    .map(|j| match what {
+                        "TURN" | "TWIST" => Jitter::Turn(nice(30.0 * j, 1e-6)),
+                        _ => Jitter::Factor(j),
+                    });
+                if v == trivial && j.is_none() {
                     Part::Value(v)
                 } else {
-                    Part::Expr(consts.add(&format!("{name}_{what}{suffix}"), v, note))
+                    Part::Expr(consts.add_jittered(&format!("{name}_{what}{suffix}"), v, j, note))
                 }
             };
             (
@@ -536,8 +598,17 @@ pub fn program(
             scale: 1.0,
         };
         let t = Tr::between(&origin, &frame, 1.0);
-        let size = frame.pos.length().max(1.0);
-        let (a, d, sc, b) = Round::new(1.0, size).values(&t);
+        // Placement is as precise as the drawing: 10⁻⁵ of its diagonal.
+        let (lo, hi) = elements.iter().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), e| (lo.min(e.min), hi.max(e.max)),
+        );
+        let diagonal = (hi - lo).length().max(1e-9);
+        let round = Round {
+            d: diagonal * 1e-5,
+            ..Round::new(1.0, 1.0)
+        };
+        let (a, d, sc, b) = round.values(&t);
         axiom.extend(transform(
             Part::Value(a),
             Part::Value(d),

@@ -31,6 +31,8 @@ pub struct Options {
     pub symmetrize: bool,
     /// Largest mean misfit of alike elements, relative to their size.
     pub similarity: f64,
+    /// Random variation of repeated transforms (see `emit::Settings::jitter`).
+    pub jitter: Option<f64>,
 }
 
 impl Default for Options {
@@ -39,6 +41,7 @@ impl Default for Options {
             weights: Weights::default(),
             symmetrize: false,
             similarity: 0.02,
+            jitter: None,
         }
     }
 }
@@ -151,6 +154,8 @@ pub fn from_svg(
     let settings = emit::Settings {
         source: &source,
         name: super::emit::system_name(&stem),
+        symmetrize: opts.symmetrize,
+        jitter: opts.jitter,
     };
     let file = emit::program(&drawing.elements, &inst, &grammar, &settings, None);
     let text = crate::fmt::format_file(&file);

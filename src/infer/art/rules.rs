@@ -83,9 +83,9 @@ impl Tolerance {
         scale: 0.005,
     };
     pub const RELAXED: Tolerance = Tolerance {
-        angle: 6.0 * std::f64::consts::PI / 180.0,
-        distance: 0.08,
-        scale: 0.08,
+        angle: 10.0 * std::f64::consts::PI / 180.0,
+        distance: 0.15,
+        scale: 0.1,
     };
 }
 
@@ -172,6 +172,9 @@ struct Candidate {
 
 /// Edges by their two ends.
 type Index = HashMap<(usize, usize), usize>;
+
+/// The largest change of a turn per step of a linear sequence, radians.
+const LINEAR_STEP_MAX: f64 = 30.0 * std::f64::consts::PI / 180.0;
 
 /// Neighbours compared per instance.
 const NEIGHBOURS: usize = 8;
@@ -546,8 +549,12 @@ fn linear(
             sizes[*l] += 1;
         }
         // The most common step that actually turns.
+        // A step that turns, by less than LINEAR_STEP_MAX (larger changes
+        // are not a gradual curve but different structures).
+        let max = LINEAR_STEP_MAX / tol.angle;
         let Some(top) = (0..dc.len())
             .filter(|&i| dc[i][0].abs() > 1.5 || dc[i][3].abs() > 1.5)
+            .filter(|&i| dc[i][0].abs() <= max && dc[i][3].abs() <= max)
             .max_by(|&x, &y| sizes[x].cmp(&sizes[y]).then(y.cmp(&x)))
         else {
             continue;
@@ -807,12 +814,34 @@ fn union_box(insts: &[Inst], ids: impl IntoIterator<Item = usize>) -> (DVec2, DV
 }
 
 fn replace(insts: &mut Vec<Inst>, first: usize, members: &[usize], sym: Sym) {
+    let frame = insts[first].frame;
+    replace_at(insts, frame, members, sym);
+}
+
+fn replace_at(insts: &mut Vec<Inst>, frame: Frame, members: &[usize], sym: Sym) {
     let (min, max) = union_box(insts, members.iter().copied());
     for &i in members {
         insts[i].alive = false;
     }
-    let frame = insts[first].frame;
     insts.push(Inst::new(sym, frame, min, max));
+}
+
+/// Where a chain drawn with `t` from one start frame fits its elements best:
+/// the mean of the start frames each element implies (noise shrinks with the
+/// chain's length; exact chains give their first frame).
+fn fitted_start(insts: &[Inst], chain: &[usize], t: &Tr) -> Frame {
+    let origin = Frame {
+        pos: DVec2::ZERO,
+        rot: 0.0,
+        scale: 1.0,
+    };
+    let back = t.apply(&origin).inverse();
+    let implied: Vec<Frame> = chain
+        .iter()
+        .enumerate()
+        .map(|(k, &i)| (0..k).fold(insts[i].frame, |f, _| f.then(&back)))
+        .collect();
+    Frame::mean(&implied).unwrap_or(insts[chain[0]].frame)
 }
 
 fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan) {
@@ -824,7 +853,11 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan) {
             for c in &chains {
                 let m = (c.len() - 1) as u32;
                 counts.insert(m);
-                replace(insts, c[0], c, Sym::Rule(r, m));
+                let start = match delta {
+                    None => fitted_start(insts, c, &t),
+                    Some(_) => insts[c[0]].frame,
+                };
+                replace_at(insts, start, c, Sym::Rule(r, m));
             }
             g.rules.push(Rule {
                 body: Body::Seq { a, t, delta },

@@ -276,6 +276,35 @@ impl Frame {
     pub fn apply(&self, p: DVec2) -> DVec2 {
         self.pos + rotate(p, self.rot) * self.scale
     }
+
+    /// The frame `local` (given in this frame's coordinates) in the world.
+    pub fn then(&self, local: &Frame) -> Frame {
+        Frame {
+            pos: self.apply(local.pos),
+            rot: wrap(self.rot + local.rot),
+            scale: self.scale * local.scale,
+        }
+    }
+
+    /// The frame this one is `local` of: `inverse` with `x.then(self) = id`.
+    pub fn inverse(&self) -> Frame {
+        Frame {
+            pos: -rotate(self.pos, -self.rot) / self.scale,
+            rot: wrap(-self.rot),
+            scale: 1.0 / self.scale,
+        }
+    }
+
+    /// The mean of frames (rotations averaged around the first's).
+    pub fn mean(frames: &[Frame]) -> Option<Frame> {
+        let first = frames.first()?;
+        let n = frames.len() as f64;
+        Some(Frame {
+            pos: frames.iter().map(|f| f.pos).sum::<DVec2>() / n,
+            rot: wrap(first.rot + frames.iter().map(|f| wrap(f.rot - first.rot)).sum::<f64>() / n),
+            scale: (frames.iter().map(|f| f.scale.ln()).sum::<f64>() / n).exp(),
+        })
+    }
 }
 
 /// The kinds of a drawing, and each element's kind and frame.
