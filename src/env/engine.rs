@@ -27,13 +27,14 @@
 //! when none of its systems derives and no message is still to come.
 
 use super::geometry::{closest_on_segment, crossing};
-use super::index::Grid;
+use super::index::{Grid, Layers};
 use super::scene::{Answer, Instance, Outcome, Probe, Scene, collide, query, seed_state};
 use crate::derive::{self, Limits, ModString};
 use crate::diagnostic::Diagnostic;
 use crate::query::QUERIES;
 use crate::run::runtime_diagnostic;
 use crate::turtle;
+use crate::turtle::State;
 use glam::DVec2;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -116,13 +117,23 @@ struct Reservation {
     pass: Vec<f64>,
 }
 
+/// A system's drawing: its segments (and elements' axes) in a grid, and the
+/// query modules met, with the turtle there.
+struct Drawing {
+    grid: Grid,
+    queries: Vec<(usize, u8, State)>,
+}
+
 /// A unit's guide while it runs.
 struct Live {
     guide: usize,
     run: GuideRun,
-    probes: Vec<Option<Probe>>,
+    probes: Vec<Option<Drawing>>,
     /// Answer this system's queries in this step.
     fresh: Vec<bool>,
+    /// The system's string holds only modules without rules (no query, no
+    /// cut): deriving it changes nothing any more, so it is not done.
+    settled: Vec<bool>,
     reserved: Vec<Reservation>,
 }
 
@@ -198,48 +209,75 @@ pub fn execute(
     cache: &mut Cache,
 ) -> Result<(Outcome, Vec<bool>), Diagnostic> {
     let n = scene.guides.len();
-    let mut runs: Vec<Option<GuideRun>> = vec![None; n];
+    let units = units(scene);
+    // Levels: a unit runs after every unit that sends it messages; the units
+    // of one level run in parallel.
+    let mut unit_of = vec![0; n];
+    for (u, members) in units.iter().enumerate() {
+        for &g in members {
+            unit_of[g] = u;
+        }
+    }
+    let mut level = vec![0usize; units.len()];
+    for u in 0..units.len() {
+        for l in scene
+            .links
+            .iter()
+            .filter(|l| l.tokens > 0 && l.from.0 < n && l.to.0 < n)
+        {
+            let (a, b) = (unit_of[l.from.0], unit_of[l.to.0]);
+            if b == u && a != u {
+                level[u] = level[u].max(level[a] + 1);
+            }
+        }
+    }
+    let mut sent: Vec<Vec<Message>> = vec![Vec::new(); n];
     let mut fresh = vec![false; n];
     let mut keep = HashMap::new();
-    for unit in units(scene) {
-        // Messages into this unit from the units before it.
-        let mut inbox: Vec<Message> = unit
-            .iter()
-            .flat_map(|&g| {
-                scene
-                    .links
-                    .iter()
-                    .enumerate()
-                    .filter(move |(_, l)| l.to.0 == g)
-                    .map(|(i, l)| (i, l.from.0))
-            })
-            .filter(|(_, from)| unit.binary_search(from).is_err())
-            .flat_map(|(li, from)| {
-                runs[from]
-                    .as_ref()
-                    .map_or(&[][..], |r| &r.sent[..])
-                    .iter()
-                    .filter(move |m| m.link == li)
-                    .cloned()
+    let top = level.iter().copied().max().unwrap_or(0);
+    for lv in 0..=top {
+        let mut jobs = Vec::new();
+        for (u, unit) in units.iter().enumerate().filter(|(u, _)| level[*u] == lv) {
+            // Messages into this unit from the units before it.
+            let mut inbox: Vec<Message> = scene
+                .links
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| {
+                    l.to.0 < n && unit_of[l.to.0] == u && l.from.0 < n && unit_of[l.from.0] != u
+                })
+                .flat_map(|(li, l)| sent[l.from.0].iter().filter(move |m| m.link == li).cloned())
+                .collect();
+            inbox.sort_by_key(|m| (m.step, m.from_guide, m.seq));
+            let key = unit_key(scene, cfg, revs, unit, &inbox);
+            let cached = match cache.units.remove(unit) {
+                Some((k, r)) if k == key => Some(r),
+                _ => None,
+            };
+            jobs.push((unit, inbox, key, cached));
+        }
+        let results: Vec<Result<(bool, Vec<GuideRun>), Diagnostic>> = jobs
+            .par_iter_mut()
+            .map(|(unit, inbox, _, cached)| match cached.take() {
+                Some(r) => Ok((false, r)),
+                None => run_unit(scene, cfg, unit, inbox).map(|r| (true, r)),
             })
             .collect();
-        inbox.sort_by_key(|m| (m.step, m.from_guide, m.seq));
-        let key = unit_key(scene, cfg, revs, &unit, &inbox);
-        let result = match cache.units.remove(&unit) {
-            Some((k, r)) if k == key => r,
-            _ => {
-                for &g in &unit {
-                    fresh[g] = true;
-                }
-                run_unit(scene, cfg, &unit, &inbox)?
+        for ((unit, _, key, _), result) in jobs.into_iter().zip(results) {
+            let (computed, result) = result?;
+            for (&g, r) in unit.iter().zip(&result) {
+                fresh[g] = computed;
+                sent[g] = r.sent.clone();
             }
-        };
-        for (&g, r) in unit.iter().zip(&result) {
-            runs[g] = Some(r.clone());
+            keep.insert(unit.clone(), (key, result));
         }
-        keep.insert(unit, (key, result));
     }
-    cache.units = keep;
+    let mut runs: Vec<Option<&GuideRun>> = vec![None; n];
+    for (unit, (_, result)) in &keep {
+        for (&g, r) in unit.iter().zip(result) {
+            runs[g] = Some(r);
+        }
+    }
     let mut out = Outcome {
         instances: Vec::new(),
         steps: 0,
@@ -254,9 +292,12 @@ pub fn execute(
         out.instances.extend(r.instances.iter().cloned());
         out.guides.push(GuideRun {
             instances: Vec::new(),
-            ..r
+            sent: r.sent.clone(),
+            tokens: r.tokens.clone(),
+            ..*r
         });
     }
+    cache.units = keep;
     Ok((out, fresh))
 }
 
@@ -337,6 +378,7 @@ fn run_unit(
             run: GuideRun::default(),
             probes: Vec::new(),
             fresh: Vec::new(),
+            settled: Vec::new(),
             reserved: Vec::new(),
         };
         for s in &guide.seeds {
@@ -414,42 +456,60 @@ impl Live {
         self.run.instances.push(inst);
         self.probes.push(None);
         self.fresh.push(true);
+        self.settled.push(false);
     }
 }
 
 /// Derives every system with steps left, once; whether any did.
 fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<bool, Diagnostic> {
-    let mut jobs: Vec<(&mut Instance, &mut Option<Probe>, &mut bool)> = Vec::new();
+    type Job<'a> = (
+        &'a mut Instance,
+        &'a mut Option<Drawing>,
+        &'a mut bool,
+        &'a mut bool,
+    );
+    let mut jobs: Vec<Job> = Vec::new();
+    let mut any = false;
     for l in live.iter_mut() {
         let prog = &scene.programs[scene.guides[l.guide].program];
         let mut n = 0;
-        for ((inst, probe), fresh) in l
+        for (((inst, probe), fresh), settled) in l
             .run
             .instances
             .iter_mut()
             .zip(&mut l.probes)
             .zip(&mut l.fresh)
+            .zip(&mut l.settled)
         {
             if inst.steps < prog.derive {
-                jobs.push((inst, probe, fresh));
                 n += 1;
+                if *settled {
+                    inst.steps += 1;
+                } else {
+                    jobs.push((inst, probe, fresh, settled));
+                }
             }
         }
         if n > 0 {
+            any = true;
             l.run.derivations += n;
             l.run.last_step = t;
         }
     }
-    let any = !jobs.is_empty();
     let results: Vec<Result<(), Diagnostic>> = jobs
         .into_par_iter()
-        .map(|(inst, probe, fresh)| {
+        .map(|(inst, probe, fresh, settled)| {
             let prog = &scene.programs[scene.guides[inst.guide].program];
             inst.steps += 1;
-            inst.string = derive::step(prog, &inst.string, inst.steps, cfg.seed, cfg.limits)
+            let string = derive::step(prog, &inst.string, inst.steps, cfg.seed, cfg.limits)
                 .map_err(|e| runtime_diagnostic(&e, prog))?;
-            *probe = None;
+            // An unchanged string draws the same: keep its drawing.
+            if string != inst.string {
+                inst.string = string;
+                *probe = None;
+            }
             *fresh = true;
+            *settled = inst.string.syms.iter().all(|&x| inert(prog, x));
             Ok(())
         })
         .collect();
@@ -489,7 +549,10 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
             let mut p = Probe::default();
             turtle::interpret_from(prog, &inst.string, cfg.seed, inst.start, &mut p)
                 .map_err(|e| runtime_diagnostic(&e, prog))?;
-            *probe = Some(p);
+            *probe = Some(Drawing {
+                grid: Grid::new(p.segments),
+                queries: p.queries,
+            });
             Ok(())
         })
         .collect();
@@ -508,7 +571,7 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
         // closest to its heading (the first of equals): several branches may
         // start at one point.
         let mut hit: Option<(f64, DVec2)> = None;
-        for &(s0, s1) in l.probes[r.instance].iter().flat_map(|p| &p.segments) {
+        for &(s0, s1) in l.probes[r.instance].iter().flat_map(|p| p.grid.segs()) {
             if (s0 - r.from).length() > tol {
                 continue;
             }
@@ -597,37 +660,18 @@ fn answer(
 ) -> Result<(), Diagnostic> {
     interpret(scene, cfg, live)?;
     let _ = t;
-    // Per guide: what is drawn, and a grid when something asks about it.
-    let drawn: Vec<Vec<(DVec2, DVec2)>> = live
+    // Per guide: the grids of its systems' drawings, ids running on.
+    let layers: Vec<Layers> = live
         .iter()
         .map(|l| {
-            let mut d = Vec::new();
-            for p in l.probes.iter().flatten() {
-                d.extend_from_slice(&p.segments);
+            let mut off = 0;
+            let mut parts = Vec::with_capacity(l.probes.len());
+            for d in l.probes.iter().flatten() {
+                parts.push((off, &d.grid));
+                off += d.grid.segs().len();
             }
-            d
+            Layers { parts }
         })
-        .collect();
-    let asked: Vec<Vec<DVec2>> = live
-        .iter()
-        .map(|l| {
-            let mut a = Vec::new();
-            for (p, &f) in l.probes.iter().zip(&l.fresh) {
-                if let (Some(p), true) = (p, f) {
-                    for (_, kind, st) in &p.queries {
-                        if matches!(QUERIES[*kind as usize].name, "?X" | "?D_A" | "?N_A") {
-                            a.push(st.pos.truncate());
-                        }
-                    }
-                }
-            }
-            a
-        })
-        .collect();
-    let grids: Vec<Option<Grid>> = drawn
-        .par_iter()
-        .zip(asked.par_iter())
-        .map(|(d, a)| (!a.is_empty()).then(|| Grid::new(d, a)))
         .collect();
     type Answered = (usize, usize, Vec<(usize, usize, Answer)>, Vec<Crossing>);
     let mut jobs = Vec::new();
@@ -648,7 +692,7 @@ fn answer(
             let inst = &l.run.instances[k];
             let prog = &scene.programs[scene.guides[gi].program];
             let offsets = param_offsets(prog, &inst.string);
-            let grid = grids[li].as_ref();
+            let grid = Some(&layers[li]);
             let mut answers = Vec::with_capacity(probe.queries.len());
             let mut crossings = Vec::new();
             for &(module, kind, state) in &probe.queries {
@@ -729,6 +773,15 @@ fn answer(
         l.fresh.iter_mut().for_each(|f| *f = false);
     }
     Ok(())
+}
+
+/// Whether module `sym` never changes: no rules, not a query, not `cut`.
+fn inert(prog: &crate::compile::Program, sym: crate::compile::Sym) -> bool {
+    prog.rules.get(sym as usize).is_none_or(|r| r.is_empty())
+        && !matches!(
+            prog.symbols.info[sym as usize].action,
+            crate::compile::Action::Query(_) | crate::compile::Action::Cut
+        )
 }
 
 /// Whether an interpretation rule rewrites a query module (then a system's

@@ -14,8 +14,7 @@ use glam::DVec2;
 /// The grid never has more than this many cells along an axis.
 pub const MAX_CELLS_PER_AXIS: usize = 2048;
 
-/// With fewer asking points or segments than these, the grid is one cell.
-pub const SCAN_BELOW_ASKS: usize = 8;
+/// With fewer segments than this, the grid is one cell.
 pub const SCAN_BELOW_SEGMENTS: usize = 32;
 
 /// A segment touching the asking point within this distance is the asker's own.
@@ -26,8 +25,8 @@ pub fn touches(s: &(DVec2, DVec2), p: DVec2) -> bool {
     (s.0 - p).length() <= TOUCH || (s.1 - p).length() <= TOUCH
 }
 
-pub struct Grid<'a> {
-    segs: &'a [(DVec2, DVec2)],
+pub struct Grid {
+    segs: Vec<(DVec2, DVec2)>,
     min: DVec2,
     max: DVec2,
     /// Cell sizes (0 along an axis with one cell of zero extent).
@@ -48,11 +47,10 @@ fn margin(p: DVec2) -> f64 {
     1e-9 * (1.0 + p.x.abs().max(p.y.abs()))
 }
 
-impl<'a> Grid<'a> {
-    /// Indexes `segs`; the grid also covers `points` (the places queries will be
-    /// asked from), so every asking point lies inside it. Segments with a
-    /// coordinate that is not finite are left out (they cross nothing).
-    pub fn new(segs: &'a [(DVec2, DVec2)], points: &[DVec2]) -> Grid<'a> {
+impl Grid {
+    /// Indexes `segs` (the grid keeps them). Segments with a coordinate that
+    /// is not finite are left out (they cross nothing).
+    pub fn new(segs: Vec<(DVec2, DVec2)>) -> Grid {
         let finite = |s: &(DVec2, DVec2)| s.0.is_finite() && s.1.is_finite();
         let mut min = DVec2::splat(f64::INFINITY);
         let mut max = DVec2::splat(f64::NEG_INFINITY);
@@ -79,14 +77,9 @@ impl<'a> Grid<'a> {
         if n == 0 {
             return grid;
         }
-        for p in points.iter().filter(|p| p.is_finite()) {
-            min = min.min(*p);
-            max = max.max(*p);
-        }
         let size = max - min;
-        // A few questions about a few segments: a scan of one cell is cheaper
-        // than sorting segments into cells.
-        if points.len() < SCAN_BELOW_ASKS || n < SCAN_BELOW_SEGMENTS || !size.is_finite() {
+        // A few segments: a scan of one cell is cheaper than sorting them into cells.
+        if n < SCAN_BELOW_SEGMENTS || !size.is_finite() {
             return grid.single(min, max);
         }
         // About one cell per segment, and cells at least as long as a mean segment.
@@ -126,7 +119,7 @@ impl<'a> Grid<'a> {
 
     /// One cell holding every finite segment (also when the span is beyond the
     /// range of numbers).
-    fn single(mut self, min: DVec2, max: DVec2) -> Grid<'a> {
+    fn single(mut self, min: DVec2, max: DVec2) -> Grid {
         self.min = min;
         self.max = max;
         self.nx = 1;
@@ -141,35 +134,51 @@ impl<'a> Grid<'a> {
         self
     }
 
-    /// Registers every finite segment in the cells along it (counting sort).
+    /// Registers every finite segment in the cells along it (counting sort:
+    /// one pass counts, one pass places).
     fn fill(&mut self) {
         let cells = self.nx * self.ny;
-        let mut counts = vec![0u32; cells + 1];
+        let mut start = vec![0u32; cells + 1];
         let mut scratch = Vec::new();
-        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(self.segs.len() * 2);
+        self.each_cell(&mut scratch, |c, _| start[c as usize + 1] += 1);
+        for c in 0..cells {
+            start[c + 1] += start[c];
+        }
+        let mut at = start.clone();
+        let mut items = vec![0u32; start[cells] as usize];
+        self.each_cell(&mut scratch, |c, i| {
+            items[at[c as usize] as usize] = i;
+            at[c as usize] += 1;
+        });
+        self.start = start;
+        self.items = items;
+    }
+
+    /// Calls `f(cell, segment)` for every cell of every finite segment. A
+    /// segment within one cell's stride is registered in the cells of its box
+    /// (no margin: queries widen their own boxes), a longer one piece by piece.
+    fn each_cell(&self, scratch: &mut Vec<u32>, mut f: impl FnMut(u32, u32)) {
         for (i, s) in self.segs.iter().enumerate() {
             if !(s.0.is_finite() && s.1.is_finite()) {
                 continue;
             }
-            scratch.clear();
-            self.walk(s.0, s.1, &mut scratch);
-            for &c in &scratch {
-                counts[c as usize] += 1;
-                pairs.push((c, i as u32));
+            let (lo, hi) = (s.0.min(s.1), s.0.max(s.1));
+            if hi.x - lo.x <= self.stride && hi.y - lo.y <= self.stride {
+                let (c0, c1) = (self.col(lo.x), self.col(hi.x));
+                let (r0, r1) = (self.row(lo.y), self.row(hi.y));
+                for r in r0..=r1 {
+                    for c in c0..=c1 {
+                        f((r * self.nx + c) as u32, i as u32);
+                    }
+                }
+            } else {
+                scratch.clear();
+                self.walk(s.0, s.1, scratch);
+                for &c in scratch.iter() {
+                    f(c, i as u32);
+                }
             }
         }
-        let mut start = vec![0u32; cells + 1];
-        for c in 0..cells {
-            start[c + 1] = start[c] + counts[c];
-        }
-        let mut at = start.clone();
-        let mut items = vec![0u32; pairs.len()];
-        for (c, i) in pairs {
-            items[at[c as usize] as usize] = i;
-            at[c as usize] += 1;
-        }
-        self.start = start;
-        self.items = items;
     }
 
     fn col(&self, x: f64) -> usize {
@@ -208,6 +217,11 @@ impl<'a> Grid<'a> {
         } else {
             1
         };
+        if pieces == 1 {
+            // One box: its cells are distinct already.
+            self.boxed(a, b, out);
+            return;
+        }
         let first = out.len();
         for k in 0..pieces {
             let p = a.lerp(b, k as f64 / pieces as f64);
@@ -223,6 +237,16 @@ impl<'a> Grid<'a> {
             }
         }
         out.truncate(w);
+    }
+
+    /// The indexed segments, in their order.
+    pub fn segs(&self) -> &[(DVec2, DVec2)] {
+        &self.segs
+    }
+
+    /// The smallest distance from `p` to the box of the segments.
+    fn box_distance(&self, p: DVec2) -> f64 {
+        (self.min - p).max(p - self.max).max(DVec2::ZERO).length()
     }
 
     fn cell_items(&self, c: u32) -> &[u32] {
@@ -346,13 +370,30 @@ impl<'a> Grid<'a> {
         if dir.length_squared() == 0.0 {
             return None;
         }
-        // One piece when there is one cell; else pieces of a cell's length
-        // until the ray leaves the grid (it starts inside).
-        let (stride, pieces) = if self.stride.is_finite() {
-            let across = (self.max - self.min).length() / self.stride;
+        // The part of the ray inside the grid's box (widened by a margin).
+        let m = DVec2::splat(margin(self.min).max(margin(self.max)) * 16.0);
+        let (lo, hi) = (self.min - m, self.max + m);
+        let (mut enter, mut exit) = (0.0f64, f64::INFINITY);
+        for (o, d, a, b) in [(p.x, dir.x, lo.x, hi.x), (p.y, dir.y, lo.y, hi.y)] {
+            if d == 0.0 {
+                if o < a || o > b {
+                    return None;
+                }
+            } else {
+                let (t0, t1) = ((a - o) / d, (b - o) / d);
+                enter = enter.max(t0.min(t1));
+                exit = exit.min(t0.max(t1));
+            }
+        }
+        if enter.is_nan() || exit.is_nan() || enter > exit || enter > limit {
+            return None;
+        }
+        // One piece when there is one cell; else pieces of a cell's length.
+        let (stride, pieces) = if self.stride.is_finite() && self.nx * self.ny > 1 {
+            let across = (exit.min(limit) - enter) / self.stride;
             (
                 self.stride,
-                (across.ceil() as usize).min(8 * MAX_CELLS_PER_AXIS) + 2,
+                (across.ceil().max(0.0) as usize).min(8 * MAX_CELLS_PER_AXIS) + 2,
             )
         } else {
             (f64::INFINITY, 1)
@@ -361,8 +402,8 @@ impl<'a> Grid<'a> {
         let mut cells = Vec::new();
         let mut cands: Vec<u32> = Vec::new();
         for k in 0..pieces {
-            let t0 = k as f64 * stride;
-            if t0 > limit {
+            let t0 = enter + k as f64 * stride;
+            if t0 > limit || t0 > exit {
                 break;
             }
             let t1 = t0 + stride;
@@ -394,6 +435,51 @@ impl<'a> Grid<'a> {
             // A hit not yet seen lies beyond this piece.
             if best.is_some_and(|(t, _)| t < t1 - margin(p + dir * t1) * 16.0) {
                 break;
+            }
+        }
+        best
+    }
+}
+
+/// The grids of all systems of a guide, in order: segment ids run on from one
+/// system to the next, as if all were one list.
+pub struct Layers<'a> {
+    pub parts: Vec<(usize, &'a Grid)>,
+}
+
+impl Layers<'_> {
+    /// `Grid::first_crossing` over all parts: the lowest id.
+    pub fn first_crossing(&self, p: DVec2, q: DVec2) -> Option<usize> {
+        self.parts
+            .iter()
+            .find_map(|(off, g)| g.first_crossing(p, q).map(|i| off + i))
+    }
+
+    /// `Grid::nearest` over all parts: the closest, then the lowest id.
+    pub fn nearest(&self, p: DVec2) -> Option<(f64, DVec2, usize)> {
+        let mut best: Option<(f64, DVec2, usize)> = None;
+        for (off, g) in &self.parts {
+            if best.is_some_and(|b| g.box_distance(p) > b.0) {
+                continue;
+            }
+            if let Some((d, c, i)) = g.nearest(p)
+                && best.is_none_or(|b| d.total_cmp(&b.0).then((off + i).cmp(&b.2)).is_lt())
+            {
+                best = Some((d, c, off + i));
+            }
+        }
+        best
+    }
+
+    /// `Grid::ray` over all parts: the nearest hit, then the lowest id.
+    pub fn ray(&self, p: DVec2, dir: DVec2, limit: f64) -> Option<(f64, usize)> {
+        let mut best: Option<(f64, usize)> = None;
+        for (off, g) in &self.parts {
+            let lim = best.map_or(limit, |b| b.0);
+            if let Some((t, i)) = g.ray(p, dir, lim)
+                && best.is_none_or(|b| t.total_cmp(&b.0).then((off + i).cmp(&b.1)).is_lt())
+            {
+                best = Some((t, off + i));
             }
         }
         best
@@ -441,8 +527,7 @@ mod tests {
     /// Compares the grid with the scans; returns how many asks found something
     /// (crossing, nearest, ray).
     fn check(segs: &[(DVec2, DVec2)], asks: &[(DVec2, DVec2)]) -> [usize; 3] {
-        let points: Vec<DVec2> = asks.iter().map(|a| a.0).collect();
-        let grid = Grid::new(segs, &points);
+        let grid = Grid::new(segs.to_vec());
         let mut found = [0; 3];
         for &(p, dir) in asks {
             let q = p + dir * 3.0;
@@ -451,6 +536,22 @@ mod tests {
             found[1] += usize::from(grid.nearest(p).is_some());
             found[2] += usize::from(grid.ray(p, dir, f64::INFINITY).is_some());
             assert_eq!(x, scan_crossing(segs, p, q), "{p} {q}");
+            // The same segments in three grids, ids running on.
+            let (a, b) = (segs.len() / 3, 2 * segs.len() / 3);
+            let grids = [
+                Grid::new(segs[..a].to_vec()),
+                Grid::new(segs[a..b].to_vec()),
+                Grid::new(segs[b..].to_vec()),
+            ];
+            let layers = Layers {
+                parts: vec![(0, &grids[0]), (a, &grids[1]), (b, &grids[2])],
+            };
+            assert_eq!(layers.first_crossing(p, q), x);
+            assert_eq!(
+                layers.nearest(p).map(|(d, _, i)| (d, i)),
+                scan_nearest(segs, p)
+            );
+            assert_eq!(layers.ray(p, dir, f64::INFINITY), scan_ray(segs, p, dir));
             assert_eq!(
                 grid.nearest(p).map(|(d, _, i)| (d, i)),
                 scan_nearest(segs, p),
@@ -520,12 +621,14 @@ mod tests {
             .collect();
         segs.extend([s, s]);
         let p = DVec2::new(5.0, 0.0);
-        for asks in [1, 20] {
-            let grid = Grid::new(&segs, &vec![p; asks]);
-            assert_eq!(grid.nx * grid.ny > 1, asks == 20);
-            assert_eq!(grid.first_crossing(p, DVec2::new(5.0, 10.0)), Some(40));
-            assert_eq!(grid.nearest(p).map(|x| x.2), Some(40));
-            assert_eq!(grid.ray(p, DVec2::Y, f64::INFINITY), Some((5.0, 40)));
+        for n in [42, 20] {
+            let grid = Grid::new(segs[40 - (n - 2)..].to_vec());
+            let segs = &segs[40 - (n - 2)..];
+            assert_eq!(grid.nx * grid.ny > 1, n == 42);
+            let first = segs.len() - 2;
+            assert_eq!(grid.first_crossing(p, DVec2::new(5.0, 10.0)), Some(first));
+            assert_eq!(grid.nearest(p).map(|x| x.2), Some(first));
+            assert_eq!(grid.ray(p, DVec2::Y, f64::INFINITY), Some((5.0, first)));
             assert_eq!(grid.ray(p, DVec2::Y, 4.0), None, "beyond the limit");
         }
         // All on one horizontal line, all at one point, empty, not finite.
@@ -546,7 +649,7 @@ mod tests {
             (DVec2::new(f64::NAN, 0.0), DVec2::ONE),
             (DVec2::new(-1e300, 0.0), DVec2::new(1e300, 1.0)),
         ];
-        let g = Grid::new(&wild, &[DVec2::ZERO]);
+        let g = Grid::new(wild);
         assert_eq!(
             g.first_crossing(DVec2::new(0.0, -1.0), DVec2::new(0.0, 2.0)),
             Some(1)

@@ -5,7 +5,7 @@
 
 use super::engine::{self, Cache, Config, GuideRun, Token};
 use super::geometry::{closest_on_segment, crossing, inside, ray_hit, signed_angle};
-use super::index::Grid;
+use super::index::Layers;
 use crate::ast::{File, GuideStmt, Item, LinkStmt, SceneStmt};
 use crate::check::Checked;
 use crate::compile::{self, ExprCompiler, Program};
@@ -275,7 +275,7 @@ fn found(b: bool) -> f64 {
 /// drawn in the guide (None when nothing asks about it).
 pub(crate) fn query(
     scene: &Scene,
-    grid: Option<&Grid>,
+    grid: Option<&Layers>,
     gi: usize,
     name: &str,
     st: &State,
@@ -366,7 +366,7 @@ pub(crate) fn query(
 /// (where a link may hold a token to reserve).
 pub(crate) fn collide(
     scene: &Scene,
-    grid: Option<&Grid>,
+    grid: Option<&Layers>,
     gi: usize,
     st: &State,
     delta: f64,

@@ -261,3 +261,87 @@ fn a_rerun_recomputes_only_the_changed_guide_and_its_dependents() {
     runner.run().expect("runs");
     assert_eq!(runner.recomputed, vec![true, false, false]);
 }
+
+/// The urban layout (Fig. 7): streets leave the middle district through all
+/// four linked edges and grow in every district; in the SVG, every drawn
+/// segment has its middle inside the guide whose layer holds it.
+#[test]
+fn the_urban_layout_fills_every_district_and_keeps_the_centre_rule() {
+    let text = crate::support::read_text(&crate::support::root().join("lang-examples/urban.lsy"));
+    let fe = frontend::run(&text, Vec::new(), &[]);
+    assert!(!fe.has_errors());
+    let checked = fe.checked.as_ref().expect("checked");
+    let opts = lsyc::run::Options::default();
+    let r = lsyc::run::run_scene(&fe.file, checked, None, &opts).expect("runs");
+    assert!(r.outcome.messages >= 12, "{} messages", r.outcome.messages);
+    for (i, l) in r.scene.links.iter().enumerate() {
+        assert!(l.used >= 2, "link {i} carried {} messages", l.used);
+    }
+    let mut svg = Vec::new();
+    let stats = lsyc::run::write_scene(
+        &r,
+        Some(lsyc::run::Format::Svg),
+        Default::default(),
+        0,
+        true,
+        &mut svg,
+    )
+    .unwrap_or_else(|_| panic!("draws"));
+    assert!(stats.segments > 4000, "{} segments", stats.segments);
+    let svg = String::from_utf8(svg).expect("utf-8");
+    // Read back each guide's layer: `<path d="M x y l dx dy …">`, y down.
+    let attr = |line: &str, name: &str| -> Option<String> {
+        let at = line.find(&format!(" {name}=\""))? + name.len() + 3;
+        Some(line[at..].split('"').next()?.to_string())
+    };
+    let nums = |s: &str| -> Vec<DVec2> {
+        let v: Vec<f64> = s
+            .split(|c: char| c.is_whitespace() || c == ',')
+            .filter(|t| !t.is_empty())
+            .map(|t| t.parse().expect("a number"))
+            .collect();
+        v.chunks(2).map(|p| DVec2::new(p[0], -p[1])).collect()
+    };
+    let mut per_guide: std::collections::HashMap<String, usize> = Default::default();
+    let mut guide: Option<usize> = None;
+    for line in svg.lines() {
+        if line.starts_with("<g class=\"guide-content\"") {
+            let name = attr(line, "data-guide").expect("named");
+            guide = r.scene.guides.iter().position(|g| g.name == name);
+            continue;
+        }
+        if line == "</g>" {
+            guide = None;
+        }
+        let (Some(g), true) = (guide, line.starts_with("<path")) else {
+            continue;
+        };
+        let d = attr(line, "d").expect("path data");
+        let (start, steps) = d[1..].split_once('l').expect("M … l …");
+        let mut at = nums(start)[0];
+        let poly = &r.scene.guides[g].polygon;
+        for step in nums(steps) {
+            let m = at + step * 0.5;
+            let on_edge = (0..poly.len()).any(|i| {
+                let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+                (lsyc::env::geometry::closest_on_segment(m, a, b) - m).length() < 0.02
+            });
+            assert!(
+                lsyc::env::geometry::inside(m, poly) || on_edge,
+                "a segment of `{}` ends at {} with its middle {m} outside",
+                r.scene.guides[g].name,
+                at + step
+            );
+            *per_guide.entry(r.scene.guides[g].name.clone()).or_default() += 1;
+            at += step;
+        }
+    }
+    for g in &r.scene.guides {
+        assert!(
+            per_guide.get(&g.name).copied().unwrap_or(0) > 100,
+            "`{}` drew {:?} path steps",
+            g.name,
+            per_guide.get(&g.name)
+        );
+    }
+}

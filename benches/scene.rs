@@ -1,0 +1,84 @@
+//! The whole urban scene of the guided-modeling paper (Fig. 7), at the paper's
+//! size or larger: `lang-examples/urban.lsy` with `-D SIZE=0.95` (over 85,000
+//! street segments, the paper's element count). One iteration is what
+//! `lsyc run urban.lsy` does before writing a file: build the scene, run every
+//! system (derivation, query answers through the spatial index, tokens and
+//! messages), then draw every guide's systems through the centre rule (counting
+//! what is kept). Parsing and checking are outside the timed region.
+//!
+//! Before timing, one run prints its counts (segments, queries, messages,
+//! systems, steps). Timed on rayon's default pool (all cores) and on a
+//! one-thread pool.
+//!
+//! `cargo bench --bench scene`.
+
+use criterion::{Criterion, SamplingMode, criterion_group};
+use lsyc::check::Override;
+use lsyc::frontend;
+use lsyc::run::{self, Options};
+use std::hint::black_box;
+use std::time::Duration;
+
+/// The size of the benchmark's layout (the gallery picture uses the file's 0.25).
+const SIZE: &str = "SIZE=0.95";
+
+fn urban(c: &mut Criterion) {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/lang-examples/urban.lsy");
+    let text = std::fs::read_to_string(path).expect("urban.lsy");
+    let overrides = [Override::parse(SIZE).expect("override")];
+    let fe = frontend::run(&text, Vec::new(), &overrides);
+    assert!(!fe.has_errors(), "urban.lsy has errors");
+    let checked = fe.checked.as_ref().expect("checked");
+    let opts = Options::default();
+    let whole = || {
+        let r = run::run_scene(&fe.file, checked, None, &opts).expect("runs");
+        let stats = run::write_scene(&r, None, Default::default(), 0, false, &mut std::io::sink())
+            .unwrap_or_else(|_| panic!("draws"));
+        (r, stats)
+    };
+    let (r, stats) = whole();
+    eprintln!(
+        "urban {SIZE}: {} segments kept by the centre rule, {} queries, {} messages, {} systems, {} steps, {} modules",
+        stats.segments,
+        stats.queries,
+        stats.messages,
+        r.outcome.instances.len(),
+        stats.steps,
+        stats.modules
+    );
+    let mut g = c.benchmark_group("urban");
+    g.sampling_mode(SamplingMode::Flat)
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(8));
+    g.bench_function("whole scene, all threads", |b| {
+        b.iter(|| black_box(whole()))
+    });
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("pool");
+    g.bench_function("whole scene, 1 thread", |b| {
+        b.iter(|| one.install(|| black_box(whole())))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, urban);
+
+fn main() {
+    eprintln!(
+        "machine: {} threads, {}",
+        std::thread::available_parallelism().map_or(0, |n| n.get()),
+        std::fs::read_to_string("/proc/cpuinfo")
+            .ok()
+            .and_then(|s| {
+                s.lines()
+                    .find(|l| l.starts_with("model name"))
+                    .and_then(|l| l.split(':').nth(1))
+                    .map(|m| m.trim().to_string())
+            })
+            .unwrap_or_else(|| "unknown CPU".into())
+    );
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}
