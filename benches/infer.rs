@@ -42,7 +42,8 @@ impl Rng {
 }
 
 fn drawing(kind: &str, n: usize) -> String {
-    let mut s = String::from(r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="-100 -100 4000 4000">"#);
+    let mut s =
+        String::from(r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="-100 -100 4000 4000">"#);
     let side = |per: usize| ((n as f64 / per as f64).sqrt().ceil() as usize).max(1);
     match kind {
         "grid" => {

@@ -296,7 +296,8 @@ fn text_output_parses_back_as_an_axiom() {
         if s.len() > 20_000 {
             continue;
         }
-        let program = format!("lsystem Again {{ axiom {s}; }}");
+        // After the file itself, so that its declared modules are known.
+        let program = format!("{text}\nlsystem Again {{ axiom {s}; }}");
         let errs = crate::support::parse_errors(&program);
         assert!(
             errs.is_empty(),

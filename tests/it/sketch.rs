@@ -333,12 +333,12 @@ fn the_command_line() {
     );
 
     // Usage errors: exit 2.
-    let (code, msg) = err(&["infer", &path("binary")]);
-    assert!(msg.contains("separate feature"), "{msg}");
+    let (code, msg) = err(&["infer", &path("binary"), "--skeleton", &path("binary")]);
+    assert!(msg.contains("cannot be used with"), "{msg}");
     assert_eq!(code, Some(2));
     let (code, msg2) = err(&["infer"]);
     assert_eq!(code, Some(2));
-    assert!(msg2.contains("separate feature"), "{msg} {msg2}");
+    assert!(msg2.contains("give a drawing"), "{msg} {msg2}");
     let (code, _) = err(&["infer", "--skeleton", &path("binary"), "--epsilon", "-1"]);
     assert_eq!(code, Some(2));
 }

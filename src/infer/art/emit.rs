@@ -22,6 +22,7 @@ use crate::infer::emit::{comment, node, sym, var};
 use crate::infer::strokes::Seg;
 use crate::span::Span;
 use glam::DVec2;
+use std::collections::BTreeMap;
 
 /// What the emitter needs besides the grammar.
 pub struct Settings<'a> {
@@ -109,20 +110,57 @@ fn counted(g: &Grammar, r: usize) -> bool {
     }
 }
 
-/// Derivation steps to expand `s` completely.
-fn steps(g: &Grammar, s: Sym) -> u64 {
+/// Derivation steps to expand `s` completely, as named counts (with their
+/// multiplicities) plus a number, so that `derive` follows `-D` edits of the
+/// counts. `named[r]` is rule `r`'s count constant, if it has one.
+fn steps(g: &Grammar, s: Sym, named: &[Option<String>]) -> (BTreeMap<String, u64>, u64) {
     match s {
-        Sym::Element(_) => 0,
+        Sym::Element(_) => (BTreeMap::new(), 0),
         Sym::Rule(r, m) => match &g.rules[r].body {
             Body::Seq { a, .. } | Body::Branch { a, .. } => {
-                if counted(g, r) {
-                    u64::from(m) + 1 + steps(g, *a)
-                } else {
-                    1 + steps(g, *a)
+                let (mut names, n) = steps(g, *a, named);
+                if !counted(g, r) {
+                    return (names, n + 1);
+                }
+                match &named[r] {
+                    Some(c) => {
+                        *names.entry(c.clone()).or_default() += 1;
+                        (names, n + 1)
+                    }
+                    None => (names, n + 1 + u64::from(m)),
                 }
             }
-            Body::Pair { a, b, .. } => 1 + steps(g, *a).max(steps(g, *b)),
+            Body::Pair { a, b, .. } => {
+                // max(x + y, z + w) ≤ max(x, z) + max(y, w) for counts ≥ 0.
+                let (mut x, n) = steps(g, *a, named);
+                let (y, k) = steps(g, *b, named);
+                for (name, c) in y {
+                    let e = x.entry(name).or_default();
+                    *e = (*e).max(c);
+                }
+                (x, 1 + n.max(k))
+            }
         },
+    }
+}
+
+fn steps_expr(names: BTreeMap<String, u64>, n: u64) -> Expr {
+    let mut out: Option<Expr> = None;
+    for (name, c) in names {
+        let term = if c == 1 {
+            var(&name)
+        } else {
+            bin(BinOp::Mul, Expr::num(c as f64), var(&name))
+        };
+        out = Some(match out {
+            Some(e) => bin(BinOp::Add, e, term),
+            None => term,
+        });
+    }
+    match out {
+        Some(e) if n > 0 => bin(BinOp::Add, e, Expr::num(n as f64)),
+        Some(e) => e,
+        None => Expr::num(n.max(1) as f64),
     }
 }
 
@@ -373,7 +411,7 @@ pub fn program(
     }
 
     // Rules.
-    let mut decls: Vec<Node<Stmt>> = Vec::new();
+    let mut decls: Vec<Node<Item>> = Vec::new();
     let mut rules: Vec<Node<Stmt>> = Vec::new();
     let m = || var("m");
     let m_minus_1 = || bin(BinOp::Sub, var("m"), Expr::num(1.0));
@@ -397,7 +435,7 @@ pub fn program(
     for (r, rule) in g.rules.iter().enumerate() {
         let name = names.rules[r].clone();
         let counted_r = counted(g, r);
-        decls.push(node(Stmt::Module(ModuleDecl {
+        decls.push(node(Item::Module(ModuleDecl {
             name: Ident::new(name.clone()),
             params: if counted_r {
                 vec![Ident::new("m")]
@@ -590,7 +628,7 @@ pub fn program(
 
     // Axiom: from the origin, heading up, to the last instance's frame.
     let mut axiom = Vec::new();
-    let mut derive = 1;
+    let mut derive = Expr::num(1.0);
     if let Some((frame, s)) = g.axiom {
         let origin = Frame {
             pos: DVec2::ZERO,
@@ -621,17 +659,21 @@ pub fn program(
                 Sym::Element(_) => None,
             }
         }));
-        derive = steps(g, s).max(1);
+        let named: Vec<Option<String>> = count_of
+            .iter()
+            .map(|c| match c.as_ref().map(|e| &e.kind) {
+                Some(ExprKind::Var(v)) => Some(v.clone()),
+                _ => None,
+            })
+            .collect();
+        let (names, n) = steps(g, s, &named);
+        derive = steps_expr(names, n);
     }
     let _ = rotate;
 
     let mut stmts: Vec<Node<Stmt>> = Vec::new();
-    stmts.push(node(Stmt::Derive(Expr::num(derive as f64))));
+    stmts.push(node(Stmt::Derive(derive)));
     stmts.push(node(Stmt::Axiom(axiom)));
-    for (k, mut d) in decls.into_iter().enumerate() {
-        d.trivia.blank_before = k == 0;
-        stmts.push(d);
-    }
     stmts.extend(rules);
 
     // Header on the first item.
@@ -647,7 +689,14 @@ pub fn program(
             g.rounds,
             if g.rounds == 1 { "" } else { "s" },
         ),
-        "Edit the constants (or override them: lsyc run -D P1_N=10) to change counts and".into(),
+        match count_of.iter().flatten().next().map(|e| &e.kind) {
+            Some(ExprKind::Var(v)) => format!(
+                "Edit the constants (or override them: lsyc run -D {v}=10) to change counts and"
+            ),
+            _ => {
+                "Edit the constants (or override them with lsyc run -D) to change counts and".into()
+            }
+        },
         "transforms; replace an element's path to draw something else in its place.".into(),
     ];
     let mut first = true;
@@ -668,6 +717,11 @@ pub fn program(
     for (k, mut c) in consts.items.into_iter().enumerate() {
         c.trivia.blank_before = k == 0;
         push_item(c, &mut items);
+    }
+    // Rule modules at the top, so that a derived string reads back as an axiom.
+    for (k, mut d) in decls.into_iter().enumerate() {
+        d.trivia.blank_before = k == 0;
+        push_item(d, &mut items);
     }
     let mut sys = node(Item::Lsystem(Lsystem {
         name: Ident::new(s.name.clone()),
