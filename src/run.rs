@@ -443,10 +443,39 @@ pub fn write_scene(
             let bytes = w.finish().map_err(std::io::Error::other)?;
             out.write_all(&bytes)?;
         }
-        Some(other) => {
-            return Err(OutputError::Io(std::io::Error::other(format!(
-                "{other:?} output of a scene is not available; use .svg or .png"
-            ))));
+        Some(Format::Obj) => {
+            // One mesh for the whole scene: every guide's systems through the
+            // centre rule (tubes sized by the first system's step).
+            let options = r
+                .scene
+                .programs
+                .first()
+                .map(render::obj::ObjOptions::for_program)
+                .unwrap_or_default();
+            let mut w = render::obj::ObjWriter::new(out, options);
+            draw_scene(r, seed, &mut w).map_err(OutputError::Diagnostic)?;
+            w.finish()?;
+        }
+        Some(Format::Txt) => {
+            // Every system's string in the language's syntax, after a comment
+            // saying where it grew; each line reads back as an axiom.
+            for inst in &r.outcome.instances {
+                let g = &r.scene.guides[inst.guide];
+                let prog = &r.scene.programs[g.program];
+                let h = inst.start.h;
+                let heading = (-h.x).atan2(h.y).to_degrees();
+                let round = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
+                writeln!(
+                    out,
+                    "// guide {}, lsystem {}, seeded at ({}, {}) heading {}",
+                    g.name,
+                    prog.name,
+                    round(inst.start.pos.x),
+                    round(inst.start.pos.y),
+                    round(heading)
+                )?;
+                render::txt::write(out, prog, &inst.string)?;
+            }
         }
         None => {}
     }

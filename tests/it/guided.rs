@@ -345,3 +345,51 @@ fn the_urban_layout_fills_every_district_and_keeps_the_centre_rule() {
         );
     }
 }
+
+/// `lsyc run SCENE -o out.obj / out.txt`: the palm as a mesh (clipped by the
+/// centre rule like the pictures) and as text, one system per line after a
+/// comment, each line an axiom again.
+#[test]
+fn scenes_write_obj_and_text() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let palm = crate::support::root().join("lang-examples/palm.lsy");
+    let run = |ext: &str| -> String {
+        let out = dir.path().join(format!("palm.{ext}"));
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_lsyc"))
+            .args(["run", palm.to_str().expect("utf-8"), "-o"])
+            .arg(&out)
+            .output()
+            .expect("runs");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read_to_string(&out).expect("written")
+    };
+    let obj = run("obj");
+    let vertices = obj.lines().filter(|l| l.starts_with("v ")).count();
+    let faces: Vec<&str> = obj.lines().filter(|l| l.starts_with("f ")).collect();
+    assert!(vertices > 100 && faces.len() > 100, "{vertices} vertices");
+    for f in &faces {
+        for idx in f.split_whitespace().skip(1) {
+            let v: usize = idx
+                .split('/')
+                .next()
+                .and_then(|x| x.parse().ok())
+                .expect("index");
+            assert!((1..=vertices).contains(&v), "{f}");
+        }
+    }
+    let txt = run("txt");
+    let lines: Vec<&str> = txt.lines().collect();
+    assert_eq!(lines.len(), 4, "two systems, each a comment and a string");
+    assert_eq!(
+        lines[0],
+        "// guide trunk, lsystem Trunk, seeded at (15, 0) heading 0"
+    );
+    assert!(lines[2].starts_with("// guide crown, lsystem Leaves, seeded at ("));
+    for s in [lines[1], lines[3]] {
+        assert!(s.contains('F'), "{s}");
+        let program =
+            format!("element Blade {{ path \"M0 0 L1 1 Z\"; }}\nlsystem Again {{ axiom {s}; }}");
+        let errs = crate::support::parse_errors(&program);
+        assert!(errs.is_empty(), "{s}");
+    }
+}
