@@ -70,6 +70,11 @@ pub struct Args {
     /// lsystem on its own instead.
     #[arg(long, value_name = "NAME")]
     pub scene: Option<String>,
+
+    /// Draw element NAME as the drawing in an SVG file instead (centred and scaled
+    /// to the element's size, in the drawing's colours); repeatable.
+    #[arg(long = "element", value_name = "NAME=FILE.svg")]
+    pub elements: Vec<String>,
 }
 
 pub fn run(args: &Args, reporter: &Reporter) -> u8 {
@@ -126,9 +131,31 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         ));
         return 2;
     }
-    let fe = frontend::run(&src.text, src.diagnostics.clone(), &ovr);
+    let mut fe = frontend::run(&src.text, src.diagnostics.clone(), &ovr);
     reporter.emit(&fe.diagnostics, &src.name, &src.text);
-    let Some(checked) = fe.checked.as_ref().filter(|_| !fe.has_errors()) else {
+    if fe.has_errors() {
+        return 1;
+    }
+    for spec in &args.elements {
+        let Some((name, file)) = spec.split_once('=') else {
+            reporter.say(&format!(
+                "error: --element {spec}: write NAME=FILE.svg, e.g. --element A=leaf.svg"
+            ));
+            return 2;
+        };
+        let data = match std::fs::read(file) {
+            Ok(d) => d,
+            Err(e) => {
+                reporter.say(&format!("error: cannot read `{file}`: {e}"));
+                return 1;
+            }
+        };
+        if let Err(why) = lsyc::infer::art::replace_element(&mut fe.file, name, &data) {
+            reporter.say(&format!("error: --element {spec}: {why}"));
+            return 1;
+        }
+    }
+    let Some(checked) = fe.checked.as_ref() else {
         return 1;
     };
     let has_scene = fe

@@ -278,3 +278,50 @@ fn bad_drawings_are_clear_errors() {
         );
     }
 }
+
+#[test]
+fn an_element_is_replaced_by_another_drawing() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let prog = dir.path().join("grid.lsy");
+    std::fs::write(&prog, infer(&case("grid"), &Options::default()).text).expect("write");
+    let star = dir.path().join("star.svg");
+    std::fs::write(
+        &star,
+        r##"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100"><path d="M50 5 L61 38 L95 38 L68 59 L78 92 L50 72 L22 92 L32 59 L5 38 L39 38 Z" fill="#e0a800"/></svg>"##,
+    )
+    .expect("write");
+    let out_svg = dir.path().join("stars.svg");
+    let run = |spec: String| {
+        Command::new(env!("CARGO_BIN_EXE_lsyc"))
+            .arg("run")
+            .arg(&prog)
+            .arg("--element")
+            .arg(spec)
+            .arg("-o")
+            .arg(&out_svg)
+            .output()
+            .expect("runs")
+    };
+    let out = run(format!("A={}", star.display()));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Twenty stars where the windows were, each the windows' size.
+    let d = read::read(&std::fs::read(&out_svg).expect("svg")).expect("reads");
+    assert_eq!(d.elements.len(), 20);
+    assert!(
+        d.elements
+            .iter()
+            .all(|e| e.style.fill.as_deref() == Some("#e0a800"))
+    );
+    let first = &d.elements[0];
+    let size = (first.max - first.min).max_element();
+    assert!((6.0..12.0).contains(&size), "{size}");
+    let out = run(format!("Z={}", star.display()));
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no element `Z`"));
+    let out = run("A".into());
+    assert_eq!(out.status.code(), Some(2));
+}

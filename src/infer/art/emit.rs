@@ -308,7 +308,20 @@ fn placed(names: &Names, g: &Grammar, s: Sym, count: Option<Expr>) -> Vec<Module
     }
 }
 
-fn path_data(subpaths: &[Vec<Seg>], origin: DVec2, radius: f64) -> String {
+/// A segment with its points mapped by `f`.
+pub fn map_seg(s: &Seg, f: impl Fn(DVec2) -> DVec2) -> Seg {
+    match *s {
+        Seg::Move(p) => Seg::Move(f(p)),
+        Seg::Line(p) => Seg::Line(f(p)),
+        Seg::Quad(c, p) => Seg::Quad(f(c), f(p)),
+        Seg::Cubic(a, b, p) => Seg::Cubic(f(a), f(b), f(p)),
+        Seg::Close => Seg::Close,
+    }
+}
+
+/// SVG path data for subpaths, relative to `origin`, with about four
+/// significant digits for a shape of `radius`.
+pub fn path_data(subpaths: &[Vec<Seg>], origin: DVec2, radius: f64) -> String {
     let decimals = (3.0 - radius.max(1e-9).log10().floor()).clamp(0.0, 8.0) as i32;
     let k = 10f64.powi(decimals);
     let num = |v: f64| {

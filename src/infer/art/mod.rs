@@ -167,3 +167,71 @@ pub fn from_svg(
         stats,
     })
 }
+
+/// Replaces the path of element `name` in `file` by the drawing in `svg` (all
+/// its shapes as one path), centred where the element's outline is centred and
+/// scaled to the same size, with the drawing's colours: `lsyc run
+/// --element A=leaf.svg`. The error says what is wrong, for a message.
+pub fn replace_element(file: &mut File, name: &str, svg: &[u8]) -> Result<(), String> {
+    use crate::ast::{Item, PropValue};
+    let element = file
+        .items
+        .stmts
+        .iter_mut()
+        .find_map(|i| match &mut i.node {
+            Item::Element(e) if e.name.name == name => Some(e),
+            _ => None,
+        })
+        .ok_or_else(|| format!("the program has no element `{name}`"))?;
+    let old = element
+        .props
+        .stmts
+        .iter()
+        .find_map(|p| match (&p.node.key.name[..], &p.node.value) {
+            ("path", PropValue::Str(d, _)) => Some(d.clone()),
+            _ => None,
+        })
+        .unwrap_or_default();
+    // The old outline, read like a drawing (its y flips, which keeps sizes).
+    let wrapped = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg"><path d="{}"/></svg>"#,
+        crate::render::svg::xml(&old)
+    );
+    let size = |d: &read::Drawing| {
+        let lines: Vec<Vec<glam::DVec2>> =
+            d.elements.iter().flat_map(|e| e.outline.clone()).collect();
+        shape::Shape::of(&lines).map(|s| (s.centroid, s.radius))
+    };
+    let old_size = read::read(wrapped.as_bytes())
+        .ok()
+        .and_then(|d| size(&d))
+        .map_or(1.0, |(_, r)| r);
+    let new = read::read(svg)?;
+    let (centre, radius) = size(&new)
+        .ok_or_else(|| "the drawing has no paths or shapes with an extent".to_string())?;
+    let k = old_size / radius;
+    let mut subpaths = Vec::new();
+    for e in &new.elements {
+        for sub in &e.subpaths {
+            subpaths.push(
+                sub.iter()
+                    .map(|s| emit::map_seg(s, |p| (p - centre) * k))
+                    .collect::<Vec<_>>(),
+            );
+        }
+    }
+    let data = emit::path_data(&subpaths, glam::DVec2::ZERO, old_size);
+    let style = new.elements[0].style.clone();
+    for p in element.props.stmts.iter_mut() {
+        let value = match &p.node.key.name[..] {
+            "path" => Some(data.clone()),
+            "fill" => Some(style.fill.clone().unwrap_or_else(|| "none".into())),
+            "stroke" => style.stroke.clone(),
+            _ => None,
+        };
+        if let (Some(v), PropValue::Str(s, _)) = (value, &mut p.node.value) {
+            *s = v;
+        }
+    }
+    Ok(())
+}
