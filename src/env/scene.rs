@@ -338,8 +338,9 @@ pub(crate) fn query(
         "?H" => Answer::new(&[st.h.x, st.h.y, st.h.z]),
         "?D_L" => nearest(&link_edges()),
         "?D_G" => nearest(&guide_edges()),
+        // Drawn segments have ids after the guide's edges, as for ?N_A and ?X.
         "?D_A" => match grid.and_then(|g| g.nearest(p)) {
-            Some((d, c, i)) => closest(d, c, i),
+            Some((d, c, i)) => closest(d, c, poly.len() + i),
             None => Answer::new(&[0.0; 4]),
         },
         "?N_L" => ahead(first_ahead(&link_edges())),

@@ -393,3 +393,38 @@ fn scenes_write_obj_and_text() {
         assert!(errs.is_empty(), "{s}");
     }
 }
+
+/// ?D_A and ?N_A on hand-checked geometry: a turtle at (5, 7) in a 10 × 10
+/// guide, above a drawn segment from (5, 2) to (5, 5) and a side one from
+/// (7, 5) to (9, 5); ids of drawn segments follow the 4 guide edges.
+#[test]
+fn element_queries_answer_with_ids_after_the_guide_edges() {
+    let text = "
+lsystem Probe {
+    derive 0;
+    axiom F(3) [-(90) f(2) F(2)] f(2) ?D_A(1) -(90) f(2) -(90) ?N_A(1);
+}
+scene S {
+    guide g { polygon (0, 0) (10, 0) (10, 10) (0, 10); system Probe; seed (5, 2) heading 0; }
+}";
+    let (scene, out) = run(text);
+    let inst = &out.instances[0];
+    let prog = &scene.programs[0];
+    let params = |n: usize| -> Vec<f64> {
+        let at: usize = inst.string.syms[..n]
+            .iter()
+            .map(|&s| prog.symbols.arity(s))
+            .sum();
+        inst.string.params[at..at + prog.symbols.arity(inst.string.syms[n])].to_vec()
+    };
+    // The trunk is 2 below, straight behind; it is drawn segment 0: id 4.
+    let d = params(7);
+    assert_eq!(
+        (d[0], d[1], d[2].abs(), d[3]),
+        (1.0, 2.0, 180.0, 4.0),
+        "?D_A {d:?}"
+    );
+    // From (7, 7) looking down, the side segment (drawn segment 1) is 2 ahead.
+    let n = params(11);
+    assert_eq!(n[..3], [1.0, 2.0, 5.0], "?N_A {n:?}");
+}
