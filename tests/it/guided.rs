@@ -428,3 +428,25 @@ scene S {
     let n = params(11);
     assert_eq!(n[..3], [1.0, 2.0, 5.0], "?N_A {n:?}");
 }
+
+/// Units, systems and queries run in parallel; the drawing does not depend on
+/// the number of threads.
+#[test]
+fn the_urban_layout_is_the_same_on_one_or_two_threads() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let urban = crate::support::root().join("lang-examples/urban.lsy");
+    let draw = |threads: &str| -> Vec<u8> {
+        let out = dir.path().join(format!("urban-{threads}.svg"));
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_lsyc"))
+            .args(["run", urban.to_str().expect("utf-8"), "--threads", threads])
+            .args(["--guides", "-o"])
+            .arg(&out)
+            .output()
+            .expect("runs");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(&out).expect("written")
+    };
+    let one = draw("1");
+    assert!(one.len() > 10_000);
+    assert!(one == draw("2"), "the SVGs differ");
+}
