@@ -58,7 +58,15 @@ fn chamfer(a: &[DVec2], b: &[DVec2]) -> f64 {
 /// Infers, checks, runs with the `lsyc` binary, and returns the program and
 /// the Chamfer distance relative to the input's diagonal.
 fn round_trip(name: &str, opts: &Options) -> (String, f64) {
-    let path = root().join(format!("tests/data/infer/{name}.svg"));
+    round_trip_file(
+        &root().join(format!("tests/data/infer/{name}.svg")),
+        name,
+        opts,
+    )
+}
+
+fn round_trip_file(path: &Path, name: &str, opts: &Options) -> (String, f64) {
+    let path = path.to_path_buf();
     let inferred = infer(&path, opts);
     let text = inferred.text;
     let fe = frontend::run(&text, Vec::new(), &[]);
@@ -86,6 +94,12 @@ fn round_trip(name: &str, opts: &Options) -> (String, f64) {
     );
     let input = std::fs::read(&path).expect("input");
     let output = std::fs::read(&back).expect("output");
+    let count = |svg: &[u8]| read::read(svg).expect("reads").elements.len();
+    assert_eq!(
+        count(&output),
+        count(&input),
+        "{name}: every element drawn once"
+    );
     let a0 = samples(&input, 1.0);
     let diag = diagonal(&a0);
     let step = diag / 1500.0;
@@ -324,4 +338,33 @@ fn an_element_is_replaced_by_another_drawing() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("no element `Z`"));
     let out = run("A".into());
     assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn lsyc_drawings_draw_back() {
+    // lsyc's own SVG (elements as `<use>` of shared paths, y flipped, a fitted
+    // viewBox) of gallery programs, inferred and drawn again.
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (prog, define) in [
+        ("scaled-branching", Some("DEPTH=5")),
+        ("sequence-rules", None),
+        ("helix", None),
+        ("palm", None),
+    ] {
+        let svg = dir.path().join(format!("{prog}.svg"));
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_lsyc"));
+        cmd.arg("run")
+            .arg(root().join(format!("lang-examples/{prog}.lsy")));
+        if let Some(d) = define {
+            cmd.args(["-D", d]);
+        }
+        let out = cmd.arg("-o").arg(&svg).output().expect("runs");
+        assert!(
+            out.status.success(),
+            "{prog}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let (_, d) = round_trip_file(&svg, prog, &Options::default());
+        assert!(d <= 1e-3, "{prog}: Chamfer {d:.2e} of the diagonal");
+    }
 }

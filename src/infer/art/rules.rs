@@ -191,6 +191,7 @@ pub fn infer(
         |(lo, hi), i| (lo.min(i.min), hi.max(i.max)),
     );
     let diagonal = (hi - lo).length().max(1e-12);
+    let elements = insts.len() as u64;
     let mut g = Grammar {
         rules: Vec::new(),
         axiom: None,
@@ -202,6 +203,11 @@ pub fn infer(
         progress(live.len());
         if live.len() <= 1 {
             g.axiom = live.first().map(|&i| (insts[i].frame, insts[i].sym));
+            debug_assert_eq!(
+                g.axiom.map_or(0, |(_, s)| g.covered(s)),
+                elements,
+                "every element is drawn exactly once"
+            );
             return g;
         }
         g.rounds += 1;
@@ -430,7 +436,17 @@ fn sequence(
         .collect();
     let t = mean(&used);
     let chains = cut_drift(insts, chains, |_, _| t, tol);
-    seq_candidate(edges, index, chains, t, None, phi)
+    let mut cand = seq_candidate(edges, index, chains, t, None, phi)?;
+    if !same {
+        // Across two kinds the chains are pairs: A T B.
+        if let Plan::Seq { chains, t, .. } = cand.plan {
+            cand.plan = Plan::Pair {
+                pairs: chains.iter().map(|c| (c[0], c[1])).collect(),
+                t,
+            };
+        }
+    }
+    Some(cand)
 }
 
 /// Splits chains where redrawing with `step(chain position, chain length)`
@@ -940,5 +956,19 @@ fn pair_up(g: &mut Grammar, insts: &mut Vec<Inst>, edges: &[Edge]) {
                 t: e.t,
             },
         );
+    }
+}
+
+impl Grammar {
+    /// How many elements `s` draws.
+    pub fn covered(&self, s: Sym) -> u64 {
+        match s {
+            Sym::Element(_) => 1,
+            Sym::Rule(r, m) => match &self.rules[r].body {
+                Body::Seq { a, .. } => (u64::from(m) + 1) * self.covered(*a),
+                Body::Branch { a, .. } => ((1u64 << (m + 1).min(62)) - 1) * self.covered(*a),
+                Body::Pair { a, b, .. } => self.covered(*a) + self.covered(*b),
+            },
+        }
     }
 }
