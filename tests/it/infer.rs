@@ -162,6 +162,22 @@ fn recovered_counts_and_transforms_are_the_generators() {
     assert_eq!(constant(&grid, "P1_STEP"), 13.0);
     assert_eq!(constant(&grid, "P2_N"), 3.0);
     assert_eq!(constant(&grid, "P2_STEP"), 10.0);
+    // Weighting only proximity groups the nearer neighbours first: the
+    // columns (10 apart) before the rows (13 apart).
+    let near = Options {
+        weights: art::rules::Weights {
+            n: 0.0,
+            h: 1.0,
+            phi: 0.0,
+            l: 0.0,
+        },
+        ..Options::default()
+    };
+    let cols = infer(&case("grid"), &near).text;
+    assert!(
+        cols.contains("R1_STEP1 = 10;") || cols.contains("P1_STEP = 10;"),
+        "{cols}"
+    );
     // The helix (Fig. 9): 60 leaves, scale 0.993 and 8.5° per step.
     let helix = infer(&case("helix"), &o).text;
     assert_eq!(constant(&helix, "P1_N"), 59.0);
