@@ -304,15 +304,12 @@ fn draw_scene(
     for (gi, g) in r.scene.guides.iter().enumerate() {
         let prog = &r.scene.programs[g.program];
         for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
-            let mut clip = crate::env::scene::Clip {
-                polygon: &g.polygon,
-                inner: &mut *sink,
-                kept: 0,
-                removed: 0,
-            };
-            let d = turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
+            // Counts and bounds of what the centre rule keeps.
+            let mut clip = crate::env::scene::Clip::new(&g.polygon, &mut *sink);
+            turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
                 .map_err(|e| runtime_diagnostic(&e, prog))?;
-            total.segments += clip.kept;
+            let d = clip.kept;
+            total.segments += d.segments;
             total.elements += d.elements;
             total.polygons += d.polygons;
             if let Some(b) = d.bbox {
@@ -390,12 +387,7 @@ pub fn write_scene(
                 w.begin_guide(names[gi]);
                 let prog = &r.scene.programs[g.program];
                 for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
-                    let mut clip = crate::env::scene::Clip {
-                        polygon: &g.polygon,
-                        inner: &mut w,
-                        kept: 0,
-                        removed: 0,
-                    };
+                    let mut clip = crate::env::scene::Clip::new(&g.polygon, &mut w);
                     turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
                         .map_err(|e| OutputError::Diagnostic(runtime_diagnostic(&e, prog)))?;
                 }

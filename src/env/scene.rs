@@ -11,7 +11,7 @@ use crate::check::Checked;
 use crate::compile::{self, ExprCompiler, Program};
 use crate::derive::{Limits, ModString};
 use crate::diagnostic::{Code, Diagnostic};
-use crate::turtle::{Sink, State};
+use crate::turtle::{Drawn, Sink, State};
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
 
@@ -394,18 +394,41 @@ pub(crate) fn collide(
 }
 
 /// Forwards to `inner` only what lies inside the guide by the centre rule: a
-/// segment or element whose centre is outside its guide is removed.
+/// segment, element or polygon whose centre is outside its guide is removed.
+/// `kept` counts what went through (and its bounding box, as the turtle's
+/// `Drawn` has it: segment ends, polygon points, element origins).
 pub struct Clip<'a> {
     pub polygon: &'a [DVec2],
     pub inner: &'a mut dyn Sink,
-    pub kept: u64,
+    pub kept: Drawn,
     pub removed: u64,
+}
+
+impl<'a> Clip<'a> {
+    pub fn new(polygon: &'a [DVec2], inner: &'a mut dyn Sink) -> Clip<'a> {
+        Clip {
+            polygon,
+            inner,
+            kept: Drawn::default(),
+            removed: 0,
+        }
+    }
+
+    fn grow(&mut self, p: DVec3) {
+        let b = self.kept.bbox.get_or_insert([p.x, p.y, p.x, p.y]);
+        b[0] = b[0].min(p.x);
+        b[1] = b[1].min(p.y);
+        b[2] = b[2].max(p.x);
+        b[3] = b[3].max(p.y);
+    }
 }
 
 impl Sink for Clip<'_> {
     fn segment(&mut self, a: DVec3, b: DVec3, w: f64, c: u32) {
         if inside(((a + b) * 0.5).truncate(), self.polygon) {
-            self.kept += 1;
+            self.kept.segments += 1;
+            self.grow(a);
+            self.grow(b);
             self.inner.segment(a, b, w, c);
         } else {
             self.removed += 1;
@@ -414,12 +437,19 @@ impl Sink for Clip<'_> {
     fn polygon(&mut self, pts: &[DVec3], c: u32) {
         let centre = pts.iter().fold(DVec3::ZERO, |s, &p| s + p) / pts.len().max(1) as f64;
         if inside(centre.truncate(), self.polygon) {
+            self.kept.polygons += 1;
+            for &p in pts {
+                self.grow(p);
+            }
             self.inner.polygon(pts, c);
+        } else {
+            self.removed += 1;
         }
     }
     fn element(&mut self, i: u16, at: DVec3, h: DVec3, l: DVec3, s: f64, c: u32) {
         if inside((at + h * (0.5 * s)).truncate(), self.polygon) {
-            self.kept += 1;
+            self.kept.elements += 1;
+            self.grow(at);
             self.inner.element(i, at, h, l, s, c);
         } else {
             self.removed += 1;

@@ -450,3 +450,26 @@ fn the_urban_layout_is_the_same_on_one_or_two_threads() {
     assert!(one.len() > 10_000);
     assert!(one == draw("2"), "the SVGs differ");
 }
+
+/// `--stats` of a scene counts what the centre rule keeps: segments and
+/// elements apart, and the box of the kept geometry only.
+#[test]
+fn scene_stats_count_what_the_centre_rule_keeps() {
+    let text = "
+element Dot { path \"M-1 0 L1 0 L0 2 Z\"; }
+lsystem Grow { derive 0; axiom F(4) [+(90) f(20) Dot] [-(90) F(30)] Dot; }
+scene S {
+    guide g { polygon (0, 0) (10, 0) (10, 10) (0, 10); system Grow; seed (5, 2) heading 0; }
+}";
+    let fe = frontend::run(text, Vec::new(), &[]);
+    assert!(!fe.has_errors());
+    let checked = fe.checked.as_ref().expect("checked");
+    let r = lsyc::run::run_scene(&fe.file, checked, None, &Default::default()).expect("runs");
+    let stats =
+        lsyc::run::write_scene(&r, None, Default::default(), 0, false, &mut std::io::sink())
+            .unwrap_or_else(|_| panic!("draws"));
+    // Kept: F(4) from (5, 2) to (5, 6) and the Dot at (5, 6). Removed: the Dot
+    // at (-15, 6) and the F(30) whose middle is at (20, 6).
+    assert_eq!((stats.segments, stats.elements), (1, 1));
+    assert_eq!(stats.bbox, Some([5.0, 2.0, 5.0, 6.0]));
+}
