@@ -60,6 +60,10 @@ pub struct Args {
     #[arg(long, value_name = "J", conflicts_with = "skeleton")]
     pub jitter: Option<f64>,
 
+    /// Art: a mirror image of an element is that element mirrored (one outline draws both).
+    #[arg(long, conflicts_with = "skeleton")]
+    pub reflect: bool,
+
     /// Art: print what was found (elements, kinds, clusters, rules, time per phase) as JSON on stderr.
     #[arg(long)]
     pub stats: bool,
@@ -79,6 +83,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     };
     let mut opts = art::Options {
         symmetrize: args.symmetrize,
+        reflect: args.reflect,
         ..art::Options::default()
     };
     if !(args.similarity.is_finite() && args.similarity > 0.0 && args.similarity < 1.0) {

@@ -124,6 +124,7 @@ const EXACT: &[&str] = &[
     "clutter",
     "mixed-skip",
     "noisy-grid",
+    "mirrored",
 ];
 
 #[test]
@@ -383,4 +384,23 @@ fn lsyc_drawings_draw_back() {
         let (_, d) = round_trip_file(&svg, prog, &Options::default());
         assert!(d <= 1e-3, "{prog}: Chamfer {d:.2e} of the diagonal");
     }
+}
+
+#[test]
+fn reflect_makes_mirror_images_one_outline() {
+    let plain = infer(&case("mirrored"), &Options::default()).text;
+    assert!(
+        plain.contains("// B: 4 in the drawing; drawn as element 2"),
+        "{plain}"
+    );
+    let opts = Options {
+        reflect: true,
+        ..Options::default()
+    };
+    let (text, d) = round_trip("mirrored", &opts);
+    assert!(
+        text.contains("// B: 4 in the drawing; A mirrored."),
+        "{text}"
+    );
+    assert!(d <= 1e-3, "Chamfer {d:.2e} of the diagonal");
 }

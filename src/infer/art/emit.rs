@@ -380,9 +380,22 @@ pub fn program(
     for (k, kind) in inst.kinds.iter().enumerate() {
         let e = &elements[kind.representative];
         let sh = &inst.shapes[kind.representative];
+        // A mirror kind draws its twin's outline with x negated.
+        let subpaths: Vec<Vec<Seg>> = match kind.mirror_of {
+            Some(_) => e
+                .subpaths
+                .iter()
+                .map(|sub| {
+                    sub.iter()
+                        .map(|s| map_seg(s, |p| DVec2::new(2.0 * sh.centroid.x - p.x, p.y)))
+                        .collect()
+                })
+                .collect(),
+            None => e.subpaths.clone(),
+        };
         let mut props = vec![string_prop(
             "path",
-            path_data(&e.subpaths, sh.centroid + kind.origin, sh.radius),
+            path_data(&subpaths, sh.centroid + kind.origin, sh.radius),
         )];
         props.push(string_prop(
             "fill",
@@ -410,15 +423,21 @@ pub fn program(
             1 => String::new(),
             n => format!(", {n}-fold symmetric"),
         };
+        let drawn = match kind.mirror_of {
+            Some(twin) => format!("{} mirrored", names.elements[twin]),
+            None => format!(
+                "drawn as element {}{} of the drawing, centred",
+                e.number,
+                if e.id.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (id `{}`)", e.id)
+                }
+            ),
+        };
         item.trivia.leading.push(comment(format!(
-            "{}: {count} in the drawing{sym_note}; drawn as element {}{} of the drawing, centred.",
-            names.elements[k],
-            e.number,
-            if e.id.is_empty() {
-                String::new()
-            } else {
-                format!(" (id `{}`)", e.id)
-            }
+            "{}: {count} in the drawing{sym_note}; {drawn}.",
+            names.elements[k]
         )));
         element_items.push(item);
     }

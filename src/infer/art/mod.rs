@@ -33,6 +33,8 @@ pub struct Options {
     pub similarity: f64,
     /// Random variation of repeated transforms (see `emit::Settings::jitter`).
     pub jitter: Option<f64>,
+    /// Mirror images of a kind become its mirror kind, drawn from one outline.
+    pub reflect: bool,
 }
 
 impl Default for Options {
@@ -42,6 +44,7 @@ impl Default for Options {
             symmetrize: false,
             similarity: 0.02,
             jitter: None,
+            reflect: false,
         }
     }
 }
@@ -125,7 +128,7 @@ pub fn from_svg(
     } else {
         opts.similarity
     };
-    let mut inst = shape::instancing(&drawing.elements, similarity);
+    let mut inst = shape::instancing(&drawing.elements, similarity, opts.reflect);
     origin::find(&mut inst, tol);
     stats.kinds = inst.kinds.len();
     stats.instancing_ms = ms(t);

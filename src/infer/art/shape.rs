@@ -260,6 +260,9 @@ pub struct Kind {
     /// The local frame's origin relative to the representative's centroid
     /// (see `origin`): zero unless the drawing shows a better one.
     pub origin: DVec2,
+    /// `Some(k)`: this kind is kind `k` mirrored (x negated in its local
+    /// frame), found with `--reflect`; it shares `k`'s representative.
+    pub mirror_of: Option<usize>,
 }
 
 /// Where an instance of a kind sits: its representative's frame mapped there.
@@ -318,7 +321,21 @@ pub struct Instancing {
 
 /// Groups elements into kinds. `tolerance` is the largest mean misfit,
 /// relative to the element's radius, of two alike elements.
-pub fn instancing(elements: &[Element], tolerance: f64) -> Instancing {
+/// The shape mirrored about the vertical line through its centroid.
+fn mirrored(sh: &Shape) -> Option<Shape> {
+    let lines: Vec<Vec<DVec2>> = sh
+        .outline
+        .iter()
+        .map(|l| {
+            l.iter()
+                .map(|p| sh.centroid + DVec2::new(-p.x, p.y))
+                .collect()
+        })
+        .collect();
+    Shape::of(&lines)
+}
+
+pub fn instancing(elements: &[Element], tolerance: f64, reflect: bool) -> Instancing {
     let shapes: Vec<Shape> = elements
         .iter()
         .map(|e| {
@@ -337,6 +354,8 @@ pub fn instancing(elements: &[Element], tolerance: f64) -> Instancing {
         })
         .collect();
     let mut kinds: Vec<Kind> = Vec::new();
+    // Each kind's representative outline (mirrored for a mirror kind).
+    let mut kind_shapes: Vec<Shape> = Vec::new();
     let mut of: Vec<(usize, Frame)> = Vec::with_capacity(elements.len());
     // Choices of rotation for instances of symmetric kinds.
     let mut choices: Vec<Vec<f64>> = Vec::with_capacity(elements.len());
@@ -348,15 +367,41 @@ pub fn instancing(elements: &[Element], tolerance: f64) -> Instancing {
             if r.style.key() != e.style.key() || r.subpaths.len() != e.subpaths.len() {
                 continue;
             }
-            let fits = shapes[kind.representative].align(sh, tolerance);
+            let fits = kind_shapes[k].align(sh, tolerance);
             if !fits.is_empty() {
                 found = Some((k, fits));
                 break;
             }
         }
+        if found.is_none() && reflect {
+            // A mirror image of a kind that has no mirror kind yet.
+            for k in 0..kinds.len() {
+                let r = &elements[kinds[k].representative];
+                if kinds[k].mirror_of.is_some()
+                    || kinds.iter().any(|m| m.mirror_of == Some(k))
+                    || r.style.key() != e.style.key()
+                    || r.subpaths.len() != e.subpaths.len()
+                {
+                    continue;
+                }
+                let Some(m) = mirrored(&kind_shapes[k]) else {
+                    continue;
+                };
+                let fits = m.align(sh, tolerance);
+                if !fits.is_empty() {
+                    kinds.push(Kind {
+                        mirror_of: Some(k),
+                        ..kinds[k].clone()
+                    });
+                    kind_shapes.push(m);
+                    found = Some((kinds.len() - 1, fits));
+                    break;
+                }
+            }
+        }
         match found {
             Some((k, fits)) => {
-                let rep = &shapes[kinds[k].representative];
+                let rep = &kind_shapes[k];
                 let best = fits[0].1;
                 let variants: Vec<f64> = fits
                     .iter()
@@ -382,7 +427,9 @@ pub fn instancing(elements: &[Element], tolerance: f64) -> Instancing {
                     representative: i,
                     symmetry,
                     origin: DVec2::ZERO,
+                    mirror_of: None,
                 });
+                kind_shapes.push(sh.clone());
                 of.push((
                     kinds.len() - 1,
                     Frame {
