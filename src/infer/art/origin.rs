@@ -67,6 +67,49 @@ impl Sim {
     }
 }
 
+/// Moves `q` so that, in frames with their origin at `q`, the steps i → j and
+/// j → l of each run are as equal as they can be.
+fn refine(frames: &[Frame], runs: &[[usize; 3]], mut q: DVec2, radius: f64) -> DVec2 {
+    let residuals = |q: DVec2| -> Vec<f64> {
+        let at = |f: &Frame| f.pos + rotate(q, f.rot) * f.scale;
+        runs.iter()
+            .map(|&[i, j, l]| {
+                let (a, b, c) = (at(&frames[i]), at(&frames[j]), at(&frames[l]));
+                a.distance(b) / frames[i].scale - b.distance(c) / frames[j].scale
+            })
+            .collect()
+    };
+    let h = radius * 1e-4;
+    for _ in 0..10 {
+        let r = residuals(q);
+        let rx = residuals(q + DVec2::new(h, 0.0));
+        let ry = residuals(q + DVec2::new(0.0, h));
+        // Normal equations of the 2-parameter linear least squares.
+        let (mut a, mut b, mut c, mut gx, mut gy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for k in 0..r.len() {
+            let (jx, jy) = ((rx[k] - r[k]) / h, (ry[k] - r[k]) / h);
+            a += jx * jx;
+            b += jx * jy;
+            c += jy * jy;
+            gx += jx * r[k];
+            gy += jy * r[k];
+        }
+        let det = a * c - b * b;
+        if det.abs() < 1e-18 {
+            break;
+        }
+        let step = DVec2::new(c * gx - b * gy, -b * gx + a * gy) / det;
+        if !step.is_finite() || step.length() > radius {
+            break;
+        }
+        q -= step;
+        if step.length() < radius * 1e-7 {
+            break;
+        }
+    }
+    q
+}
+
 /// Neighbours looked at per instance: the two nearest, the ones a chain
 /// passes through (a ring's farther members would vote for its centre).
 const NEIGHBOURS: usize = 2;
@@ -84,7 +127,7 @@ pub fn find(inst: &mut Instancing, tol: Tolerance) {
         let points: Vec<DVec2> = frames.iter().map(|f| f.pos).collect();
         let grid = Grid::new(&points);
         let cell = 0.02 * radius;
-        let mut votes: Vec<(Point, Sim)> = Vec::new();
+        let mut votes: Vec<(Point, Sim, [usize; 3])> = Vec::new();
         for j in 0..frames.len() {
             let near = grid.nearest(points[j], NEIGHBOURS + 1);
             for &i in &near {
@@ -99,7 +142,11 @@ pub fn find(inst: &mut Instancing, tol: Tolerance) {
                         if let Some((q, delta)) = m.pivot(tol)
                             && q.length() < 20.0 * radius
                         {
-                            votes.push(([q.x / cell, q.y / cell, delta / tol.angle, 0.0], m));
+                            votes.push((
+                                [q.x / cell, q.y / cell, delta / tol.angle, 0.0],
+                                m,
+                                [i, j, l],
+                            ));
                         }
                     }
                 }
@@ -144,6 +191,15 @@ pub fn find(inst: &mut Instancing, tol: Tolerance) {
         if q.length() < 0.05 * radius {
             continue;
         }
+        // Refine: the step of a linear sequence is constant in the right frame,
+        // so minimise the differences of consecutive steps (Gauss–Newton).
+        let runs: Vec<[usize; 3]> = votes
+            .iter()
+            .zip(&label)
+            .filter(|(_, l)| **l == top)
+            .map(|(v, _)| v.2)
+            .collect();
+        let q = refine(&frames, &runs, q, radius);
         inst.kinds[k].origin = q;
         for &i in &members {
             let f = &mut inst.of[i].1;
