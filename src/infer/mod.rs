@@ -76,6 +76,21 @@ pub enum InferError {
     TooManyElements { file: String, elements: usize },
 }
 
+/// For a drawing's file name: the name the header gives (the file's own name)
+/// and the lsystem's name (from its stem: `sketch-tree.svg` → `SketchTree`).
+pub fn names(name: &str) -> (String, String) {
+    let path = std::path::Path::new(name);
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let source = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| name.to_string());
+    (source, emit::system_name(&stem))
+}
+
 /// A sketch and what was inferred from it.
 pub struct Inferred {
     pub skeleton: Skeleton,
@@ -112,18 +127,10 @@ pub fn skeleton_from_svg(data: &[u8], name: &str, opts: &Options) -> Result<Infe
         limit: d.limit,
     })?;
     let analysis = Analysis::new(&sk.children());
-    let path = std::path::Path::new(name);
-    let stem = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let source = path
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| name.to_string());
+    let (source, system) = names(name);
     let settings = emit::Settings {
         source: &source,
-        name: emit::system_name(&stem),
+        name: system,
         strokes: strokes.len(),
         numbers: strokes.iter().map(|s| s.number).collect(),
         seed_3d: opts.three_d.then_some(opts.seed),

@@ -589,23 +589,7 @@ pub fn program(
                     None,
                 );
             }
-            Body::Seq { a, t, .. } => {
-                // Used only as a pair: P -> A T A.
-                let (va, vd, vs, vb) = Round::new(1.0, scale_units(t)).values(t);
-                let mut succ = placed(&names, g, *a, child_count(*a));
-                succ.extend(transform(
-                    Part::Value(va),
-                    Part::Value(vd),
-                    Part::Value(vs),
-                    Part::Value(vb),
-                ));
-                succ.push(module_of(&names, g, *a, child_count(*a)));
-                add_rule(
-                    None,
-                    succ,
-                    Some(format!("{name}: two {} (a pair)", describe(&names, *a))),
-                );
-            }
+
             Body::Branch { a, t, u } => {
                 let n = run(g, r);
                 let (ta, td, ts, tb) = named_parts(&mut consts, t, "1", n);
@@ -634,7 +618,12 @@ pub fn program(
                     None,
                 );
             }
-            Body::Pair { a, t, b } => {
+            // A sequence used only with m = 1 is the pair P -> A T A.
+            Body::Seq { a, t, .. } | Body::Pair { a, t, b: _ } => {
+                let b = match &rule.body {
+                    Body::Pair { b, .. } => *b,
+                    _ => *a,
+                };
                 let (va, vd, vs, vb) = Round::new(1.0, scale_units(t)).values(t);
                 let mut succ = placed(&names, g, *a, child_count(*a));
                 succ.extend(transform(
@@ -643,16 +632,13 @@ pub fn program(
                     Part::Value(vs),
                     Part::Value(vb),
                 ));
-                succ.push(module_of(&names, g, *b, child_count(*b)));
-                add_rule(
-                    None,
-                    succ,
-                    Some(format!(
-                        "{name}: {} and {} (a pair)",
-                        describe(&names, *a),
-                        describe(&names, *b)
-                    )),
-                );
+                succ.push(module_of(&names, g, b, child_count(b)));
+                let what = if b == *a {
+                    format!("two {}", describe(&names, *a))
+                } else {
+                    format!("{} and {}", describe(&names, *a), describe(&names, b))
+                };
+                add_rule(None, succ, Some(format!("{name}: {what} (a pair)")));
             }
         }
     }

@@ -145,18 +145,10 @@ pub fn from_svg(
     stats.clusters = grammar.clusters;
     stats.rules_ms = ms(t);
     let t = Instant::now();
-    let path = std::path::Path::new(name);
-    let stem = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let source = path
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| name.to_string());
+    let (source, system) = super::names(name);
     let settings = emit::Settings {
         source: &source,
-        name: super::emit::system_name(&stem),
+        name: system,
         symmetrize: opts.symmetrize,
         jitter: opts.jitter,
     };
