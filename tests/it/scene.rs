@@ -377,3 +377,36 @@ fn the_spiral_sends_branches_that_grow_lateral_spirals() {
         assert_eq!(l.used, 1, "every link's token is used");
     }
 }
+
+#[test]
+fn the_dinosaur_grows_from_the_legs_through_every_guide() {
+    let (layers, stats) = draw("lang-examples/dinosaur.lsy", None);
+    // Four legs seed the body; the body the neck and the tail; then guide by guide
+    // to the head and the tip of the tail: every link's one token is used.
+    assert_eq!(stats["messages"], 11);
+    let r = run_scene(
+        &std::fs::read_to_string(root().join("lang-examples/dinosaur.lsy")).expect("dinosaur"),
+    );
+    assert!(r.scene.links.iter().all(|l| l.used == 1));
+    for g in &r.scene.guides {
+        assert!(
+            !layers.segments(&g.name).is_empty(),
+            "nothing grew in `{}`",
+            g.name
+        );
+    }
+    // Leafy where the paper puts leaves: the body, the head and the tail's tip.
+    for (guide, least) in [("body", 300), ("head", 20), ("tip", 20)] {
+        let n = layers.centres.get(guide).map_or(0, Vec::len);
+        assert!(n >= least, "{guide}: {n} leaves");
+    }
+    // A stem goes up each leg from the ground to the body (y = 100).
+    for leg in ["leg1", "leg2", "leg3", "leg4"] {
+        let top = layers
+            .segments(leg)
+            .iter()
+            .map(|(a, b)| a.y.max(b.y))
+            .fold(f64::MIN, f64::max);
+        assert!(top > 95.0, "{leg}: the stem ends at y = {top}");
+    }
+}
