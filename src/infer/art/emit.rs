@@ -12,7 +12,7 @@
 
 use super::read::Element;
 use super::rules::{Body, Grammar, Sym};
-use super::shape::{Frame, Instancing, rotate};
+use super::shape::{Frame, Instancing};
 use super::space::Tr;
 use crate::ast::{
     BinOp, Block, ConstDecl, Element as ElementItem, Expr, ExprKind, File, Ident, Item, Lsystem,
@@ -363,14 +363,7 @@ fn describe(names: &Names, s: Sym) -> String {
 }
 
 /// The program for a grammar.
-pub fn program(
-    elements: &[Element],
-    inst: &Instancing,
-    g: &Grammar,
-    s: &Settings,
-    seconds: Option<f64>,
-) -> File {
-    let _ = seconds;
+pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Settings) -> File {
     let names = Names::new(inst.kinds.len(), g);
     let mut consts = Consts { items: Vec::new() };
     let mut items: Vec<Node<Item>> = Vec::new();
@@ -642,7 +635,6 @@ pub fn program(
             }
         }
     }
-    let _ = m;
 
     // Axiom: from the origin, heading up, to the last instance's frame.
     let mut axiom = Vec::new();
@@ -687,7 +679,6 @@ pub fn program(
         let (names, n) = steps(g, s, &named);
         derive = steps_expr(names, n);
     }
-    let _ = rotate;
 
     let mut stmts: Vec<Node<Stmt>> = Vec::new();
     stmts.push(node(Stmt::Derive(derive)));

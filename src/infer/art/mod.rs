@@ -152,7 +152,7 @@ pub fn from_svg(
         symmetrize: opts.symmetrize,
         jitter: opts.jitter,
     };
-    let file = emit::program(&drawing.elements, &inst, &grammar, &settings, None);
+    let file = emit::program(&drawing.elements, &inst, &grammar, &settings);
     let text = crate::fmt::format_file(&file);
     stats.emit_ms = ms(t);
     Ok(Inferred {
