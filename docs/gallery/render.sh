@@ -1,12 +1,31 @@
 #!/usr/bin/env bash
 # Renders every gallery program to docs/gallery/NAME.png with lsyc itself.
-# Scenes (files with a `scene`) are drawn with their guides' outlines.
+# Scenes (files with a `scene`) are drawn with their guides' outlines; a file's
+# first scene is NAME.png, each further scene NAME-SCENE.png (lower case).
+# Edited scenes (Guided Procedural Modeling, Figs. 1 and 9b) are edited with
+# `lsyc edit` into a temporary file and drawn to NAME-edited.png.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 cargo build --release --quiet
+lsyc=./target/release/lsyc
 for f in lang-examples/*.lsy; do
     name=$(basename "$f" .lsy)
     extra=()
     grep -q '^scene ' "$f" && extra=(--guides)
-    ./target/release/lsyc run "$f" -o "docs/gallery/$name.png" --size 480 "${extra[@]}"
+    "$lsyc" run "$f" -o "docs/gallery/$name.png" --size 480 "${extra[@]}"
+    for scene in $(grep '^scene ' "$f" | tail -n +2 | cut -d' ' -f2); do
+        lower=$(echo "$scene" | tr '[:upper:]' '[:lower:]')
+        "$lsyc" run "$f" --scene "$scene" -o "docs/gallery/$name-$lower.png" --size 480 --guides
+    done
 done
+
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+edited() {
+    local name=$1
+    shift
+    "$lsyc" edit "lang-examples/$name.lsy" "$@" >"$tmp/$name.lsy"
+    "$lsyc" run "$tmp/$name.lsy" -o "docs/gallery/$name-edited.png" --size 480 --guides
+}
+# Fig. 1 b–c: two clusters scaled up and the top of the crown raised, the trunk held.
+edited tree --pin trunk --scale clusterR2=1.3 --scale clusterL2=1.3 --by top.v4=0,30 --by top.v5=0,30

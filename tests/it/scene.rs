@@ -195,14 +195,16 @@ fn svg_layers_per_guide() {
 /// segments of its paths, the centres of its elements and of its polygons, and
 /// its outline (all in the scene's coordinates, +y up).
 #[derive(Default)]
-struct Layers {
-    outlines: HashMap<String, Vec<DVec2>>,
-    segments: HashMap<String, Vec<(DVec2, DVec2)>>,
-    centres: HashMap<String, Vec<DVec2>>,
+pub(crate) struct Layers {
+    pub(crate) outlines: HashMap<String, Vec<DVec2>>,
+    pub(crate) segments: HashMap<String, Vec<(DVec2, DVec2)>>,
+    pub(crate) centres: HashMap<String, Vec<DVec2>>,
+    /// Per guide, the axis (base to tip, unit) of each element it printed.
+    pub(crate) axes: HashMap<String, Vec<DVec2>>,
 }
 
 impl Layers {
-    fn segments(&self, guide: &str) -> &[(DVec2, DVec2)] {
+    pub(crate) fn segments(&self, guide: &str) -> &[(DVec2, DVec2)] {
         self.segments.get(guide).map_or(&[], Vec::as_slice)
     }
 }
@@ -263,7 +265,9 @@ fn read_layers(svg: &str) -> Layers {
             let t = attr(line, "transform").expect("transform");
             let m = numbers(&t["matrix(".len()..t.len() - 1]);
             let centre = DVec2::new(m[4] + 0.5 * m[2], -(m[5] + 0.5 * m[3]));
-            layers.centres.entry(g).or_default().push(centre);
+            layers.centres.entry(g.clone()).or_default().push(centre);
+            let axis = DVec2::new(m[2], -m[3]).normalize_or_zero();
+            layers.axes.entry(g).or_default().push(axis);
         } else if line.starts_with("<polygon") {
             let pts = points(attr(line, "points").expect("points"));
             let c = pts.iter().fold(DVec2::ZERO, |s, &p| s + p) / pts.len() as f64;
@@ -273,8 +277,9 @@ fn read_layers(svg: &str) -> Layers {
     layers
 }
 
-/// Runs `lsyc run FILE --scene NAME -o OUT.svg --guides --stats`.
-fn draw(file: &str, scene: Option<&str>) -> (Layers, serde_json::Value) {
+/// Runs `lsyc run FILE --scene NAME -o OUT.svg --guides --stats` (FILE relative
+/// to the repository, or absolute).
+pub(crate) fn draw(file: &str, scene: Option<&str>) -> (Layers, serde_json::Value) {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("scene.svg");
     let mut args = vec![
@@ -305,46 +310,128 @@ fn inside_or_on(p: DVec2, poly: &[DVec2]) -> bool {
         || (0..n).any(|i| (closest_on_segment(p, poly[i], poly[(i + 1) % n]) - p).length() < 0.02)
 }
 
-/// Every scene of every gallery file: each drawn segment has its middle, and
-/// each element and polygon its centre, inside the guide that drew it.
+/// The scenes of a program, by name, in the order written.
+fn scene_names(text: &str) -> Vec<String> {
+    text.lines()
+        .filter_map(|l| l.strip_prefix("scene "))
+        .filter_map(|l| l.split_whitespace().next())
+        .map(str::to_string)
+        .collect()
+}
+
+/// Each drawn segment has its middle, and each element and polygon its centre,
+/// inside the guide that drew it.
+pub(crate) fn assert_centre_rule(layers: &Layers, what: &str) {
+    for (guide, segs) in &layers.segments {
+        let poly = &layers.outlines[guide];
+        for (a, b) in segs {
+            let m = (*a + *b) * 0.5;
+            assert!(
+                inside_or_on(m, poly),
+                "{what}: the segment {a} – {b} of `{guide}` has its middle outside"
+            );
+        }
+    }
+    for (guide, centres) in &layers.centres {
+        let poly = &layers.outlines[guide];
+        for c in centres {
+            assert!(
+                inside_or_on(*c, poly),
+                "{what}: an element of `{guide}` has its centre {c} outside"
+            );
+        }
+    }
+}
+
+/// Every scene of every gallery file keeps the centre rule.
 #[test]
 fn the_centre_rule_holds_in_every_gallery_scene() {
     let mut scenes = 0;
     for path in crate::support::lsy_files(&["lang-examples"]) {
         let text = crate::support::read_text(&path);
         let file = crate::support::rel(&path);
-        for name in text
-            .lines()
-            .filter_map(|l| l.strip_prefix("scene "))
-            .filter_map(|l| l.split_whitespace().next())
-        {
+        for name in scene_names(&text) {
             scenes += 1;
-            let (layers, stats) = draw(&file, Some(name));
+            let (layers, stats) = draw(&file, Some(&name));
             let drawn: usize = layers.segments.values().map(Vec::len).sum();
             assert!(drawn > 0, "{file} {name}: nothing drawn");
             assert!(stats["segments"].as_u64().unwrap_or(0) > 0, "{file} {name}");
-            for (guide, segs) in &layers.segments {
-                let poly = &layers.outlines[guide];
-                for (a, b) in segs {
-                    let m = (*a + *b) * 0.5;
-                    assert!(
-                        inside_or_on(m, poly),
-                        "{file} {name}: the segment {a} – {b} of `{guide}` has its middle outside"
-                    );
-                }
-            }
-            for (guide, centres) in &layers.centres {
-                let poly = &layers.outlines[guide];
-                for c in centres {
-                    assert!(
-                        inside_or_on(*c, poly),
-                        "{file} {name}: an element of `{guide}` has its centre {c} outside"
-                    );
-                }
-            }
+            assert_centre_rule(&layers, &format!("{file} {name}"));
         }
     }
     assert!(scenes >= 2, "{scenes} scenes");
+}
+
+/// The guides of each scene of a program that hold an explicit seed.
+fn seeded_guides(text: &str) -> HashMap<String, Vec<String>> {
+    let mut out: HashMap<String, Vec<String>> = HashMap::new();
+    let (mut scene, mut guide) = (String::new(), String::new());
+    for line in text.lines().map(str::trim) {
+        if let Some(rest) = line.strip_prefix("scene ") {
+            scene = rest.split_whitespace().next().unwrap_or("").to_string();
+            out.entry(scene.clone()).or_default();
+        } else if let Some(rest) = line.strip_prefix("guide ") {
+            guide = rest.split_whitespace().next().unwrap_or("").to_string();
+        } else if line.starts_with("seed ") {
+            out.entry(scene.clone()).or_default().push(guide.clone());
+        }
+    }
+    out
+}
+
+/// `lsyc edit` works on every gallery scene: dragging a vertex of one guide (the
+/// first by name that holds no seed), with the seeded guides pinned as the roots
+/// of the model, gives a program that checks, runs, still grows in every guide
+/// that grew before, and keeps the centre rule.
+#[test]
+fn every_gallery_scene_can_be_edited() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for path in crate::support::lsy_files(&["lang-examples"]) {
+        let text = crate::support::read_text(&path);
+        let file = crate::support::rel(&path);
+        let seeded = seeded_guides(&text);
+        for name in scene_names(&text) {
+            let (before, _) = draw(&file, Some(&name));
+            let mut guides: Vec<&String> = before.outlines.keys().collect();
+            guides.sort();
+            let pinned = &seeded[&name];
+            let moved = guides
+                .iter()
+                .find(|g| !pinned.contains(g))
+                .unwrap_or(&guides[0]);
+            let mut args = vec!["edit".to_string(), file.clone(), "--scene".to_string()];
+            args.push(name.clone());
+            args.extend(["--by".to_string(), format!("{moved}.v0=4,3")]);
+            for g in pinned.iter().filter(|g| g != moved) {
+                args.extend(["--pin".to_string(), g.clone()]);
+            }
+            let o = std::process::Command::new(env!("CARGO_BIN_EXE_lsyc"))
+                .args(&args)
+                .current_dir(root())
+                .output()
+                .expect("runs");
+            let what = args[1..].join(" ");
+            assert!(
+                o.status.success(),
+                "lsyc {what}: {}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+            let edited = dir.path().join(format!("{name}.lsy"));
+            std::fs::write(&edited, &o.stdout).expect("write");
+            let (after, _) = draw(edited.to_str().expect("utf-8"), Some(&name));
+            assert_ne!(
+                before.outlines[*moved], after.outlines[*moved],
+                "lsyc {what}: `{moved}` did not change"
+            );
+            for (g, segs) in &before.segments {
+                assert!(
+                    segs.is_empty() || !after.segments(g).is_empty(),
+                    "lsyc {what}: nothing grows in `{g}` any more"
+                );
+            }
+            assert_centre_rule(&after, &format!("lsyc {what}"));
+        }
+    }
 }
 
 #[test]
@@ -409,4 +496,110 @@ fn the_dinosaur_grows_from_the_legs_through_every_guide() {
             .fold(f64::MIN, f64::max);
         assert!(top > 95.0, "{leg}: the stem ends at y = {top}");
     }
+}
+
+#[test]
+fn the_guided_tree_grows_from_the_trunk_through_the_limbs_into_the_crown() {
+    let (layers, stats) = draw("lang-examples/tree.lsy", None);
+    // The trunk seeds four limbs and the top; each limb its cluster.
+    assert_eq!(stats["messages"], 9);
+    assert_eq!(stats["systems"], 10);
+    // About as many elements as the paper's tree (15,000).
+    let elements = stats["segments"].as_u64().expect("segments")
+        + stats["elements"].as_u64().expect("elements");
+    assert!((10_000..20_000).contains(&elements), "{elements} elements");
+    for (g, outline) in &layers.outlines {
+        let segs = layers.segments(g);
+        assert!(segs.len() >= 10, "`{g}`: {} segments", segs.len());
+        let leaves = layers.centres.get(g).map_or(0, Vec::len);
+        if g == "trunk" || g.starts_with("limb") {
+            assert_eq!(leaves, 0, "`{g}` is bare wood");
+        } else {
+            assert!(leaves >= 100, "`{g}`: {leaves} leaves");
+        }
+        // A limb runs from its base to the far end of its guide.
+        if g.starts_with("limb") {
+            let far = |p: DVec2| p.x.abs();
+            let reach = segs.iter().map(|(_, b)| far(*b)).fold(0.0, f64::max);
+            let end = outline.iter().map(|p| far(*p)).fold(0.0, f64::max);
+            assert!(reach > end - 15.0, "`{g}` reaches {reach} of {end}");
+        }
+    }
+}
+
+#[test]
+fn the_single_tree_fills_its_guide_and_its_leaves_hang() {
+    let (layers, stats) = draw("lang-examples/tree.lsy", Some("Single"));
+    assert_eq!(stats["systems"], 1);
+    assert_eq!(stats["messages"], 0);
+    let outline = &layers.outlines["tree"];
+    let segs = layers.segments("tree");
+    // The crown takes the guide's shape: it spans most of the guide's width.
+    let span = |xs: &mut dyn Iterator<Item = f64>| {
+        let (lo, hi) = xs.fold((f64::MAX, f64::MIN), |(l, h), x| (l.min(x), h.max(x)));
+        hi - lo
+    };
+    let guide_width = span(&mut outline.iter().map(|p| p.x));
+    let crown_width = span(&mut segs.iter().flat_map(|(a, b)| [a.x, b.x]));
+    assert!(
+        crown_width > 0.8 * guide_width,
+        "the crown is {crown_width} wide in a guide {guide_width} wide"
+    );
+    // Leaves only far enough from the root (13 segments of 7 up a straight trunk
+    // of 7 segments: none below the trunk's top).
+    let centres = &layers.centres["tree"];
+    assert!(centres.len() > 1000, "{} leaves", centres.len());
+    assert!(centres.iter().all(|c| c.y > 50.0));
+    // Leaves bend downward: far more of them point down than the shoots that carry
+    // them, which all grow upward or sideways from the trunk.
+    let axes = &layers.axes["tree"];
+    let down = axes.iter().filter(|a| a.y < 0.0).count() as f64 / axes.len() as f64;
+    let shoots_down = segs.iter().filter(|(a, b)| b.y < a.y).count() as f64 / segs.len() as f64;
+    assert!(
+        down > shoots_down + 0.2,
+        "{down:.2} of the leaves point down, {shoots_down:.2} of the segments"
+    );
+}
+
+/// The paper's Fig. 1 b–c: scaling two clusters up (the trunk held) re-grows
+/// them larger; every message still arrives.
+#[test]
+fn scaling_clusters_of_the_guided_tree_grows_them_larger() {
+    let (before, _) = draw("lang-examples/tree.lsy", None);
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_lsyc"))
+        .args([
+            "edit",
+            "lang-examples/tree.lsy",
+            "--pin",
+            "trunk",
+            "--scale",
+            "clusterR2=1.3",
+            "--scale",
+            "clusterL2=1.3",
+        ])
+        .current_dir(root())
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let dir = tempfile::tempdir().expect("tempdir");
+    let edited = dir.path().join("tree.lsy");
+    std::fs::write(&edited, &o.stdout).expect("write");
+    let (after, stats) = draw(edited.to_str().expect("utf-8"), None);
+    assert_eq!(stats["messages"], 9);
+    assert_eq!(before.outlines["trunk"], after.outlines["trunk"], "pinned");
+    // The clusters grow over a larger area (their shoots are as long as before,
+    // but fewer of them stop at the edge).
+    let extent = |segs: &[(DVec2, DVec2)]| {
+        let pts = segs.iter().flat_map(|(a, b)| [*a, *b]);
+        let (lo, hi) = pts.fold((DVec2::MAX, DVec2::MIN), |(l, h), p| (l.min(p), h.max(p)));
+        hi - lo
+    };
+    for g in ["clusterR2", "clusterL2"] {
+        let (b, a) = (extent(before.segments(g)), extent(after.segments(g)));
+        assert!(
+            a.x > 1.1 * b.x && a.y > 1.1 * b.y,
+            "`{g}`: {b} across, then {a}"
+        );
+    }
+    assert_centre_rule(&after, "the edited tree");
 }
