@@ -6,9 +6,12 @@
 //! messages), then draw every guide's systems through the centre rule (counting
 //! what is kept). Parsing and checking are outside the timed region.
 //!
-//! Before timing, one run prints its counts (segments, queries, messages,
-//! systems, steps). Timed on rayon's default pool (all cores) and on a
-//! one-thread pool.
+//! Also the guided tree of the paper (Fig. 1, `lang-examples/tree.lsy`: about
+//! 15,000 elements, segments and leaves; the paper took 2 s for it).
+//!
+//! Before timing, one run prints its counts (segments, elements, queries,
+//! messages, systems, steps). Timed on rayon's default pool (all cores) and on
+//! a one-thread pool.
 //!
 //! `cargo bench --bench scene`.
 
@@ -22,12 +25,16 @@ use std::time::Duration;
 /// The size of the benchmark's layout (the gallery picture uses the file's 0.25).
 const SIZE: &str = "SIZE=0.95";
 
-fn urban(c: &mut Criterion) {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/lang-examples/urban.lsy");
-    let text = std::fs::read_to_string(path).expect("urban.lsy");
-    let overrides = [Override::parse(SIZE).expect("override")];
-    let fe = frontend::run(&text, Vec::new(), &overrides);
-    assert!(!fe.has_errors(), "urban.lsy has errors");
+/// Times one scene of a gallery file, whole, as `lsyc run` runs it.
+fn scene(c: &mut Criterion, group: &str, file: &str, overrides: &[&str]) {
+    let path = format!("{}/lang-examples/{file}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).expect("the gallery file");
+    let parsed: Vec<Override> = overrides
+        .iter()
+        .map(|o| Override::parse(o).expect("override"))
+        .collect();
+    let fe = frontend::run(&text, Vec::new(), &parsed);
+    assert!(!fe.has_errors(), "{file} has errors");
     let checked = fe.checked.as_ref().expect("checked");
     let opts = Options::default();
     let whole = || {
@@ -38,15 +45,17 @@ fn urban(c: &mut Criterion) {
     };
     let (r, stats) = whole();
     eprintln!(
-        "urban {SIZE}: {} segments kept by the centre rule, {} queries, {} messages, {} systems, {} steps, {} modules",
+        "{group} {}: {} segments and {} elements kept by the centre rule, {} queries, {} messages, {} systems, {} steps, {} modules",
+        overrides.join(" "),
         stats.segments,
+        stats.elements,
         stats.queries,
         stats.messages,
         r.outcome.instances.len(),
         stats.steps,
         stats.modules
     );
-    let mut g = c.benchmark_group("urban");
+    let mut g = c.benchmark_group(group);
     g.sampling_mode(SamplingMode::Flat)
         .sample_size(10)
         .measurement_time(Duration::from_secs(8));
@@ -63,7 +72,15 @@ fn urban(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, urban);
+fn urban(c: &mut Criterion) {
+    scene(c, "urban", "urban.lsy", &[SIZE]);
+}
+
+fn tree(c: &mut Criterion) {
+    scene(c, "tree", "tree.lsy", &[]);
+}
+
+criterion_group!(benches, urban, tree);
 
 fn main() {
     eprintln!(
