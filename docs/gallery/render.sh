@@ -29,3 +29,6 @@ edited() {
 }
 # Fig. 1 b–c: two clusters scaled up and the top of the crown raised, the trunk held.
 edited tree --pin trunk --scale clusterR2=1.3 --scale clusterL2=1.3 --by top.v4=0,30 --by top.v5=0,30
+# Fig. 9b: two cable vertices dragged down, the deck and the towers held; the hangers
+# regrow at the same spacing.
+edited bridge --by main1.v2=0,-30 --by main8.v3=0,-30 --pin deck --pin towerL --pin towerR

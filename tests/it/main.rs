@@ -1,5 +1,6 @@
 //! All integration tests, in one binary so that `cargo test` links once.
 
+mod bridge;
 mod cli;
 mod corpus;
 mod diagnostics;
