@@ -745,12 +745,17 @@ fn answer(
             continue; // it will not draw again: no reservation
         }
         for c in crossings {
-            let free = scene.links.iter().enumerate().position(|(i, link)| {
-                link.from == (l.guide, c.edge)
-                    && used[i] as usize + l.reserved.iter().filter(|r| r.link == i).count()
-                        < link.tokens as usize
-            });
-            if let Some(link) = free {
+            // Every link that starts at the crossed edge and has a free token (an
+            // edge may fan out to several guides), in scene order.
+            let free: Vec<usize> = (0..scene.links.len())
+                .filter(|&i| {
+                    let link = &scene.links[i];
+                    link.from == (l.guide, c.edge)
+                        && used[i] as usize + l.reserved.iter().filter(|r| r.link == i).count()
+                            < link.tokens as usize
+                })
+                .collect();
+            for link in free {
                 l.run.tokens.push(TokenEvent {
                     step: t,
                     link,
@@ -764,7 +769,7 @@ fn answer(
                     module: c.module,
                     from: c.from,
                     dir: c.dir,
-                    pass: c.pass,
+                    pass: c.pass.clone(),
                 });
             }
         }

@@ -131,6 +131,43 @@ fn a_crossing_sends_a_message_that_seeds_the_end_guide() {
     assert_eq!(r.outcome.instances.len(), 1);
 }
 
+/// An edge that starts several links fans out: one crossing uses a free token of
+/// each and seeds every end guide, each at the crossing point projected onto its
+/// own end edge, with its own link's heading; a link without a free token sends
+/// nothing.
+#[test]
+fn a_crossing_of_an_edge_with_several_links_seeds_each_end_guide() {
+    let text = LINKED.replace("TOKENS", "1");
+    let text = text.replace(
+        "    link a.edge(2)",
+        "    guide c { polygon (0, 10) (10, 10) (4, 30) (0, 30); system Side; }
+    guide e { polygon (0, 10) (10, 10) (10, 30); system Side; }
+    link a.edge(2) -> c.edge(0) { tokens 1; heading -45; }
+    link a.edge(2) -> e.edge(0) { tokens 0; }
+    link a.edge(2)",
+    );
+    let r = run_scene(&text);
+    assert_eq!(r.outcome.messages, 2);
+    let mut seeded: Vec<&Instance> = r.outcome.instances.iter().skip(1).collect();
+    seeded.sort_by_key(|i| i.guide);
+    // Guides b and c, not e (its link has no token).
+    let guides: Vec<usize> = seeded.iter().map(|i| i.guide).collect();
+    assert_eq!(guides, vec![1, 2]);
+    for inst in &seeded {
+        assert!(
+            (inst.start.pos - glam::DVec3::new(5.0, 10.0, 0.0)).length() < 1e-9,
+            "{:?}",
+            inst.start.pos
+        );
+        assert_eq!(params_of(&r, inst, 0), vec![7.0]);
+    }
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    assert!((seeded[0].start.h - glam::DVec3::new(-1.0, 0.0, 0.0)).length() < 1e-12);
+    assert!((seeded[1].start.h - glam::DVec3::new(h, h, 0.0)).length() < 1e-12);
+    let used: Vec<u32> = r.scene.links.iter().map(|l| l.used).collect();
+    assert_eq!(used, vec![1, 0, 1]);
+}
+
 #[test]
 fn scenes_end_and_repeat() {
     let text = std::fs::read_to_string(root().join("lang-examples/palm.lsy")).expect("palm");
