@@ -303,9 +303,10 @@ fn draw_scene(
     let mut total = Drawn::default();
     for (gi, g) in r.scene.guides.iter().enumerate() {
         let prog = &r.scene.programs[g.program];
+        let centres = crate::env::scene::element_centres(prog);
         for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
             // Counts and bounds of what the centre rule keeps.
-            let mut clip = crate::env::scene::Clip::new(&g.polygon, &mut *sink);
+            let mut clip = crate::env::scene::Clip::new(&g.polygon, &centres, &mut *sink);
             turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
                 .map_err(|e| runtime_diagnostic(&e, prog))?;
             let d = clip.kept;
@@ -386,8 +387,9 @@ pub fn write_scene(
             for (gi, g) in r.scene.guides.iter().enumerate() {
                 w.begin_guide(names[gi]);
                 let prog = &r.scene.programs[g.program];
+                let centres = crate::env::scene::element_centres(prog);
                 for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
-                    let mut clip = crate::env::scene::Clip::new(&g.polygon, &mut w);
+                    let mut clip = crate::env::scene::Clip::new(&g.polygon, &centres, &mut w);
                     turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
                         .map_err(|e| OutputError::Diagnostic(runtime_diagnostic(&e, prog)))?;
                 }

@@ -2,7 +2,7 @@
 # Renders every gallery program to docs/gallery/NAME.png with lsyc itself.
 # Scenes (files with a `scene`) are drawn with their guides' outlines; a file's
 # first scene is NAME.png, each further scene NAME-SCENE.png (lower case).
-# Edited scenes (Guided Procedural Modeling, Figs. 1 and 9b) are edited with
+# Edited scenes (Guided Procedural Modeling, Figs. 1, 4 and 9b) are edited with
 # `lsyc edit` into a temporary file and drawn to NAME-edited.png.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -27,6 +27,9 @@ edited() {
     "$lsyc" edit "lang-examples/$name.lsy" "$@" >"$tmp/$name.lsy"
     "$lsyc" run "$tmp/$name.lsy" -o "docs/gallery/$name-edited.png" --size 480 --guides
 }
+# Fig. 4 b–c: the top of the trunk dragged to the right, its lower guides held; the
+# leaves, snapped to the trunk's top, follow.
+edited palm --by trunk3.v2=30,-5 --by trunk3.v3=30,-5 --pin trunk1 --pin trunk2
 # Fig. 1 b–c: two clusters scaled up and the top of the crown raised, the trunk held.
 edited tree --pin trunk --scale clusterR2=1.3 --scale clusterL2=1.3 --by top.v4=0,30 --by top.v5=0,30
 # Fig. 9b: two cable vertices dragged down, the deck and the towers held; the hangers

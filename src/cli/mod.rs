@@ -19,7 +19,7 @@ Examples:
   lsyc run lang-examples/koch-island.lsy -o koch.svg
   lsyc run lang-examples/plant-e.lsy -o plant.png --stats
   lsyc run lang-examples/palm.lsy -o palm.svg --guides
-  lsyc edit lang-examples/palm.lsy --by crown.v2=-40,20 --write
+  lsyc edit lang-examples/palm.lsy --by trunk3.v2=30,-5 --pin trunk2 --write
   lsyc infer art.svg -o art.lsy
   lsyc infer --skeleton sketch.svg -o tree.lsy
   lsyc check lang-examples/koch-island.lsy
@@ -81,7 +81,7 @@ pub enum Command {
     Infer(infer::Args),
     /// Edit a scene's guides with a mass-spring system: drag vertices, move, rotate, scale guides.
     #[command(
-        after_help = "Examples:\n  lsyc edit palm.lsy --move trunk.v2=40,310\n  lsyc edit palm.lsy --by crown.v1=20,0 --pin trunk\n  lsyc edit palm.lsy --translate crown=10,0 --rotate crown=15 --write"
+        after_help = "Examples:\n  lsyc edit palm.lsy --move frond4.v4=100,480 --pin trunk1\n  lsyc edit palm.lsy --by trunk3.v2=30,-5 --pin trunk2\n  lsyc edit palm.lsy --pin trunk1 --translate frond1=10,0 --rotate frond1=15 --write"
     )]
     Edit(edit::Args),
 }

@@ -393,21 +393,47 @@ pub(crate) fn collide(
     (Answer::new(&[0.0, 0.0]), None)
 }
 
+/// The centre of every element of `prog` in its local frame (`outline_centre`).
+pub fn element_centres(prog: &Program) -> Vec<DVec2> {
+    prog.elements
+        .iter()
+        .map(|e| outline_centre(&e.path))
+        .collect()
+}
+
+/// The centre of an element's path data in its local frame (x right, y along the
+/// heading): the middle of its outline's bounding box, or the origin for a path
+/// that encloses nothing.
+pub fn outline_centre(path: &str) -> DVec2 {
+    crate::render::obj::outline_from_path(path)
+        .and_then(|o| {
+            let mut pts = o.points.iter().map(|&[x, y]| DVec2::new(x, y));
+            let first = pts.next()?;
+            let (lo, hi) = pts.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)));
+            Some((lo + hi) * 0.5)
+        })
+        .unwrap_or(DVec2::ZERO)
+}
+
 /// Forwards to `inner` only what lies inside the guide by the centre rule: a
-/// segment, element or polygon whose centre is outside its guide is removed.
+/// segment, element or polygon whose centre is outside its guide is removed (an
+/// element's centre is that of its outline, placed and scaled as it is drawn).
 /// `kept` counts what went through (and its bounding box, as the turtle's
 /// `Drawn` has it: segment ends, polygon points, element origins).
 pub struct Clip<'a> {
     pub polygon: &'a [DVec2],
+    /// Per element index, its local centre (`element_centres`).
+    pub centres: &'a [DVec2],
     pub inner: &'a mut dyn Sink,
     pub kept: Drawn,
     pub removed: u64,
 }
 
 impl<'a> Clip<'a> {
-    pub fn new(polygon: &'a [DVec2], inner: &'a mut dyn Sink) -> Clip<'a> {
+    pub fn new(polygon: &'a [DVec2], centres: &'a [DVec2], inner: &'a mut dyn Sink) -> Clip<'a> {
         Clip {
             polygon,
+            centres,
             inner,
             kept: Drawn::default(),
             removed: 0,
@@ -447,7 +473,10 @@ impl Sink for Clip<'_> {
         }
     }
     fn element(&mut self, i: u16, at: DVec3, h: DVec3, l: DVec3, s: f64, c: u32) {
-        if inside((at + h * (0.5 * s)).truncate(), self.polygon) {
+        let local = self.centres.get(i as usize).copied().unwrap_or(DVec2::ZERO);
+        // Local +x is -l, local +y is h.
+        let centre = at + (h * local.y - l * local.x) * s;
+        if inside(centre.truncate(), self.polygon) {
             self.kept.elements += 1;
             self.grow(at);
             self.inner.element(i, at, h, l, s, c);

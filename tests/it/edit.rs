@@ -210,30 +210,64 @@ fn write_rewrites_the_file_atomically() {
 
 #[test]
 fn the_palm_of_the_gallery_can_be_edited() {
+    // Fig. 4 b: the top of the trunk dragged to the right, the trunk's lower guides
+    // held; the leaves' guides share the top's vertices and follow it.
     let r = lsyc(&[
         "edit",
         "lang-examples/palm.lsy",
-        "--move",
-        "trunk.v2=40,310",
+        "--by",
+        "trunk3.v2=30,-5",
+        "--by",
+        "trunk3.v3=30,-5",
         "--pin",
-        "trunk.v0",
+        "trunk1",
         "--pin",
-        "trunk.v1",
+        "trunk2",
     ]);
     assert_eq!(r.status, 0, "{}", r.stderr);
     let source = std::fs::read_to_string(root().join("lang-examples/palm.lsy")).expect("palm");
     assert_comments_kept(&source, &r.stdout);
-    // The gallery file changes as the scene grows; check what the edit promises.
+    // The gallery file changes as the scene grows; check what the edit promises:
+    // the two vertices moved by exactly what was asked, the pinned guides kept.
+    let polygon = |text: &str, guide: &str| -> String {
+        let at = text.find(&format!("guide {guide} {{")).expect("the guide");
+        let line = text[at..].lines().nth(1).expect("its polygon").trim();
+        line.to_string()
+    };
+    for g in ["trunk1", "trunk2"] {
+        assert_eq!(polygon(&source, g), polygon(&r.stdout, g), "{g}");
+    }
+    let before = numbers(&polygon(&source, "trunk3"));
+    let after = numbers(&polygon(&r.stdout, "trunk3"));
+    assert_eq!(before[..4], after[..4], "the bottom is snapped to trunk2");
+    for (k, (b, a)) in before[4..].iter().zip(&after[4..]).enumerate() {
+        let by = if k % 2 == 0 { 30.0 } else { -5.0 };
+        assert!((a - b - by).abs() < 0.051, "{before:?} -> {after:?}");
+    }
+    // Every leaf's base is the trunk's top edge: each leaf moved with it.
+    for k in 1..=8 {
+        let leaf = numbers(&polygon(&r.stdout, &format!("frond{k}")));
+        let mut base = [leaf[0], leaf[1], leaf[2], leaf[3]];
+        if base[0] > base[2] {
+            base = [base[2], base[3], base[0], base[1]];
+        }
+        assert_eq!(base, [after[6], after[7], after[4], after[5]], "frond{k}");
+    }
     assert!(
-        r.stdout.contains("polygon (0, 0) (30, 0) (40, 310)"),
-        "{}",
-        r.stdout
-    );
-    assert!(
-        r.stderr.contains("changed trunk (2 vertices)"),
+        r.stderr
+            .contains("changed trunk3 (2 vertices), frond1 (10 vertices)"),
         "{}",
         r.stderr
     );
+}
+
+/// The numbers of a `polygon (x, y) …;` line.
+fn numbers(line: &str) -> Vec<f64> {
+    line.trim_start_matches("polygon")
+        .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+        .filter(|t| !t.is_empty())
+        .map(|t| t.parse().expect("a number"))
+        .collect()
 }
 
 fn error(args: &[&str], status: i32) -> String {

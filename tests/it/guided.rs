@@ -379,13 +379,18 @@ fn scenes_write_obj_and_text() {
     }
     let txt = run("txt");
     let lines: Vec<&str> = txt.lines().collect();
-    assert_eq!(lines.len(), 4, "two systems, each a comment and a string");
+    assert_eq!(
+        lines.len(),
+        22,
+        "eleven systems, each a comment and a string"
+    );
     assert_eq!(
         lines[0],
-        "// guide trunk, lsystem Trunk, seeded at (15, 0) heading 0"
+        "// guide trunk1, lsystem Trunk, seeded at (0, 0) heading -18.4"
     );
-    assert!(lines[2].starts_with("// guide crown, lsystem Leaves, seeded at ("));
-    for s in [lines[1], lines[3]] {
+    assert!(lines[2].starts_with("// guide trunk2, lsystem Trunk, seeded at ("));
+    assert!(lines[6].starts_with("// guide frond1, lsystem Leaves, seeded at ("));
+    for s in lines.iter().skip(1).step_by(2) {
         assert!(s.contains('F'), "{s}");
         let program =
             format!("element Blade {{ path \"M0 0 L1 1 Z\"; }}\nlsystem Again {{ axiom {s}; }}");

@@ -88,6 +88,35 @@ scene S {
     // F(4) is inside; the branch F(20) to the left has its centre at x = -5 (out);
     // the last F(20) from y = 6 to 26 has its centre at y = 16 (out).
     assert_eq!(stats.segments, 1);
+    // An element is kept by the centre of its outline, placed and scaled as drawn:
+    // a leaf 10 long whose centre is 5 up its axis and 2 to its right.
+    let text = "
+element Leaf { path \"M0 0 L4 5 L0 10 Z\"; }
+lsystem Grow { derive 0; axiom LEAF; }
+scene S {
+    guide g { polygon (0, 0) (10, 0) (10, 10) (0, 10); system Grow; seed AT heading HEADING; }
+}";
+    let kept = |leaf: &str, at: &str, heading: &str| {
+        let program = text
+            .replace("LEAF", leaf)
+            .replace("AT", at)
+            .replace("HEADING", heading);
+        let r = run_scene(&program);
+        run::write_scene(&r, None, Default::default(), 0, false, &mut std::io::sink())
+            .unwrap_or_else(|_| panic!("draws"))
+            .elements
+    };
+    // Up from (5, 2): the centre (7, 7) is inside; scaled by 2, (9, 12) is not.
+    assert_eq!(kept("Leaf", "(5, 2)", "0"), 1);
+    assert_eq!(kept("*(2) Leaf", "(5, 2)", "0"), 0);
+    // Its right side counts: up from (9, 2) the centre is (11, 7), out; from
+    // (1, 2) it is (3, 7), in.
+    assert_eq!(kept("Leaf", "(9, 2)", "0"), 0);
+    assert_eq!(kept("Leaf", "(1, 2)", "0"), 1);
+    // Turned left (the axis along -x, its right side up): from (8, 9) the centre
+    // is (3, 11), out; from (8, 1) it is (3, 3), in.
+    assert_eq!(kept("Leaf", "(8, 9)", "90"), 0);
+    assert_eq!(kept("Leaf", "(8, 1)", "90"), 1);
 }
 
 const LINKED: &str = "
@@ -178,7 +207,8 @@ fn scenes_end_and_repeat() {
         "the palm ends: {} steps",
         a.outcome.steps
     );
-    assert_eq!(a.outcome.messages, 1);
+    // Two messages up the trunk, then one to each of the eight leaves.
+    assert_eq!(a.outcome.messages, 10);
     let strings = |r: &SceneRun| {
         r.outcome
             .instances
@@ -209,7 +239,7 @@ fn svg_layers_per_guide() {
         .expect("runs");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let svg = std::fs::read_to_string(&out).expect("svg");
-    for guide in ["trunk", "crown"] {
+    for guide in ["trunk1", "trunk2", "trunk3", "frond1", "frond8"] {
         assert!(
             svg.contains(&format!(
                 "<g class=\"guide-content\" data-guide=\"{guide}\">"
@@ -223,7 +253,8 @@ fn svg_layers_per_guide() {
     }
     assert!(svg.contains("<line class=\"link\""));
     let stats: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
-    assert_eq!(stats["messages"], 1);
+    assert_eq!(stats["messages"], 10);
+    assert_eq!(stats["systems"], 11);
     assert!(stats["queries"].as_u64().unwrap_or(0) > 10);
     usvg::Tree::from_str(&svg, &usvg::Options::default()).expect("usvg reads it");
 }
@@ -270,7 +301,15 @@ fn points(s: &str) -> Vec<DVec2> {
 fn read_layers(svg: &str) -> Layers {
     let mut layers = Layers::default();
     let mut guide: Option<String> = None;
+    // The local centre of every element defined, by its id.
+    let mut local: HashMap<String, DVec2> = HashMap::new();
     for line in svg.lines() {
+        if line.starts_with("<path id=") {
+            let id = attr(line, "id").expect("id").to_string();
+            let d = attr(line, "d").expect("path data");
+            local.insert(id, lsyc::env::scene::outline_centre(d));
+            continue;
+        }
         if line.starts_with("<g class=\"guide-content\"") {
             guide = attr(line, "data-guide").map(str::to_string);
             continue;
@@ -298,10 +337,16 @@ fn read_layers(svg: &str) -> Layers {
                 at += step;
             }
         } else if line.starts_with("<use") {
-            // matrix(a b c d e f): the base at (e, f), the element's axis (c, d).
+            // matrix(a b c d e f): the base at (e, f), the element's axis (c, d);
+            // its centre is where the matrix puts the outline's local centre.
             let t = attr(line, "transform").expect("transform");
             let m = numbers(&t["matrix(".len()..t.len() - 1]);
-            let centre = DVec2::new(m[4] + 0.5 * m[2], -(m[5] + 0.5 * m[3]));
+            let id = attr(line, "href").expect("href").trim_start_matches('#');
+            let c = local[id];
+            let centre = DVec2::new(
+                m[0] * c.x + m[2] * c.y + m[4],
+                -(m[1] * c.x + m[3] * c.y + m[5]),
+            );
             layers.centres.entry(g.clone()).or_default().push(centre);
             let axis = DVec2::new(m[2], -m[3]).normalize_or_zero();
             layers.axes.entry(g).or_default().push(axis);
