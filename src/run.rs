@@ -293,6 +293,15 @@ pub fn run_scene(
     })
 }
 
+/// The local centres of every program's elements (for the centre rule), by program.
+fn program_centres(scene: &crate::env::scene::Scene) -> Vec<Vec<glam::DVec2>> {
+    scene
+        .programs
+        .iter()
+        .map(crate::env::scene::element_centres)
+        .collect()
+}
+
 /// Draws every instance of a scene into `sink`, each clipped to its guide by
 /// the centre rule.
 fn draw_scene(
@@ -301,12 +310,13 @@ fn draw_scene(
     sink: &mut dyn crate::turtle::Sink,
 ) -> Result<Drawn, Diagnostic> {
     let mut total = Drawn::default();
+    let centres = program_centres(&r.scene);
     for (gi, g) in r.scene.guides.iter().enumerate() {
         let prog = &r.scene.programs[g.program];
-        let centres = crate::env::scene::element_centres(prog);
         for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
             // Counts and bounds of what the centre rule keeps.
-            let mut clip = crate::env::scene::Clip::new(&g.polygon, &centres, &mut *sink);
+            let mut clip =
+                crate::env::scene::Clip::new(&g.polygon, &centres[g.program], &mut *sink);
             turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
                 .map_err(|e| runtime_diagnostic(&e, prog))?;
             let d = clip.kept;
@@ -382,14 +392,15 @@ pub fn write_scene(
     };
     match format {
         Some(Format::Svg) => {
+            let centres = program_centres(&r.scene);
             let mut w = render::svg::SvgWriter::new(out, view, &bounds, elements, &used)?;
             let names: Vec<&str> = r.scene.guides.iter().map(|g| g.name.as_str()).collect();
             for (gi, g) in r.scene.guides.iter().enumerate() {
                 w.begin_guide(names[gi]);
                 let prog = &r.scene.programs[g.program];
-                let centres = crate::env::scene::element_centres(prog);
                 for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
-                    let mut clip = crate::env::scene::Clip::new(&g.polygon, &centres, &mut w);
+                    let mut clip =
+                        crate::env::scene::Clip::new(&g.polygon, &centres[g.program], &mut w);
                     turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
                         .map_err(|e| OutputError::Diagnostic(runtime_diagnostic(&e, prog)))?;
                 }
