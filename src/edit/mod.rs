@@ -30,7 +30,6 @@ pub mod spring;
 
 use crate::ast::{Expr, ExprKind, File, GuideStmt, Item, Scene, SceneStmt, UnOp};
 use crate::check::{Checked, suggest};
-use crate::compile::ExprCompiler;
 use spring::{P2, Params, System, polygon_springs};
 use std::collections::{BTreeMap, HashMap};
 
@@ -863,7 +862,7 @@ fn literal(e: &Expr) -> Option<f64> {
 
 /// The value of a constant expression (literals, constants, deterministic functions).
 fn const_value(e: &Expr, checked: &Checked) -> Option<f64> {
-    literal(e).or_else(|| ExprCompiler::fold_const(e, checked))
+    literal(e).or_else(|| checked.value_of(e))
 }
 
 /// The diagonal of the bounding box of every guide vertex (1 if there is none).
