@@ -441,22 +441,33 @@ impl<'a> Checker<'a> {
             in_cycle.insert(cycle[0].to_string());
             return;
         }
+        // A long cycle is named by its first constants only: the message stays
+        // readable (and small) however many constants the cycle runs through.
+        const SHOWN: usize = 8;
+        let shown = &cycle[..cycle.len().min(SHOWN)];
+        let more = cycle.len() - shown.len();
+        let names = shown
+            .iter()
+            .map(|c| format!("`{c}`"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let names = if more > 0 {
+            format!("{names} and {more} more")
+        } else {
+            names
+        };
         let mut d = Diagnostic::error(
             Code::ConstCycle,
-            format!(
-                "constants {} are defined in terms of each other",
-                cycle
-                    .iter()
-                    .map(|c| format!("`{c}`"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
+            format!("constants {names} are defined in terms of each other"),
         )
         .primary(first, "this constant depends on itself");
-        for c in &cycle[1..] {
+        for c in &shown[1..] {
             d = d.secondary(self.consts[c].span, "which depends on this one");
         }
-        let mut chain: Vec<&str> = cycle.to_vec();
+        let mut chain: Vec<&str> = shown.to_vec();
+        if more > 0 {
+            chain.push("…");
+        }
         chain.push(cycle[0]);
         d = d
             .note(format!("the cycle: {}", chain.join(" → ")))
