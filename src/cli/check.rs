@@ -53,7 +53,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         if fe.has_errors() {
             status = 1;
         }
-        reporter.say(&format!("{}: {}", src.name, summary(&fe.diagnostics)));
+        reporter.info(&format!("{}: {}", src.name, summary(&fe.diagnostics)));
     }
     status
 }

@@ -157,7 +157,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         Some(c) if !fe.has_errors() => c,
         _ => {
             reporter.emit(&fe.diagnostics, &src.name, &src.text);
-            reporter.say(&format!("{}: not edited, it has errors", src.name));
+            reporter.info(&format!("{}: not edited, it has errors", src.name));
             return 1;
         }
     };
@@ -169,28 +169,23 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     let outcome = match edit::edit(&mut file, checked, &args.ops, &options) {
         Ok(o) => o,
         Err(EditError::Input(msg)) => {
-            reporter.say(&format!("error: {}: {msg}", src.name));
+            reporter.error(&format!("{}: {msg}", src.name), None);
             return 1;
         }
         Err(EditError::Usage(msg, hint)) => {
-            reporter.say(&format!("error: {msg}"));
-            if let Some(h) = hint {
-                reporter.say(&format!("  help: {h}"));
-            }
+            reporter.error(&msg, hint.as_deref());
             return 2;
         }
     };
     for r in &outcome.replaced {
-        reporter.say(&format!(
-            "note: {r} (its expression was replaced by the number)"
-        ));
+        reporter.note(&format!("{r} (its expression was replaced by the number)"));
     }
     for w in &outcome.warnings {
-        reporter.say(&format!("warning: {w}"));
+        reporter.warning(w);
     }
     if !outcome.converged {
-        reporter.say(&format!(
-            "warning: the spring system did not settle in {} iteration{}; the positions are the last ones",
+        reporter.warning(&format!(
+            "the spring system did not settle in {} iteration{}; the positions are the last ones",
             outcome.iterations,
             if outcome.iterations == 1 { "" } else { "s" }
         ));
@@ -234,13 +229,13 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         if out != src.text
             && let Err(e) = source::write_atomic(&args.file, out.as_bytes())
         {
-            reporter.say(&format!("error: cannot write `{}`: {e}", src.name));
+            reporter.error(&format!("cannot write `{}`: {e}", src.name), None);
             return 1;
         }
-        reporter.say(&summary);
+        reporter.info(&summary);
     } else {
         let _ = std::io::stdout().write_all(out.as_bytes());
-        reporter.say(&summary);
+        reporter.info(&summary);
     }
     0
 }

@@ -36,7 +36,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         diags.extend(parsed.diagnostics);
         if diags.iter().any(|d| d.is_error()) {
             reporter.emit(&diags, &src.name, &src.text);
-            reporter.say(&format!(
+            reporter.info(&format!(
                 "{}: not formatted, it has syntax errors",
                 src.name
             ));
@@ -46,7 +46,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         let out = lsyc::fmt::format_file(&parsed.file);
         if args.check {
             if out != src.text {
-                reporter.say(&format!(
+                reporter.info(&format!(
                     "{}: not in canonical form (run `lsyc fmt --write {}`)",
                     src.name, src.name
                 ));
@@ -55,10 +55,10 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         } else if args.write {
             if out != src.text {
                 if let Err(e) = source::write_atomic(path, out.as_bytes()) {
-                    reporter.say(&format!("error: cannot write `{}`: {e}", src.name));
+                    reporter.error(&format!("cannot write `{}`: {e}", src.name), None);
                     status = 1;
                 } else {
-                    reporter.say(&format!("{}: formatted", src.name));
+                    reporter.info(&format!("{}: formatted", src.name));
                 }
             }
         } else {

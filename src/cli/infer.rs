@@ -74,10 +74,9 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         return run_sketch(args, sketch, reporter);
     }
     let Some(art) = &args.art else {
-        reporter.say(
-            "error: give a drawing to infer from\n\
-             usage: lsyc infer ART.svg [-o OUT.lsy]  (repeated elements)\n       \
-             lsyc infer --skeleton SKETCH.svg [-o TREE.lsy]  (a tree sketch)",
+        reporter.error(
+            "give a drawing to infer from",
+            Some("lsyc infer ART.svg [-o OUT.lsy] (repeated elements), or lsyc infer --skeleton SKETCH.svg [-o TREE.lsy] (a tree sketch)"),
         );
         return 2;
     };
@@ -87,18 +86,24 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         ..art::Options::default()
     };
     if !(args.similarity.is_finite() && args.similarity > 0.0 && args.similarity < 1.0) {
-        reporter.say(&format!(
-            "error: --similarity must be between 0 and 1 (a misfit relative to the element's size), not {}",
-            args.similarity
-        ));
+        reporter.error(
+            &format!(
+                "--similarity must be between 0 and 1 (a misfit relative to the element's size), not {}",
+                args.similarity
+            ),
+            None,
+        );
         return 2;
     }
     opts.similarity = args.similarity;
     if let Some(j) = args.jitter {
         if !(j.is_finite() && j > 0.0 && j < 1.0) {
-            reporter.say(&format!(
-                "error: --jitter must be between 0 and 1 (0.1: turns vary by ±3°, steps by ±10%), not {j}"
-            ));
+            reporter.error(
+                &format!(
+                    "--jitter must be between 0 and 1 (0.1: turns vary by ±3°, steps by ±10%), not {j}"
+                ),
+                None,
+            );
             return 2;
         }
         opts.jitter = Some(j);
@@ -107,7 +112,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         match parse_weights(w) {
             Ok(w) => opts.weights = w,
             Err(why) => {
-                reporter.say(&format!("error: --weights {w}: {why}"));
+                reporter.error(&format!("--weights {w}: {why}"), None);
                 return 2;
             }
         }
@@ -146,19 +151,20 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     let inferred = match result {
         Ok(i) => i,
         Err(e) => {
-            reporter.say(&format!("error: {e}"));
+            reporter.error(&e.to_string(), None);
             return 1;
         }
     };
     for s in &inferred.skipped {
-        reporter.say(&format!(
-            "warning: {name}: skipped {s} (only paths and shapes are elements)"
+        reporter.warning(&format!(
+            "{name}: skipped {s} (only paths and shapes are elements)"
         ));
     }
     if args.stats
         && let Ok(json) = serde_json::to_string(&inferred.stats)
     {
-        reporter.say(&json);
+        // Already one JSON object: the same line in either error format.
+        eprintln!("{json}");
     }
     let st = &inferred.stats;
     let summary = format!(
@@ -206,10 +212,10 @@ fn same_as_input(
         _ => false,
     };
     if same {
-        reporter.say(&format!(
-            "error: the output `{}` is the {what}; choose another file",
-            out.display()
-        ));
+        reporter.error(
+            &format!("the output `{}` is the {what}", out.display()),
+            Some("choose another file: lsyc never writes over its input"),
+        );
         return Some(2);
     }
     None
@@ -218,10 +224,10 @@ fn same_as_input(
 fn read_input(path: &std::path::Path, name: &str, reporter: &Reporter) -> Result<Vec<u8>, u8> {
     let too_large = std::fs::metadata(path).is_ok_and(|m| m.len() > MAX_SVG_BYTES as u64);
     if too_large {
-        reporter.say(&format!(
-            "error: `{name}` is larger than {} MiB",
-            MAX_SVG_BYTES >> 20
-        ));
+        reporter.error(
+            &format!("`{name}` is larger than {} MiB", MAX_SVG_BYTES >> 20),
+            None,
+        );
         return Err(1);
     }
     std::fs::read(path).map_err(|e| {
@@ -230,7 +236,7 @@ fn read_input(path: &std::path::Path, name: &str, reporter: &Reporter) -> Result
             std::io::ErrorKind::IsADirectory => "it is a directory".to_string(),
             _ => e.to_string(),
         };
-        reporter.say(&format!("error: cannot read `{name}`: {why}"));
+        reporter.error(&format!("cannot read `{name}`: {why}"), None);
         1
     })
 }
@@ -245,10 +251,10 @@ fn write_program(
     match out {
         Some(out) => {
             if let Err(e) = source::write_atomic(out, text.as_bytes()) {
-                reporter.say(&format!("error: cannot write `{}`: {e}", out.display()));
+                reporter.error(&format!("cannot write `{}`: {e}", out.display()), None);
                 return 1;
             }
-            reporter.say(&format!("{summary}, wrote {}", out.display()));
+            reporter.info(&format!("{summary}, wrote {}", out.display()));
         }
         None => {
             let _ = std::io::stdout().write_all(text.as_bytes());
@@ -261,9 +267,10 @@ fn run_sketch(args: &Args, sketch: &std::path::Path, reporter: &Reporter) -> u8 
     if let Some(e) = args.epsilon
         && !(e.is_finite() && e >= 0.0)
     {
-        reporter.say(&format!(
-            "error: --epsilon must be a distance of 0 or more, not {e}"
-        ));
+        reporter.error(
+            &format!("--epsilon must be a distance of 0 or more, not {e}"),
+            None,
+        );
         return 2;
     }
     if let Some(code) = same_as_input(args.output.as_deref(), sketch, "sketch", reporter) {
@@ -282,7 +289,7 @@ fn run_sketch(args: &Args, sketch: &std::path::Path, reporter: &Reporter) -> u8 
     let inferred = match infer::skeleton_from_svg(&data, &name, &opts) {
         Ok(i) => i,
         Err(e) => {
-            reporter.say(&format!("error: {e}"));
+            reporter.error(&e.to_string(), None);
             return 1;
         }
     };

@@ -121,15 +121,63 @@ impl Reporter {
         self.format == Format::Json
     }
 
-    /// A one-line message on stderr. In JSON mode summaries are left out, and a
-    /// message starting with `error: ` is written as a JSON object, so that a
-    /// tool reading stderr sees every error.
-    pub fn say(&self, msg: &str) {
-        if !self.is_json() {
-            eprintln!("{msg}");
-        } else if let Some(text) = msg.strip_prefix("error: ") {
-            let v = serde_json::json!({ "severity": "error", "message": text });
+    /// An error without a place in a program (a usage error, a file that
+    /// cannot be read or written), with an optional hint.
+    pub fn error(&self, msg: &str, help: Option<&str>) {
+        self.line(Line::Error, msg, help);
+    }
+
+    pub fn warning(&self, msg: &str) {
+        self.line(Line::Warning, msg, None);
+    }
+
+    pub fn note(&self, msg: &str) {
+        self.line(Line::Note, msg, None);
+    }
+
+    /// A summary of what a command did ("koch.lsy: no problems found").
+    pub fn info(&self, msg: &str) {
+        self.line(Line::Info, msg, None);
+    }
+
+    /// One line on stderr: `error: …` for a person, one JSON object per line
+    /// (`{"severity": …, "message": …, "help": …}`) for a tool, so that every
+    /// line a command writes to stderr honours `--error-format json`.
+    fn line(&self, kind: Line, msg: &str, help: Option<&str>) {
+        if self.is_json() {
+            let mut v = serde_json::json!({ "severity": kind.name(), "message": msg });
+            if let Some(h) = help {
+                v["help"] = serde_json::Value::from(h);
+            }
             eprintln!("{v}");
+            return;
+        }
+        match kind {
+            Line::Info => eprintln!("{msg}"),
+            _ => eprintln!("{}: {msg}", kind.name()),
+        }
+        if let Some(h) = help {
+            eprintln!("  help: {h}");
+        }
+    }
+}
+
+/// The kinds of one-line messages.
+#[derive(Clone, Copy)]
+enum Line {
+    Error,
+    Warning,
+    Note,
+    Info,
+}
+
+impl Line {
+    fn name(self) -> &'static str {
+        match self {
+            Line::Error => "error",
+            Line::Warning => "warning",
+            Line::Note => "note",
+            Line::Info => "info",
         }
     }
 }

@@ -89,10 +89,10 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         Some(p) => match Format::from_path(p) {
             Some(f) => Some(f),
             None => {
-                reporter.say(&format!(
-                    "error: cannot tell the output format of `{}`: use a file ending in .svg, .png, .obj or .txt",
-                    p.display()
-                ));
+                reporter.error(
+                    &format!("cannot tell the output format of `{}`", p.display()),
+                    Some("use a file ending in .svg, .png, .obj or .txt"),
+                );
                 return 2;
             }
         },
@@ -104,7 +104,10 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         match lsyc::render::png::parse_color(&args.background) {
             Some([r, g, b]) => [r, g, b, 255],
             None => {
-                reporter.say(&format!("error: `{}` is not a colour", args.background));
+                reporter.error(
+                    &format!("`{}` is not a colour", args.background),
+                    Some("write a colour as #rrggbb, #rrggbbaa or a name such as white or none"),
+                );
                 return 2;
             }
         }
@@ -125,10 +128,10 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     if let Some(out) = &args.output
         && same_file(out, &args.file)
     {
-        reporter.say(&format!(
-            "error: the output `{}` is the input program; choose another file",
-            out.display()
-        ));
+        reporter.error(
+            &format!("the output `{}` is the input program", out.display()),
+            Some("choose another file: lsyc never writes over its input"),
+        );
         return 2;
     }
     let mut fe = frontend::run_seeded(&src.text, src.diagnostics.clone(), &ovr, args.seed);
@@ -138,20 +141,21 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     }
     for spec in &args.elements {
         let Some((name, file)) = spec.split_once('=') else {
-            reporter.say(&format!(
-                "error: --element {spec}: write NAME=FILE.svg, e.g. --element A=leaf.svg"
-            ));
+            reporter.error(
+                &format!("--element {spec}: not of the form NAME=FILE.svg"),
+                Some("e.g. --element A=leaf.svg"),
+            );
             return 2;
         };
         let data = match std::fs::read(file) {
             Ok(d) => d,
             Err(e) => {
-                reporter.say(&format!("error: cannot read `{file}`: {e}"));
+                reporter.error(&format!("cannot read `{file}`: {e}"), None);
                 return 1;
             }
         };
         if let Err(why) = lsyc::infer::art::replace_element(&mut fe.file, name, &data) {
-            reporter.say(&format!("error: --element {spec}: {why}"));
+            reporter.error(&format!("--element {spec}: {why}"), None);
             return 1;
         }
     }
@@ -233,7 +237,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     };
     let stats = Stats::new(&derived, &drawn, start.elapsed().as_secs_f64() * 1000.0);
     let wrote = report_stats(args, &stats);
-    reporter.say(&format!(
+    reporter.info(&format!(
         "{}: {} modules, {} segments, {} elements after {} steps (derive {:.0} ms, draw {:.0} ms){wrote}",
         stats.system,
         stats.modules,
@@ -358,13 +362,13 @@ fn run_scene(
                 return 1;
             }
             Err(OutputError::Io(e)) => {
-                reporter.say(&format!("error: {e}"));
+                reporter.error(&e.to_string(), None);
                 return 1;
             }
         },
     };
     let wrote = report_stats(args, &stats);
-    reporter.say(&format!(
+    reporter.info(&format!(
         "scene {}: {} systems, {} modules, {} segments, {} elements, {} queries, {} messages after {} steps{wrote}",
         stats.scene,
         stats.systems,

@@ -311,3 +311,40 @@ fn fmt_check_write_and_stdout() {
         .collect();
     assert!(leftovers.is_empty(), "temporary files left behind");
 }
+
+/// With `--error-format json` every line on stderr is one JSON object:
+/// diagnostics, one-line errors, warnings and summaries alike.
+#[test]
+fn json_mode_writes_only_json_lines() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let f = write(
+        dir.path(),
+        "w.lsy",
+        "const unused = 1;\nlsystem A {\n    axiom F;\n}\n",
+    );
+    let out = dir.path().join("w.svg");
+    let cases: Vec<Vec<&str>> = vec![
+        vec!["run", &f, "--error-format", "json"],
+        vec![
+            "run",
+            &f,
+            "-o",
+            out.to_str().expect("utf-8"),
+            "--error-format",
+            "json",
+        ],
+        vec!["run", &f, "-o", &f, "--error-format", "json"],
+        vec!["check", &f, "--error-format", "json"],
+        vec!["fmt", &f, "--check", "--error-format", "json"],
+        vec!["infer", "--error-format", "json"],
+    ];
+    for args in cases {
+        let r = run(&args);
+        assert!(!r.stderr.trim().is_empty(), "{args:?}: nothing on stderr");
+        for line in r.stderr.lines() {
+            let v: serde_json::Value = serde_json::from_str(line)
+                .unwrap_or_else(|e| panic!("{args:?}: not JSON ({e}): {line}"));
+            assert!(v["severity"].is_string(), "{args:?}: {line}");
+        }
+    }
+}
