@@ -4,6 +4,14 @@
 //! three renderings: coloured or plain terminal text through codespan-reporting, and
 //! JSON for tools. Phases build diagnostics where they find a problem; they never
 //! format terminal strings themselves.
+//!
+//! One rendering path: the command line draws diagnostics with
+//! codespan-reporting (`render`). For other Rust programs a `Diagnostic` is
+//! also a `std::error::Error` and a `miette::Diagnostic` (code, severity, help,
+//! labels); `Diagnostic::in_source` attaches the source text so that a miette
+//! report handler can draw it the same way. Each layer's typed error
+//! (`CompileError`, `SceneError`, `DeriveError`, `ExprError`) turns into a
+//! `Diagnostic` with `.diagnostic()`.
 
 use crate::span::{LineIndex, Span};
 use codespan_reporting::diagnostic as cs;
@@ -185,6 +193,95 @@ impl Diagnostic {
             .find(|l| l.primary)
             .map(|l| l.span.start)
             .unwrap_or(0)
+    }
+}
+
+impl std::fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for Diagnostic {}
+
+impl miette::Diagnostic for Diagnostic {
+    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        Some(Box::new(self.code.as_str()))
+    }
+
+    fn severity(&self) -> Option<miette::Severity> {
+        Some(match self.severity {
+            Severity::Error => miette::Severity::Error,
+            Severity::Warning => miette::Severity::Warning,
+        })
+    }
+
+    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        let mut parts: Vec<&str> = self.notes.iter().map(String::as_str).collect();
+        parts.extend(self.help.as_deref());
+        (!parts.is_empty()).then(|| Box::new(parts.join("\n")) as Box<dyn std::fmt::Display>)
+    }
+
+    fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
+        if self.labels.is_empty() {
+            return None;
+        }
+        Some(Box::new(self.labels.iter().map(|l| {
+            let span = l.span.range();
+            let text = (!l.message.is_empty()).then(|| l.message.clone());
+            if l.primary {
+                miette::LabeledSpan::new_primary_with_span(text, span)
+            } else {
+                miette::LabeledSpan::new_with_span(text, span)
+            }
+        })))
+    }
+}
+
+/// A diagnostic with the text it points into, for miette's report handlers.
+#[derive(Debug)]
+pub struct InSource {
+    pub diagnostic: Diagnostic,
+    source: miette::NamedSource<String>,
+}
+
+impl Diagnostic {
+    /// This diagnostic together with its file's name and text.
+    pub fn in_source(self, name: &str, text: &str) -> InSource {
+        InSource {
+            diagnostic: self,
+            source: miette::NamedSource::new(name, text.to_string()),
+        }
+    }
+}
+
+impl std::fmt::Display for InSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.diagnostic.fmt(f)
+    }
+}
+
+impl std::error::Error for InSource {}
+
+impl miette::Diagnostic for InSource {
+    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        miette::Diagnostic::code(&self.diagnostic)
+    }
+
+    fn severity(&self) -> Option<miette::Severity> {
+        miette::Diagnostic::severity(&self.diagnostic)
+    }
+
+    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        miette::Diagnostic::help(&self.diagnostic)
+    }
+
+    fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
+        miette::Diagnostic::labels(&self.diagnostic)
+    }
+
+    fn source_code(&self) -> Option<&dyn miette::SourceCode> {
+        Some(&self.source)
     }
 }
 

@@ -80,3 +80,45 @@ fn every_code_has_an_error_program() {
         "codes without a program in tests/data/check/err: {missing:?}"
     );
 }
+
+/// Every diagnostic of the error corpus, seen through `miette::Diagnostic` (as
+/// another Rust program would use the library): the same code, severity and
+/// labels, and the labels read the same text out of the source.
+#[test]
+fn diagnostics_are_miette_diagnostics() {
+    use miette::Diagnostic as _;
+    let mut seen = 0;
+    for path in lsy_files(&["tests/data/check/err"]) {
+        let name = rel(&path);
+        let bytes = std::fs::read(&path).unwrap_or_default();
+        let src = lsyc::source::from_bytes(name.clone(), &bytes);
+        let fe = frontend::run(&src.text, src.diagnostics, &[]);
+        for d in fe.diagnostics {
+            let want_code = d.code.as_str().to_string();
+            let want: Vec<(usize, usize, bool)> = d
+                .labels
+                .iter()
+                .map(|l| (l.span.start as usize, l.span.end as usize, l.primary))
+                .collect();
+            let inside = d.in_source(&name, &src.text);
+            let code = inside.code().map(|c| c.to_string());
+            assert_eq!(code.as_deref(), Some(want_code.as_str()), "{name}");
+            let got: Vec<(usize, usize, bool)> = inside
+                .labels()
+                .map(|ls| {
+                    ls.map(|l| (l.offset(), l.offset() + l.len(), l.primary()))
+                        .collect()
+                })
+                .unwrap_or_default();
+            assert_eq!(got, want, "{name}: labels");
+            let source = inside.source_code().expect("the source is attached");
+            for (start, end, _) in got.iter().filter(|(s, e, _)| e > s && *e <= src.text.len()) {
+                let span = miette::SourceSpan::from(*start..*end);
+                let read = source.read_span(&span, 0, 0).expect("the span reads");
+                assert_eq!(read.data(), &src.text.as_bytes()[*start..*end], "{name}");
+            }
+            seen += 1;
+        }
+    }
+    assert!(seen > 100, "only {seen} diagnostics seen");
+}
