@@ -6,9 +6,34 @@
 //! parameters; in an axiom or successor only the pass-through parameters are
 //! written (the outputs start at 0 until the environment answers).
 
+/// Which question a query module asks: what the environment matches on when
+/// it answers (names are for the checker and messages only).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum QueryKind {
+    /// `?P`: the turtle's position.
+    Position,
+    /// `?H`: the turtle's heading.
+    Heading,
+    /// `?D_L`: the distance to the closest link edge.
+    DistanceLink,
+    /// `?D_G`: the distance to the closest guide edge.
+    DistanceGuide,
+    /// `?D_A`: the distance to the closest element.
+    DistanceElement,
+    /// `?N_L`: the distance ahead to the next link edge.
+    AheadLink,
+    /// `?N_G`: the distance ahead to the next guide edge.
+    AheadGuide,
+    /// `?N_A`: the distance ahead to the next guide edge or element.
+    AheadElement,
+    /// `?X`: whether the next element collides.
+    Collision,
+}
+
 #[derive(Clone, Copy, Debug)]
 pub struct Query {
     pub name: &'static str,
+    pub kind: QueryKind,
     /// Names of the outputs, in order.
     pub outputs: &'static [&'static str],
     /// Pass-through parameters the environment reads (at least this many).
@@ -19,54 +44,63 @@ pub struct Query {
 pub const QUERIES: &[Query] = &[
     Query {
         name: "?P",
+        kind: QueryKind::Position,
         outputs: &["x", "y", "z"],
         inputs: &[],
         doc: "turtle position",
     },
     Query {
         name: "?H",
+        kind: QueryKind::Heading,
         outputs: &["hx", "hy", "hz"],
         inputs: &[],
         doc: "turtle heading (unit vector)",
     },
     Query {
         name: "?D_L",
+        kind: QueryKind::DistanceLink,
         outputs: &["found", "d", "beta", "id"],
         inputs: &[],
         doc: "distance d and turning angle beta to the closest link edge of the guide",
     },
     Query {
         name: "?D_G",
+        kind: QueryKind::DistanceGuide,
         outputs: &["found", "d", "beta", "id"],
         inputs: &[],
         doc: "distance d and turning angle beta to the closest guide edge",
     },
     Query {
         name: "?D_A",
+        kind: QueryKind::DistanceElement,
         outputs: &["found", "d", "beta", "id"],
         inputs: &[],
         doc: "distance d and turning angle beta to the closest element in the guide",
     },
     Query {
         name: "?N_L",
+        kind: QueryKind::AheadLink,
         outputs: &["found", "d", "id"],
         inputs: &[],
         doc: "distance along the heading to the next link edge",
     },
     Query {
         name: "?N_G",
+        kind: QueryKind::AheadGuide,
         outputs: &["found", "d", "id"],
         inputs: &[],
         doc: "distance along the heading to the next guide edge",
     },
     Query {
         name: "?N_A",
+        kind: QueryKind::AheadElement,
         outputs: &["found", "d", "id"],
         inputs: &[],
         doc: "distance along the heading to the next guide edge or element",
     },
     Query {
         name: "?X",
+        kind: QueryKind::Collision,
         outputs: &["found", "id"],
         inputs: &["delta"],
         doc: "whether the next element of length delta collides with a guide edge, link or element",

@@ -31,7 +31,7 @@ use super::index::{Grid, Layers};
 use super::scene::{Answer, Instance, Outcome, Probe, Scene, collide, query, seed_state};
 use crate::derive::{self, Limits, ModString};
 use crate::diagnostic::Diagnostic;
-use crate::query::QUERIES;
+use crate::query::{QUERIES, QueryKind};
 use crate::turtle;
 use crate::turtle::State;
 use glam::DVec2;
@@ -698,8 +698,8 @@ fn answer(
                 let at = offsets[module] as usize;
                 let arity = prog.symbols.arity(inst.string.syms[module]);
                 let own = &inst.string.params[at..at + arity];
-                let ans = match q.name {
-                    "?X" => {
+                let ans = match q.kind {
+                    QueryKind::Collision => {
                         let delta = own.get(q.outputs.len()).copied().unwrap_or(0.0);
                         let (ans, edge) = collide(scene, grid, gi, &state, delta);
                         if let Some(edge) = edge {
@@ -715,7 +715,7 @@ fn answer(
                         }
                         ans
                     }
-                    name => query(scene, grid, gi, name, &state),
+                    kind => query(scene, grid, gi, kind, &state),
                 };
                 answers.push((at, arity, ans));
             }

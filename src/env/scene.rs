@@ -11,6 +11,7 @@ use crate::check::Checked;
 use crate::compile::{self, CompileError, Program};
 use crate::derive::{Limits, ModString};
 use crate::diagnostic::{Code, Diagnostic};
+use crate::query::QueryKind;
 use crate::turtle::{Drawn, Sink, State};
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
@@ -306,7 +307,7 @@ pub(crate) fn query(
     scene: &Scene,
     grid: Option<&Layers>,
     gi: usize,
-    name: &str,
+    kind: QueryKind,
     st: &State,
 ) -> Answer {
     let p = st.pos.truncate();
@@ -362,19 +363,19 @@ pub(crate) fn query(
         }
     };
     let guide_edges = || -> Vec<(usize, DVec2, DVec2)> { edges(poly).collect() };
-    match name {
-        "?P" => Answer::new(&[st.pos.x, st.pos.y, st.pos.z]),
-        "?H" => Answer::new(&[st.h.x, st.h.y, st.h.z]),
-        "?D_L" => nearest(&link_edges()),
-        "?D_G" => nearest(&guide_edges()),
+    match kind {
+        QueryKind::Position => Answer::new(&[st.pos.x, st.pos.y, st.pos.z]),
+        QueryKind::Heading => Answer::new(&[st.h.x, st.h.y, st.h.z]),
+        QueryKind::DistanceLink => nearest(&link_edges()),
+        QueryKind::DistanceGuide => nearest(&guide_edges()),
         // Drawn segments have ids after the guide's edges, as for ?N_A and ?X.
-        "?D_A" => match grid.and_then(|g| g.nearest(p)) {
+        QueryKind::DistanceElement => match grid.and_then(|g| g.nearest(p)) {
             Some((d, c, i)) => closest(d, c, poly.len() + i),
             None => Answer::new(&[0.0; 4]),
         },
-        "?N_L" => ahead(first_ahead(&link_edges())),
-        "?N_G" => ahead(first_ahead(&guide_edges())),
-        "?N_A" => {
+        QueryKind::AheadLink => ahead(first_ahead(&link_edges())),
+        QueryKind::AheadGuide => ahead(first_ahead(&guide_edges())),
+        QueryKind::AheadElement => {
             // Guide edges come first (ids 0..n), so they win ties.
             let edge = first_ahead(&guide_edges());
             let limit = edge.map_or(f64::INFINITY, |e| e.0);
@@ -387,7 +388,8 @@ pub(crate) fn query(
                 (None, x) => x,
             })
         }
-        _ => Answer::new(&[found(false)]),
+        // Answered by `collide`, which also reports the edge crossed.
+        QueryKind::Collision => Answer::new(&[found(false)]),
     }
 }
 
