@@ -354,6 +354,26 @@ pub struct SceneStats {
     pub interpret_ms: f64,
 }
 
+/// What the scene writers share: the view, the elements and the bounds of
+/// everything drawn (guide outlines included).
+struct SceneFrame<'a> {
+    view: View,
+    elements: &'a [crate::compile::ElementDef],
+    bounds: Bounds,
+}
+
+impl SceneFrame<'_> {
+    fn outline(g: &crate::env::scene::Guide) -> Vec<glam::DVec3> {
+        g.polygon.iter().map(|p| p.extend(0.0)).collect()
+    }
+
+    fn edge_mid(r: &SceneRun, (g, e): (usize, usize)) -> glam::DVec3 {
+        let poly = &r.scene.guides[g].polygon;
+        let n = poly.len().max(1);
+        ((poly[e % n] + poly[(e + 1) % n]) * 0.5).extend(0.0)
+    }
+}
+
 /// Writes a scene in `format` to `out` (`guides`: draw outlines and links too).
 pub fn write_scene(
     r: &SceneRun,
@@ -369,7 +389,6 @@ pub fn write_scene(
     let elements: &[crate::compile::ElementDef] =
         r.scene.programs.first().map_or(&[], |p| &p.elements);
     let boxes: Vec<[f64; 4]> = r.scene.programs.first().map_or(Vec::new(), element_boxes);
-    let used = vec![true; elements.len()];
     let mut bounds_sink = BoundsSink {
         view,
         bounds: Bounds::default(),
@@ -382,106 +401,19 @@ pub fn write_scene(
             bounds.add(view.project(p.extend(0.0)));
         }
     }
-    let outline = |g: &crate::env::scene::Guide| -> Vec<glam::DVec3> {
-        g.polygon.iter().map(|p| p.extend(0.0)).collect()
-    };
-    let edge_mid = |(g, e): (usize, usize)| {
-        let poly = &r.scene.guides[g].polygon;
-        let n = poly.len().max(1);
-        ((poly[e % n] + poly[(e + 1) % n]) * 0.5).extend(0.0)
+    if let Some(first) = r.scene.programs.first() {
+        check_extent(&bounds, first).map_err(OutputError::Diagnostic)?;
+    }
+    let frame = SceneFrame {
+        view,
+        elements,
+        bounds,
     };
     match format {
-        Some(Format::Svg) => {
-            let centres = program_centres(&r.scene);
-            let mut w = render::svg::SvgWriter::new(out, view, &bounds, elements, &used)?;
-            let names: Vec<&str> = r.scene.guides.iter().map(|g| g.name.as_str()).collect();
-            for (gi, g) in r.scene.guides.iter().enumerate() {
-                w.begin_guide(names[gi]);
-                let prog = &r.scene.programs[g.program];
-                for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
-                    let mut clip =
-                        crate::env::scene::Clip::new(&g.polygon, &centres[g.program], &mut w);
-                    turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
-                        .map_err(|e| OutputError::Diagnostic(e.diagnostic(prog)))?;
-                }
-                w.end_guide();
-            }
-            if guides {
-                for g in &r.scene.guides {
-                    w.guide_outline(&g.name, &outline(g));
-                }
-                for l in &r.scene.links {
-                    w.link_line(
-                        names[l.from.0],
-                        names[l.to.0],
-                        edge_mid(l.from),
-                        edge_mid(l.to),
-                    );
-                }
-            }
-            w.finish()?;
-        }
-        Some(Format::Png) => {
-            let mut w = render::png::PngWriter::new(
-                picture.size,
-                picture.background,
-                view,
-                &bounds,
-                elements,
-            )
-            .ok_or_else(|| std::io::Error::other("the image size is not possible"))?;
-            draw_scene(r, seed, &mut w).map_err(OutputError::Diagnostic)?;
-            if guides {
-                for g in &r.scene.guides {
-                    let pts = outline(g);
-                    for i in 0..pts.len() {
-                        crate::turtle::Sink::segment(
-                            &mut w,
-                            pts[i],
-                            pts[(i + 1) % pts.len()],
-                            0.0,
-                            10,
-                        );
-                    }
-                }
-            }
-            let bytes = w.finish().map_err(std::io::Error::other)?;
-            out.write_all(&bytes)?;
-        }
-        Some(Format::Obj) => {
-            // One mesh for the whole scene: every guide's systems through the
-            // centre rule (tubes sized by the first system's step).
-            let options = r
-                .scene
-                .programs
-                .first()
-                .map(render::obj::ObjOptions::for_program)
-                .unwrap_or_default();
-            let mut w = render::obj::ObjWriter::new(out, options);
-            draw_scene(r, seed, &mut w).map_err(OutputError::Diagnostic)?;
-            w.finish()?;
-        }
-        Some(Format::Txt) => {
-            // Every system's string in the language's syntax, after a comment
-            // saying where it grew; each line reads back as an axiom.
-            for inst in &r.outcome.instances {
-                let g = &r.scene.guides[inst.guide];
-                let prog = &r.scene.programs[g.program];
-                let h = inst.start.h;
-                let heading = (-h.x).atan2(h.y).to_degrees();
-                let round = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
-                writeln!(
-                    out,
-                    "// guide {}, lsystem {}, seeded at ({}, {}) heading {}",
-                    g.name,
-                    prog.name,
-                    round(inst.start.pos.x),
-                    round(inst.start.pos.y),
-                    round(heading)
-                )?;
-                render::txt::write(out, prog, &inst.string)?;
-            }
-        }
+        Some(Format::Svg) => scene_svg(r, &frame, seed, guides, out)?,
+        Some(Format::Png) => scene_png(r, &frame, picture, seed, guides, out)?,
+        Some(Format::Obj) => scene_obj(r, seed, out)?,
+        Some(Format::Txt) => scene_txt(r, out)?,
         None => {}
     }
     let round = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
@@ -499,4 +431,114 @@ pub fn write_scene(
         derive_ms: round(r.derive_ms),
         interpret_ms: round(start.elapsed().as_secs_f64() * 1000.0),
     })
+}
+
+/// A scene as SVG: one layer per guide, then outlines and links.
+fn scene_svg(
+    r: &SceneRun,
+    frame: &SceneFrame,
+    seed: u64,
+    guides: bool,
+    out: &mut dyn Write,
+) -> Result<(), OutputError> {
+    let used = vec![true; frame.elements.len()];
+    let mut w = render::svg::SvgWriter::new(out, frame.view, &frame.bounds, frame.elements, &used)?;
+    let centres = program_centres(&r.scene);
+    let names: Vec<&str> = r.scene.guides.iter().map(|g| g.name.as_str()).collect();
+    for (gi, g) in r.scene.guides.iter().enumerate() {
+        w.begin_guide(names[gi]);
+        let prog = &r.scene.programs[g.program];
+        for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
+            let mut clip = crate::env::scene::Clip::new(&g.polygon, &centres[g.program], &mut w);
+            turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
+                .map_err(|e| OutputError::Diagnostic(e.diagnostic(prog)))?;
+        }
+        w.end_guide();
+    }
+    if guides {
+        for g in &r.scene.guides {
+            w.guide_outline(&g.name, &SceneFrame::outline(g));
+        }
+        for l in &r.scene.links {
+            w.link_line(
+                names[l.from.0],
+                names[l.to.0],
+                SceneFrame::edge_mid(r, l.from),
+                SceneFrame::edge_mid(r, l.to),
+            );
+        }
+    }
+    w.finish()?;
+    Ok(())
+}
+
+/// A scene as PNG, guide outlines drawn as hairlines.
+fn scene_png(
+    r: &SceneRun,
+    frame: &SceneFrame,
+    picture: Picture,
+    seed: u64,
+    guides: bool,
+    out: &mut dyn Write,
+) -> Result<(), OutputError> {
+    let mut w = render::png::PngWriter::new(
+        picture.size,
+        picture.background,
+        frame.view,
+        &frame.bounds,
+        frame.elements,
+    )
+    .ok_or_else(|| std::io::Error::other("the image size is not possible"))?;
+    draw_scene(r, seed, &mut w).map_err(OutputError::Diagnostic)?;
+    if guides {
+        for g in &r.scene.guides {
+            let pts = SceneFrame::outline(g);
+            for i in 0..pts.len() {
+                crate::turtle::Sink::segment(&mut w, pts[i], pts[(i + 1) % pts.len()], 0.0, 10);
+            }
+        }
+    }
+    let bytes = w.finish().map_err(std::io::Error::other)?;
+    out.write_all(&bytes)?;
+    Ok(())
+}
+
+/// A scene as one OBJ mesh.
+fn scene_obj(r: &SceneRun, seed: u64, out: &mut dyn Write) -> Result<(), OutputError> {
+    // One mesh for the whole scene: every guide's systems through the
+    // centre rule (tubes sized by the first system's step).
+    let options = r
+        .scene
+        .programs
+        .first()
+        .map(render::obj::ObjOptions::for_program)
+        .unwrap_or_default();
+    let mut w = render::obj::ObjWriter::new(out, options);
+    draw_scene(r, seed, &mut w).map_err(OutputError::Diagnostic)?;
+    w.finish()?;
+    Ok(())
+}
+
+/// A scene as text: every system's string in the language's syntax.
+fn scene_txt(r: &SceneRun, out: &mut dyn Write) -> Result<(), OutputError> {
+    // Every system's string in the language's syntax, after a comment
+    // saying where it grew; each line reads back as an axiom.
+    for inst in &r.outcome.instances {
+        let g = &r.scene.guides[inst.guide];
+        let prog = &r.scene.programs[g.program];
+        let h = inst.start.h;
+        let heading = (-h.x).atan2(h.y).to_degrees();
+        let round = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
+        writeln!(
+            out,
+            "// guide {}, lsystem {}, seeded at ({}, {}) heading {}",
+            g.name,
+            prog.name,
+            round(inst.start.pos.x),
+            round(inst.start.pos.y),
+            round(heading)
+        )?;
+        render::txt::write(out, prog, &inst.string)?;
+    }
+    Ok(())
 }

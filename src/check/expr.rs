@@ -142,39 +142,7 @@ impl Checker<'_> {
             ExprKind::Num(_) => Ty::Num,
             ExprKind::Bool(_) => Ty::Bool,
             ExprKind::Error => Ty::Err,
-            ExprKind::Var(name) => {
-                if let Some(p) = env.find(name) {
-                    p.used.set(true);
-                    return p.ty;
-                }
-                if let Some(c) = self.consts.get(name.as_str()) {
-                    self.used_consts.insert(name.clone());
-                    return c.ty;
-                }
-                let mut d = Diagnostic::error(Code::UnknownName, format!("unknown name `{name}`"))
-                    .primary(e.span, "not a parameter of this rule or a constant");
-                let mut consts: Vec<&str> = self.consts.keys().copied().collect();
-                consts.sort_unstable();
-                let names: Vec<&str> = env
-                    .params
-                    .iter()
-                    .map(|p| p.name.as_str())
-                    .chain(consts)
-                    .collect();
-                if let Some(s) = suggest(name, names) {
-                    d = d.help(format!("did you mean `{s}`?"));
-                } else if self.lsystem_params.iter().any(|p| p == name) {
-                    d = d.help(format!(
-                        "`{name}` is a parameter of the lsystem: it is visible in the axiom only; pass it on as a module parameter, e.g. `axiom A({name});`"
-                    ));
-                } else if builtins::lookup(name).is_some() {
-                    d = d.help(format!("`{name}` is a function: call it as `{name}(…)`"));
-                } else {
-                    d = d.help("parameters are bound by the predecessor, as in `A(x) -> F(x);`; constants by `const x = 1;`");
-                }
-                self.diags.push(d);
-                Ty::Err
-            }
+            ExprKind::Var(name) => self.name(name, e.span, env),
             ExprKind::Unary(op, a) => {
                 let (want, out) = match op {
                     UnOp::Neg => (Ty::Num, Ty::Num),
@@ -220,46 +188,84 @@ impl Checker<'_> {
                     Ty::Num
                 }
             },
-            ExprKind::Call(f, args) => {
-                let Some(b) = builtins::lookup(&f.name) else {
-                    let mut d = Diagnostic::error(
-                        Code::UnknownFunction,
-                        format!("unknown function `{}`", f.name),
-                    )
-                    .primary(f.span, "no built-in function has this name");
-                    if let Some(s) = suggest(&f.name, builtins::BUILTINS.iter().map(|b| b.name)) {
-                        d = d.help(format!("did you mean `{s}`?"));
-                    } else {
-                        d = d.note("the functions are listed in docs/language.md");
-                    }
-                    self.diags.push(d);
-                    for a in args {
-                        self.expr(a, env);
-                    }
-                    return Ty::Err;
-                };
-                if args.len() != b.arity {
-                    self.diags.push(
-                        Diagnostic::error(
-                            Code::ArityFunction,
-                            format!(
-                                "`{}` takes {} argument{}, but {} {} given",
-                                b.name,
-                                b.arity,
-                                plural(b.arity),
-                                args.len(),
-                                if args.len() == 1 { "was" } else { "were" }
-                            ),
-                        )
-                        .primary(e.span, format!("{}: {}", b.name, b.doc)),
-                    );
-                }
-                for a in args {
-                    self.expect(a, env, Ty::Num);
-                }
-                Ty::Num
-            }
+            ExprKind::Call(f, args) => self.call(f, args, e.span, env),
         }
+    }
+
+    /// The type of a name: a parameter of `env`, or a constant.
+    fn name(&mut self, name: &str, span: Span, env: &Env) -> Ty {
+        if let Some(p) = env.find(name) {
+            p.used.set(true);
+            return p.ty;
+        }
+        if let Some(c) = self.consts.get(name) {
+            self.used_consts.insert(name.to_string());
+            return c.ty;
+        }
+        let mut d = Diagnostic::error(Code::UnknownName, format!("unknown name `{name}`"))
+            .primary(span, "not a parameter of this rule or a constant");
+        let mut consts: Vec<&str> = self.consts.keys().copied().collect();
+        consts.sort_unstable();
+        let names: Vec<&str> = env
+            .params
+            .iter()
+            .map(|p| p.name.as_str())
+            .chain(consts)
+            .collect();
+        if let Some(s) = suggest(name, names) {
+            d = d.help(format!("did you mean `{s}`?"));
+        } else if self.lsystem_params.iter().any(|p| p == name) {
+            d = d.help(format!(
+                "`{name}` is a parameter of the lsystem: it is visible in the axiom only; pass it on as a module parameter, e.g. `axiom A({name});`"
+            ));
+        } else if builtins::lookup(name).is_some() {
+            d = d.help(format!("`{name}` is a function: call it as `{name}(…)`"));
+        } else {
+            d = d.help("parameters are bound by the predecessor, as in `A(x) -> F(x);`; constants by `const x = 1;`");
+        }
+        self.diags.push(d);
+        Ty::Err
+    }
+
+    /// The type of a call of a built-in function (always a number).
+    fn call(&mut self, f: &crate::ast::Ident, args: &[Expr], span: Span, env: &Env) -> Ty {
+        let Some(b) = builtins::lookup(&f.name) else {
+            let mut d = Diagnostic::error(
+                Code::UnknownFunction,
+                format!("unknown function `{}`", f.name),
+            )
+            .primary(f.span, "no built-in function has this name");
+            if let Some(s) = suggest(&f.name, builtins::BUILTINS.iter().map(|b| b.name)) {
+                d = d.help(format!("did you mean `{s}`?"));
+            } else {
+                d = d.note("the functions are listed in docs/language.md");
+            }
+            self.diags.push(d);
+            for a in args {
+                self.expr(a, env);
+            }
+            return Ty::Err;
+        };
+        if args.len() != b.arity {
+            self.diags.push(
+                Diagnostic::error(
+                    Code::ArityFunction,
+                    format!(
+                        "`{}` takes {} argument{}, but {} {} given",
+                        b.name,
+                        b.arity,
+                        plural(b.arity),
+                        args.len(),
+                        if args.len() == 1 { "was" } else { "were" }
+                    ),
+                )
+                .primary(span, format!("{}: {}", b.name, b.doc)),
+            );
+        }
+        for a in args {
+            self.expect(a, env, Ty::Num);
+        }
+        Ty::Num
     }
 
     /// Checks an expression and reports it if it is not of type `want`.

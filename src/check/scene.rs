@@ -15,6 +15,10 @@ const PROPS: &[(&str, bool)] = &[
     ("width", false),
 ];
 
+/// A guide's `system`: where it is named, and its lsystem's parameter count
+/// when that lsystem exists.
+type SystemRef = Option<(Span, Option<usize>)>;
+
 impl<'a> Checker<'a> {
     pub(super) fn element(&mut self, e: &'a Element) {
         let mut seen: HashMap<&str, Span> = HashMap::new();
@@ -151,139 +155,159 @@ impl<'a> Checker<'a> {
                     .push(duplicate("guide", &g.name.name, g.name.span, *first));
                 continue;
             }
-            let mut polygon: Option<(Span, usize)> = None;
-            let mut system: Option<(Span, Option<usize>)> = None;
-            for gs in &g.body.stmts {
-                match &gs.node {
-                    GuideStmt::Polygon(pts) => {
-                        if let Some((first, _)) = polygon {
-                            self.setting_twice("polygon", gs.span, first);
-                            continue;
-                        }
-                        for p in pts {
-                            self.const_num(&p.x, "a polygon coordinate");
-                            self.const_num(&p.y, "a polygon coordinate");
-                        }
-                        if pts.len() < 3 {
-                            self.diags.push(
-                                Diagnostic::error(
-                                    Code::PolygonTooSmall,
-                                    format!("a guide polygon needs at least 3 vertices, this one has {}", pts.len()),
-                                )
-                                .primary(gs.span, "too few vertices")
-                                .help("list the corners in order: polygon (0, 0) (10, 0) (10, 10);"),
-                            );
-                        }
-                        polygon = Some((gs.span, pts.len()));
-                    }
-                    GuideStmt::System(name) => {
-                        if let Some((first, _)) = system {
-                            self.setting_twice("system", gs.span, first);
-                            continue;
-                        }
-                        let params = match self.systems.get(name.name.as_str()) {
-                            Some(&(_, n)) => {
-                                self.used_systems.insert(name.name.clone());
-                                Some(n)
-                            }
-                            None => {
-                                let mut d = Diagnostic::error(
-                                    Code::UnknownSystem,
-                                    format!("there is no lsystem `{}`", name.name),
-                                )
-                                .primary(name.span, "not defined in this file");
-                                if let Some(sg) = suggest(&name.name, self.systems.keys().copied())
-                                {
-                                    d = d.help(format!("did you mean `{sg}`?"));
-                                }
-                                self.diags.push(d);
-                                None
-                            }
-                        };
-                        system = Some((name.span, params));
-                    }
-                    GuideStmt::Seed(_) | GuideStmt::Error => {}
-                }
-            }
-            // Seeds, now that the system's parameters are known.
-            for gs in &g.body.stmts {
-                let GuideStmt::Seed(seed) = &gs.node else {
-                    continue;
-                };
-                self.const_num(&seed.at.x, "a seed coordinate");
-                self.const_num(&seed.at.y, "a seed coordinate");
-                if let Some(h) = &seed.heading {
-                    self.const_num(h, "a seed heading");
-                }
-                let given = seed.args.as_ref().map_or(0, Vec::len);
-                for a in seed.args.iter().flatten() {
-                    if self.expect(a, &Env::new(), Ty::Num) == Ty::Num {
-                        self.record_value(a);
-                    }
-                }
-                if let Some((sys_span, Some(want))) = system
-                    && given != want
-                {
-                    self.diags.push(
-                            Diagnostic::error(
-                                Code::SeedArguments,
-                                format!("this seed passes {given} value{}, but the guide's lsystem takes {want}", plural(given)),
-                            )
-                            .primary(gs.span, format!("{given} passed"))
-                            .secondary(sys_span, format!("this lsystem has {want} parameter{}", plural(want)))
-                            .help(if want == 0 {
-                                "remove `with (…)`".to_string()
-                            } else {
-                                format!("pass them with `with (…)`: {want} value{}", plural(want))
-                            }),
-                        );
-                }
-            }
-            let mut missing = Vec::new();
-            if polygon.is_none() {
-                missing.push("a `polygon`");
-            }
-            if system.is_none() {
-                missing.push("a `system`");
-            }
-            if !missing.is_empty() {
-                self.diags.push(
-                    Diagnostic::error(
-                        Code::GuideIncomplete,
-                        format!("guide `{}` has no {}", g.name.name, missing.join(" and no ").trim_start_matches("a ")),
-                    )
-                    .primary(g.name.span, format!("needs {}", missing.join(" and ")))
-                    .help("a guide is a polygon hosting one lsystem: `polygon (0, 0) (10, 0) (10, 10); system Name;`"),
-                );
-            }
+            let (polygon, system) = self.guide_settings(g);
+            self.seeds(g, system);
+            self.guide_complete(g, polygon.is_some(), system.is_some());
             guides.insert(
                 &g.name.name,
                 (polygon.map_or(g.name.span, |p| p.0), polygon.map(|p| p.1)),
             );
         }
         for st in &s.body.stmts {
-            let SceneStmt::Link(l) = &st.node else {
+            if let SceneStmt::Link(l) = &st.node {
+                self.link(l, &guides);
+            }
+        }
+    }
+
+    /// A guide's polygon (its span and vertex count) and system (its span and
+    /// parameter count, when the lsystem exists).
+    fn guide_settings(&mut self, g: &'a crate::ast::Guide) -> (Option<(Span, usize)>, SystemRef) {
+        let mut polygon: Option<(Span, usize)> = None;
+        let mut system: SystemRef = None;
+        for gs in &g.body.stmts {
+            match &gs.node {
+                GuideStmt::Polygon(pts) => {
+                    if let Some((first, _)) = polygon {
+                        self.setting_twice("polygon", gs.span, first);
+                        continue;
+                    }
+                    for p in pts {
+                        self.const_num(&p.x, "a polygon coordinate");
+                        self.const_num(&p.y, "a polygon coordinate");
+                    }
+                    if pts.len() < 3 {
+                        self.diags.push(
+                            Diagnostic::error(
+                                Code::PolygonTooSmall,
+                                format!(
+                                    "a guide polygon needs at least 3 vertices, this one has {}",
+                                    pts.len()
+                                ),
+                            )
+                            .primary(gs.span, "too few vertices")
+                            .help("list the corners in order: polygon (0, 0) (10, 0) (10, 10);"),
+                        );
+                    }
+                    polygon = Some((gs.span, pts.len()));
+                }
+                GuideStmt::System(name) => {
+                    if let Some((first, _)) = system {
+                        self.setting_twice("system", gs.span, first);
+                        continue;
+                    }
+                    let params = match self.systems.get(name.name.as_str()) {
+                        Some(&(_, n)) => {
+                            self.used_systems.insert(name.name.clone());
+                            Some(n)
+                        }
+                        None => {
+                            let mut d = Diagnostic::error(
+                                Code::UnknownSystem,
+                                format!("there is no lsystem `{}`", name.name),
+                            )
+                            .primary(name.span, "not defined in this file");
+                            if let Some(sg) = suggest(&name.name, self.systems.keys().copied()) {
+                                d = d.help(format!("did you mean `{sg}`?"));
+                            }
+                            self.diags.push(d);
+                            None
+                        }
+                    };
+                    system = Some((name.span, params));
+                }
+                GuideStmt::Seed(_) | GuideStmt::Error => {}
+            }
+        }
+        (polygon, system)
+    }
+
+    /// A guide's seeds, now that its system's parameters are known.
+    fn seeds(&mut self, g: &'a crate::ast::Guide, system: SystemRef) {
+        for gs in &g.body.stmts {
+            let GuideStmt::Seed(seed) = &gs.node else {
                 continue;
             };
-            self.edge_ref(&l.from, &guides);
-            self.edge_ref(&l.to, &guides);
-            let mut seen: HashMap<&str, Span> = HashMap::new();
-            for ls in &l.body.stmts {
-                let (key, e) = match &ls.node {
-                    LinkStmt::Tokens(e) => ("tokens", e),
-                    LinkStmt::Heading(e) => ("heading", e),
-                    LinkStmt::Error => continue,
-                };
-                if let Some(first) = seen.get(key) {
-                    self.setting_twice(key, ls.span, *first);
-                    continue;
+            self.const_num(&seed.at.x, "a seed coordinate");
+            self.const_num(&seed.at.y, "a seed coordinate");
+            if let Some(h) = &seed.heading {
+                self.const_num(h, "a seed heading");
+            }
+            let given = seed.args.as_ref().map_or(0, Vec::len);
+            for a in seed.args.iter().flatten() {
+                if self.expect(a, &Env::new(), Ty::Num) == Ty::Num {
+                    self.record_value(a);
                 }
-                seen.insert(key, ls.span);
-                if key == "tokens" {
-                    self.const_int(e, "a token count", 0.0, 1e9);
-                } else {
-                    self.const_num(e, "a link heading");
-                }
+            }
+            if let Some((sys_span, Some(want))) = system
+                && given != want
+            {
+                self.diags.push(
+                        Diagnostic::error(
+                            Code::SeedArguments,
+                            format!("this seed passes {given} value{}, but the guide's lsystem takes {want}", plural(given)),
+                        )
+                        .primary(gs.span, format!("{given} passed"))
+                        .secondary(sys_span, format!("this lsystem has {want} parameter{}", plural(want)))
+                        .help(if want == 0 {
+                            "remove `with (…)`".to_string()
+                        } else {
+                            format!("pass them with `with (…)`: {want} value{}", plural(want))
+                        }),
+                    );
+            }
+        }
+    }
+
+    fn guide_complete(&mut self, g: &crate::ast::Guide, has_polygon: bool, has_system: bool) {
+        let mut missing = Vec::new();
+        if !has_polygon {
+            missing.push("a `polygon`");
+        }
+        if !has_system {
+            missing.push("a `system`");
+        }
+        if !missing.is_empty() {
+            self.diags.push(
+                Diagnostic::error(
+                    Code::GuideIncomplete,
+                    format!("guide `{}` has no {}", g.name.name, missing.join(" and no ").trim_start_matches("a ")),
+                )
+                .primary(g.name.span, format!("needs {}", missing.join(" and ")))
+                .help("a guide is a polygon hosting one lsystem: `polygon (0, 0) (10, 0) (10, 10); system Name;`"),
+            );
+        }
+    }
+
+    fn link(&mut self, l: &crate::ast::Link, guides: &HashMap<&str, (Span, Option<usize>)>) {
+        self.edge_ref(&l.from, guides);
+        self.edge_ref(&l.to, guides);
+        let mut seen: HashMap<&str, Span> = HashMap::new();
+        for ls in &l.body.stmts {
+            let (key, e) = match &ls.node {
+                LinkStmt::Tokens(e) => ("tokens", e),
+                LinkStmt::Heading(e) => ("heading", e),
+                LinkStmt::Error => continue,
+            };
+            if let Some(first) = seen.get(key) {
+                self.setting_twice(key, ls.span, *first);
+                continue;
+            }
+            seen.insert(key, ls.span);
+            if key == "tokens" {
+                self.const_int(e, "a token count", 0.0, 1e9);
+            } else {
+                self.const_num(e, "a link heading");
             }
         }
     }

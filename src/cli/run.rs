@@ -78,90 +78,28 @@ pub struct Args {
 }
 
 pub fn run(args: &Args, reporter: &Reporter) -> u8 {
-    let ovr = match overrides(&args.define) {
-        Ok(o) => o,
-        Err(d) => {
-            reporter.emit(&[d], "<command line>", "");
-            return 2;
-        }
-    };
-    let format = match &args.output {
-        Some(p) => match Format::from_path(p) {
-            Some(f) => Some(f),
-            None => {
-                reporter.error(
-                    &format!("cannot tell the output format of `{}`", p.display()),
-                    Some("use a file ending in .svg, .png, .obj or .txt"),
-                );
-                return 2;
-            }
-        },
-        None => None,
-    };
-    let background = if args.background == "none" {
-        [0, 0, 0, 0]
-    } else {
-        match lsyc::render::png::parse_color(&args.background) {
-            Some([r, g, b]) => [r, g, b, 255],
-            None => {
-                reporter.error(
-                    &format!("`{}` is not a colour", args.background),
-                    Some("write a colour as #rrggbb, #rrggbbaa or a name such as white or none"),
-                );
-                return 2;
-            }
-        }
-    };
+    match run_inner(args, reporter) {
+        Ok(()) => 0,
+        Err(status) => status,
+    }
+}
+
+/// `run` with the exit status of a failure as the error, so each step can `?`.
+fn run_inner(args: &Args, reporter: &Reporter) -> Result<(), u8> {
+    let ovr = overrides(&args.define).map_err(|d| {
+        reporter.emit(&[d], "<command line>", "");
+        2
+    })?;
+    let format = output_format(args, reporter)?;
+    let background = background(args, reporter)?;
     if let Some(n) = args.threads {
         // Only the first call in a process can set the global pool; later calls are harmless.
         let _ = rayon::ThreadPoolBuilder::new()
             .num_threads(n.max(1))
             .build_global();
     }
-    let src = match source::read(&args.file) {
-        Ok(s) => s,
-        Err(d) => {
-            reporter.emit(&[d], &args.file.display().to_string(), "");
-            return 1;
-        }
-    };
-    if let Some(out) = &args.output
-        && same_file(out, &args.file)
-    {
-        reporter.error(
-            &format!("the output `{}` is the input program", out.display()),
-            Some("choose another file: lsyc never writes over its input"),
-        );
-        return 2;
-    }
-    let mut fe = frontend::run_seeded(&src.text, src.diagnostics.clone(), &ovr, args.seed);
-    reporter.emit(&fe.diagnostics, &src.name, &src.text);
-    if fe.has_errors() {
-        return 1;
-    }
-    for spec in &args.elements {
-        let Some((name, file)) = spec.split_once('=') else {
-            reporter.error(
-                &format!("--element {spec}: not of the form NAME=FILE.svg"),
-                Some("e.g. --element A=leaf.svg"),
-            );
-            return 2;
-        };
-        let data = match std::fs::read(file) {
-            Ok(d) => d,
-            Err(e) => {
-                reporter.error(&format!("cannot read `{file}`: {e}"), None);
-                return 1;
-            }
-        };
-        if let Err(why) = lsyc::infer::art::replace_element(&mut fe.file, name, &data) {
-            reporter.error(&format!("--element {spec}: {why}"), None);
-            return 1;
-        }
-    }
-    let Some(checked) = fe.checked.as_ref() else {
-        return 1;
-    };
+    let (src, fe) = load(args, &ovr, reporter)?;
+    let checked = fe.checked.as_ref().ok_or(1u8)?;
     let has_scene = fe
         .file
         .items
@@ -178,41 +116,128 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         system: args.system.clone(),
     };
     if has_scene && args.system.is_none() && !args.disasm {
-        return run_scene(
+        return match run_scene(
             args, reporter, &src, &fe.file, checked, &opts, format, background,
-        );
-    }
-    if args.disasm {
-        return match lsyc::compile::compile(&fe.file, checked, opts.system.as_deref()) {
-            Ok(p) => {
-                print!("{}", p.disassemble());
-                0
-            }
-            Err(e) => {
-                reporter.emit(&[e.diagnostic()], &src.name, &src.text);
-                1
-            }
+        ) {
+            0 => Ok(()),
+            status => Err(status),
         };
     }
-    let steps_hint = args.steps;
-    let bar = progress_bar(steps_hint);
+    if args.disasm {
+        let prog =
+            lsyc::compile::compile(&fe.file, checked, opts.system.as_deref()).map_err(|e| {
+                reporter.emit(&[e.diagnostic()], &src.name, &src.text);
+                1u8
+            })?;
+        print!("{}", prog.disassemble());
+        return Ok(());
+    }
+    run_system(args, reporter, &src, &fe, &opts, format, background)
+}
+
+/// The output format, from the output file's extension.
+fn output_format(args: &Args, reporter: &Reporter) -> Result<Option<Format>, u8> {
+    let Some(p) = &args.output else {
+        return Ok(None);
+    };
+    Format::from_path(p).map(Some).ok_or_else(|| {
+        reporter.error(
+            &format!("cannot tell the output format of `{}`", p.display()),
+            Some("use a file ending in .svg, .png, .obj or .txt"),
+        );
+        2
+    })
+}
+
+/// The PNG background as RGBA.
+fn background(args: &Args, reporter: &Reporter) -> Result<[u8; 4], u8> {
+    if args.background == "none" {
+        return Ok([0, 0, 0, 0]);
+    }
+    match lsyc::render::png::parse_color(&args.background) {
+        Some([r, g, b]) => Ok([r, g, b, 255]),
+        None => {
+            reporter.error(
+                &format!("`{}` is not a colour", args.background),
+                Some("write a colour as #rrggbb, #rrggbbaa or a name such as white or none"),
+            );
+            Err(2)
+        }
+    }
+}
+
+/// Reads and checks the program (its diagnostics reported), with the
+/// `--element` replacements applied.
+fn load(
+    args: &Args,
+    ovr: &[lsyc::check::Override],
+    reporter: &Reporter,
+) -> Result<(source::Source, frontend::Frontend), u8> {
+    let src = source::read(&args.file).map_err(|d| {
+        reporter.emit(&[d], &args.file.display().to_string(), "");
+        1u8
+    })?;
+    if let Some(out) = &args.output
+        && same_file(out, &args.file)
+    {
+        reporter.error(
+            &format!("the output `{}` is the input program", out.display()),
+            Some("choose another file: lsyc never writes over its input"),
+        );
+        return Err(2);
+    }
+    let mut fe = frontend::run_seeded(&src.text, src.diagnostics.clone(), ovr, args.seed);
+    reporter.emit(&fe.diagnostics, &src.name, &src.text);
+    if fe.has_errors() {
+        return Err(1);
+    }
+    for spec in &args.elements {
+        let Some((name, file)) = spec.split_once('=') else {
+            reporter.error(
+                &format!("--element {spec}: not of the form NAME=FILE.svg"),
+                Some("e.g. --element A=leaf.svg"),
+            );
+            return Err(2);
+        };
+        let data = std::fs::read(file).map_err(|e| {
+            reporter.error(&format!("cannot read `{file}`: {e}"), None);
+            1u8
+        })?;
+        if let Err(why) = lsyc::infer::art::replace_element(&mut fe.file, name, &data) {
+            reporter.error(&format!("--element {spec}: {why}"), None);
+            return Err(1);
+        }
+    }
+    Ok((src, fe))
+}
+
+/// Derives one lsystem, draws it (to a file with `-o`) and reports the summary.
+fn run_system(
+    args: &Args,
+    reporter: &Reporter,
+    src: &source::Source,
+    fe: &frontend::Frontend,
+    opts: &Options,
+    format: Option<Format>,
+    background: [u8; 4],
+) -> Result<(), u8> {
+    let checked = fe.checked.as_ref().ok_or(1u8)?;
+    let fail = |d: lsyc::diagnostic::Diagnostic| {
+        reporter.emit(&[d], &src.name, &src.text);
+        1u8
+    };
+    let bar = progress_bar(args.steps);
     let on_step = |step: u32, modules: usize| {
         if let Some(b) = &bar {
             b.set_position(step as u64);
             b.set_message(format!("{modules} modules"));
         }
     };
-    let derived = run::derive(&fe.file, checked, &opts, &on_step);
+    let derived = run::derive(&fe.file, checked, opts, &on_step);
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let derived = match derived {
-        Ok(d) => d,
-        Err(d) => {
-            reporter.emit(&[d], &src.name, &src.text);
-            return 1;
-        }
-    };
+    let derived = derived.map_err(fail)?;
     let start = Instant::now();
     let drawn = match (format, &args.output) {
         (Some(format), Some(path)) => {
@@ -220,20 +245,12 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
                 size: args.size,
                 background,
             };
-            match write_file(path, reporter, &src, |w| {
+            write_file(path, reporter, src, |w| {
                 run::write_output(&derived, format, picture, args.seed, w)
-            }) {
-                Some(d) => d,
-                None => return 1,
-            }
+            })
+            .ok_or(1u8)?
         }
-        _ => match run::measure(&derived, args.seed) {
-            Ok((d, _)) => d,
-            Err(d) => {
-                reporter.emit(&[d], &src.name, &src.text);
-                return 1;
-            }
-        },
+        _ => run::measure(&derived, args.seed).map_err(fail)?.0,
     };
     let stats = Stats::new(&derived, &drawn, start.elapsed().as_secs_f64() * 1000.0);
     let wrote = report_stats(args, &stats);
@@ -248,7 +265,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         stats.interpret_ms
     ));
     let _ = std::io::stdout().flush();
-    0
+    Ok(())
 }
 
 /// Writes an output file atomically with `fill`; on failure reports why (a
