@@ -211,31 +211,39 @@ mod tests {
     #[test]
     fn fixed_point_numbers() {
         let f = |n: i64, d: usize| text(|b| write_fixed(b, n, d));
-        assert_eq!(f(0, 3), "0");
-        assert_eq!(f(1500, 3), "1.5");
-        assert_eq!(f(-1250, 3), "-1.25");
-        assert_eq!(f(41, 3), "0.041");
-        assert_eq!(f(-1, 3), "-0.001");
-        assert_eq!(f(12, 0), "12");
-        assert_eq!(f(120, 1), "12");
+        for (n, d, want) in [
+            (0, 3, "0"),
+            (1500, 3, "1.5"),
+            (-1250, 3, "-1.25"),
+            (41, 3, "0.041"),
+            (-1, 3, "-0.001"),
+            (12, 0, "12"),
+            (120, 1, "12"),
+            (i64::MIN, 0, "-9223372036854775808"),
+        ] {
+            assert_eq!(f(n, d), want, "{n} {d}");
+        }
         assert_eq!(f(i64::MIN + 1, 2).len(), 21);
-        assert_eq!(f(i64::MIN, 0), "-9223372036854775808");
         assert_eq!(f(5, 30), format!("0.{}5", "0".repeat(29)));
     }
 
     #[test]
     fn decimal_numbers_are_short_and_exact_enough() {
         let n = |v: f64, d: usize| text(|b| write_decimals(b, v, d));
-        assert_eq!(n(0.0, 3), "0");
-        assert_eq!(n(1.5, 3), "1.5");
-        assert_eq!(n(-1.25, 3), "-1.25");
-        assert_eq!(n(0.0004, 3), "0");
-        assert_eq!(n(-0.0004, 3), "0");
-        assert_eq!(n(0.0405, 3), "0.041");
-        assert_eq!(n(12.0, 0), "12");
-        assert_eq!(n(-0.001, 3), "-0.001");
-        assert_eq!(n(1.23456, 2), "1.23");
-        assert_eq!(n(f64::NAN, 2), "0");
+        for (v, d, want) in [
+            (0.0, 3, "0"),
+            (1.5, 3, "1.5"),
+            (-1.25, 3, "-1.25"),
+            (0.0004, 3, "0"),
+            (-0.0004, 3, "0"),
+            (0.0405, 3, "0.041"),
+            (12.0, 0, "12"),
+            (-0.001, 3, "-0.001"),
+            (1.23456, 2, "1.23"),
+            (f64::NAN, 2, "0"),
+        ] {
+            assert_eq!(n(v, d), want, "{v} {d}");
+        }
         assert_eq!(n(1e300, 2), format!("{}", 1e300));
     }
 

@@ -105,16 +105,11 @@ impl System {
         self.springs.push(Spring { a, b, rest, k });
     }
 
-    /// Moves the pinned particles to their targets and relaxes the free ones.
-    pub fn solve(&self, pins: &BTreeMap<usize, DVec2>, params: &Params) -> Solution {
+    /// The variables: the free particles reached through springs from a pinned
+    /// one, in index order (`free`), and each particle's index among them
+    /// (`var`, `usize::MAX` for the others).
+    fn variables(&self, pins: &BTreeMap<usize, DVec2>) -> (Vec<usize>, Vec<usize>) {
         let n = self.rest.len();
-        let mut x = self.rest.clone();
-        for (&i, &t) in pins {
-            if i < n {
-                x[i] = t;
-            }
-        }
-        // The variables: particles reached through springs from a pinned one.
         let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
         for s in &self.springs {
             adj[s.a].push(s.b);
@@ -142,6 +137,19 @@ impl System {
                 free.push(i);
             }
         }
+        (var, free)
+    }
+
+    /// Moves the pinned particles to their targets and relaxes the free ones.
+    pub fn solve(&self, pins: &BTreeMap<usize, DVec2>, params: &Params) -> Solution {
+        let n = self.rest.len();
+        let mut x = self.rest.clone();
+        for (&i, &t) in pins {
+            if i < n {
+                x[i] = t;
+            }
+        }
+        let (var, free) = self.variables(pins);
         let springs: Vec<Spring> = self
             .springs
             .iter()

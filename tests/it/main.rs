@@ -5,6 +5,7 @@ mod cli;
 mod corpus;
 mod diagnostics;
 mod edit;
+mod geometry;
 mod guided;
 mod infer;
 mod run;

@@ -1,13 +1,13 @@
-//! A uniform grid over points: the spatial index for nearest neighbours and
-//! for the points within a distance (snapping).
+//! A uniform grid over points: the index for nearest neighbours (inference's
+//! transformation spaces) and for the points within a distance (snapping guide
+//! vertices in `lsyc edit`).
 //!
 //! Owns: choosing the cells (about two points a cell, or a size the caller
 //! gives) and the two searches. Every search returns exactly what a scan of all
-//! points would, ties broken by the lower index, so the index changes speed,
-//! never answers. Must not know what the points stand for. (The segments drawn
-//! in a guide have their own index, `env::index`, built for crossings and rays.)
+//! points would, ties broken by the lower index. Must not know what the points
+//! stand for.
 
-use super::dist;
+use crate::geometry::dist;
 use glam::DVec2;
 use std::collections::HashMap;
 
