@@ -190,8 +190,8 @@ pub fn rotation_degrees(m: &DAffine2) -> f64 {
     (x.y - y.x).atan2(x.x + y.y).to_degrees()
 }
 
-/// The rotation by `deg` degrees counter-clockwise and scaling by `k` about `c`,
-/// applied to `p`.
+/// `p` rotated counter-clockwise by the angle whose (sine, cosine) is
+/// `sin_cos` and scaled by `k`, both about `c`.
 pub fn rotate_scale_about(p: DVec2, c: DVec2, sin_cos: (f64, f64), k: f64) -> DVec2 {
     let (sin, cos) = sin_cos;
     let d = p - c;

@@ -116,10 +116,18 @@ pub struct Polyline {
 /// The subpaths of `path` as polylines: each curve becomes [`CURVE_STEPS`]
 /// pieces of equal parameter steps (its end point included).
 pub fn flatten(path: &BezPath) -> Vec<Polyline> {
+    flatten_steps(path, CURVE_STEPS)
+}
+
+/// [`flatten`] with `steps` pieces a curve (at least one): the same rule and
+/// arithmetic, for a caller that has its own count (inference reads drawings
+/// with 12).
+pub fn flatten_steps(path: &BezPath, steps: usize) -> Vec<Polyline> {
     let mut out: Vec<Polyline> = Vec::new();
     let mut cur = Polyline::default();
     let mut last = DVec2::ZERO;
-    let steps = (1..=CURVE_STEPS).map(|k| k as f64 / CURVE_STEPS as f64);
+    let n = steps.max(1);
+    let steps = (1..=n).map(|k| k as f64 / n as f64);
     for el in path.elements() {
         match *el {
             PathEl::MoveTo(a) => {
@@ -223,5 +231,7 @@ mod tests {
         assert_eq!(o.len(), 3);
         assert_eq!(largest_outline("M0 0 L5 5"), None);
         assert_eq!(largest_outline("M0 0 L5 x"), None);
+        assert_eq!(flatten_steps(&p, 12)[0].points.len(), 13);
+        assert_eq!(flatten_steps(&p, CURVE_STEPS), subs);
     }
 }
