@@ -69,6 +69,7 @@ codes! {
     ArityFunction = "E0403", "a function called with the wrong number of arguments";
     QuerySignature = "E0404", "a query module written against its fixed signature";
     ArgsNotAllowed = "E0405", "parameters on a symbol that takes none";
+    TooManyParameters = "E0406", "a module with more than 255 parameters";
     TypeMismatch = "E0501", "a boolean where a number is needed, or the reverse";
     ConditionNotBool = "E0502", "a rule condition that is not a boolean";
     ConstCycle = "E0503", "constants defined in terms of each other";
@@ -79,6 +80,7 @@ codes! {
     UnbalancedPolygon = "E0602", "`{` and `}` that do not pair up";
     MissingAxiom = "E0603", "an lsystem without an axiom";
     DuplicateSetting = "E0604", "a setting given twice";
+    NoLsystem = "E0605", "a file with no lsystem to run";
     InvalidPath = "E0701", "element path data that is not valid SVG";
     MissingPath = "E0702", "an element without a `path`";
     UnknownProperty = "E0703", "an element property lsyc does not know";
@@ -92,6 +94,10 @@ codes! {
     TooManyModules = "E0903", "a derivation step that would exceed the module limit";
     TooMuchMemory = "E0904", "a derivation step that would exceed the memory limit";
     InterpretTooDeep = "E0905", "interpretation rules that expand into each other too deeply";
+    TooManySymbols = "E0906", "a program with more distinct modules than the string can number";
+    TooManySteps = "E0907", "more derivation steps than the limit";
+    TooMuchDrawing = "E0908", "interpretation that would draw more than the module limit";
+    DrawingTooLarge = "E0909", "a drawing with coordinates too large to write";
     Unused = "W0101", "a declaration that nothing uses";
     UnusedParameter = "W0102", "a rule parameter that nothing uses";
     NeverProduced = "W0201", "a rule whose predecessor never appears";

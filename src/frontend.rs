@@ -22,14 +22,19 @@ impl Frontend {
 }
 
 /// Parses and checks a source text. `pre` are diagnostics found while reading it
-/// (such as invalid UTF-8).
+/// (such as invalid UTF-8). Random constants draw from seed 0.
 pub fn run(text: &str, pre: Vec<Diagnostic>, overrides: &[Override]) -> Frontend {
+    run_seeded(text, pre, overrides, 0)
+}
+
+/// `run`, with random constants drawn from `seed` (the run's `--seed`).
+pub fn run_seeded(text: &str, pre: Vec<Diagnostic>, overrides: &[Override], seed: u64) -> Frontend {
     let parsed = parser::parse(text);
     let mut diagnostics = pre;
     diagnostics.extend(parsed.diagnostics);
     let mut checked = None;
     if !diagnostics.iter().any(Diagnostic::is_error) {
-        let c = check::check(&parsed.file, overrides);
+        let c = check::check(&parsed.file, overrides, seed);
         diagnostics.extend(c.diagnostics.iter().cloned());
         checked = Some(c);
     }

@@ -8,11 +8,10 @@
 use crate::ast::File;
 use crate::check::Checked;
 use crate::compile::{self, Action, Program};
-use crate::derive::{self, DeriveError, Limits, ModString};
+use crate::derive::{self, Limits, ModString};
 use crate::diagnostic::{Code, Diagnostic};
 use crate::render::{self, Bounds, BoundsSink, View};
 use crate::turtle::{self, Drawn};
-use crate::vm::Fault;
 use serde::Serialize;
 use std::io::Write;
 use std::time::Instant;
@@ -33,6 +32,23 @@ pub struct Derived {
     pub string: ModString,
     pub steps: u32,
     pub derive_ms: f64,
+    /// The limits of the run, which interpretation honours too.
+    pub limits: Limits,
+}
+
+impl Derived {
+    /// Interprets the derived string into `sink`, within the run's limits.
+    pub fn interpret(&self, seed: u64, sink: &mut dyn turtle::Sink) -> Result<Drawn, Diagnostic> {
+        turtle::interpret_limited(
+            &self.prog,
+            &self.string,
+            seed,
+            turtle::State::default(),
+            self.limits,
+            sink,
+        )
+        .map_err(|e| e.diagnostic(&self.prog))
+    }
 }
 
 /// Compiles and derives. `progress(step, modules)` is called after each step.
@@ -42,67 +58,21 @@ pub fn derive(
     opts: &Options,
     progress: &(dyn Fn(u32, usize) + Sync),
 ) -> Result<Derived, Diagnostic> {
-    let prog = compile::compile(file, checked, opts.system.as_deref())
-        .map_err(|m| Diagnostic::error(Code::UnknownSystem, m))?;
+    let prog =
+        compile::compile(file, checked, opts.system.as_deref()).map_err(|e| e.diagnostic())?;
     let steps = opts.steps.unwrap_or(prog.derive);
     let start = Instant::now();
     let args = vec![0.0; prog.params.len()];
     let result = derive::axiom(&prog, &args, opts.seed)
         .and_then(|a| derive::derive(&prog, a, steps, opts.seed, opts.limits, progress));
-    let string = result.map_err(|e| runtime_diagnostic(&e, &prog))?;
+    let string = result.map_err(|e| e.diagnostic(&prog))?;
     Ok(Derived {
         prog,
         string,
         steps,
         derive_ms: start.elapsed().as_secs_f64() * 1000.0,
+        limits: opts.limits,
     })
-}
-
-/// A runtime failure as a diagnostic pointing into the program.
-pub fn runtime_diagnostic(e: &DeriveError, prog: &Program) -> Diagnostic {
-    let when = |step: u32| match step {
-        0 => "while evaluating the axiom".to_string(),
-        u32::MAX => "while drawing (in an interpretation rule)".to_string(),
-        s => format!("in derivation step {s}"),
-    };
-    match e {
-        DeriveError::Vm { step, error } => match error.fault {
-            Fault::DivisionByZero => Diagnostic::error(
-                Code::DivisionByZero,
-                format!("division by zero {}", when(*step)),
-            )
-            .primary(error.span, "this divides by zero")
-            .help("guard the rule with a condition, e.g. `A(x) : x != 0 -> …`"),
-            Fault::NotFinite => Diagnostic::error(
-                Code::NotFinite,
-                format!("an expression is not a finite number {}", when(*step)),
-            )
-            .primary(error.span, "this gives infinity or NaN")
-            .help("check the operands: a square root or logarithm of a negative number, or a value that overflows"),
-        },
-        DeriveError::TooManyModules { step, modules, limit } => Diagnostic::error(
-            Code::TooManyModules,
-            format!("derivation step {step} would produce {modules} modules, more than the limit of {limit}"),
-        )
-        .primary(prog.name_span, "this lsystem grows too fast")
-        .help("derive fewer steps with -n, or raise the limit with --max-modules"),
-        DeriveError::TooMuchMemory { step, bytes, limit } => Diagnostic::error(
-            Code::TooMuchMemory,
-            format!(
-                "derivation step {step} would need about {} MiB, more than the limit of {} MiB",
-                bytes >> 20,
-                limit >> 20
-            ),
-        )
-        .primary(prog.name_span, "this lsystem grows too fast")
-        .help("derive fewer steps with -n, or raise the limit with --max-memory"),
-        DeriveError::InterpretTooDeep { module, depth } => Diagnostic::error(
-            Code::InterpretTooDeep,
-            format!("interpretation rules expand `{module}` more than {depth} levels deep"),
-        )
-        .primary(prog.name_span, "an `interpret` rule produces a module that is interpreted again, endlessly")
-        .help("interpretation rules must end in modules that draw; a rule like `interpret A -> B; interpret B -> A;` never does"),
-    }
 }
 
 /// The output formats, by file extension.
@@ -159,9 +129,40 @@ pub fn measure(d: &Derived, seed: u64) -> Result<(Drawn, Bounds), Diagnostic> {
         bounds: Bounds::default(),
         element_boxes: &boxes,
     };
-    let drawn = turtle::interpret(&d.prog, &d.string, seed, &mut sink)
-        .map_err(|e| runtime_diagnostic(&e, &d.prog))?;
+    let drawn = d.interpret(seed, &mut sink)?;
+    check_extent(&sink.bounds, &d.prog)?;
     Ok((drawn, sink.bounds))
+}
+
+/// The largest coordinate a drawing may reach: the writers place points in
+/// fixed point with up to nine decimals in 64-bit integers, and viewers work
+/// in 32-bit floats.
+pub const MAX_COORDINATE: f64 = 1e9;
+
+/// An error if the drawing reaches coordinates the writers cannot place.
+fn check_extent(b: &Bounds, prog: &Program) -> Result<(), Diagnostic> {
+    if !b.any {
+        return Ok(());
+    }
+    let far = [b.min.x, b.min.y, b.max.x, b.max.y]
+        .into_iter()
+        .map(f64::abs)
+        .fold(
+            0.0,
+            |m: f64, v| if v.is_nan() { f64::INFINITY } else { m.max(v) },
+        );
+    if far <= MAX_COORDINATE {
+        return Ok(());
+    }
+    Err(Diagnostic::error(
+        Code::DrawingTooLarge,
+        format!("the drawing reaches the coordinate {far:e}, beyond ±{MAX_COORDINATE:e}"),
+    )
+    .primary(
+        prog.name_span,
+        "this lsystem draws that far from the origin",
+    )
+    .help("use smaller lengths, fewer steps, or a scale `*(k)` below 1"))
 }
 
 /// Why writing an output failed.
@@ -184,7 +185,6 @@ pub fn write_output(
     seed: u64,
     out: &mut dyn Write,
 ) -> Result<Drawn, OutputError> {
-    let diag = |e: DeriveError| OutputError::Diagnostic(runtime_diagnostic(&e, &d.prog));
     match format {
         Format::Txt => {
             render::txt::write(out, &d.prog, &d.string)?;
@@ -204,7 +204,7 @@ pub fn write_output(
                 .collect();
             let view = View::new(d.prog.is_3d);
             let mut w = render::svg::SvgWriter::new(out, view, &bounds, &d.prog.elements, &used)?;
-            let drawn = turtle::interpret(&d.prog, &d.string, seed, &mut w).map_err(diag)?;
+            let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
             w.finish()?;
             Ok(drawn)
         }
@@ -219,15 +219,16 @@ pub fn write_output(
                 &d.prog.elements,
             )
             .ok_or_else(|| std::io::Error::other("the image size is not possible"))?;
-            let drawn = turtle::interpret(&d.prog, &d.string, seed, &mut w).map_err(diag)?;
+            let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
             let bytes = w.finish().map_err(std::io::Error::other)?;
             out.write_all(&bytes)?;
             Ok(drawn)
         }
         Format::Obj => {
+            measure(d, seed).map_err(OutputError::Diagnostic)?;
             let options = render::obj::ObjOptions::for_program(&d.prog);
             let mut w = render::obj::ObjWriter::new(out, options);
-            let drawn = turtle::interpret(&d.prog, &d.string, seed, &mut w).map_err(diag)?;
+            let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
             w.finish()?;
             Ok(drawn)
         }
@@ -282,8 +283,7 @@ pub fn run_scene(
     name: Option<&str>,
     opts: &Options,
 ) -> Result<SceneRun, Diagnostic> {
-    let mut scene =
-        crate::env::build(file, checked, name).map_err(crate::env::scene::build_error)?;
+    let mut scene = crate::env::build(file, checked, name).map_err(|e| e.diagnostic())?;
     let start = Instant::now();
     let outcome = crate::env::run(&mut scene, opts.seed, opts.limits, opts.steps)?;
     Ok(SceneRun {
@@ -318,7 +318,7 @@ fn draw_scene(
             let mut clip =
                 crate::env::scene::Clip::new(&g.polygon, &centres[g.program], &mut *sink);
             turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
-                .map_err(|e| runtime_diagnostic(&e, prog))?;
+                .map_err(|e| e.diagnostic(prog))?;
             let d = clip.kept;
             total.segments += d.segments;
             total.elements += d.elements;
@@ -402,7 +402,7 @@ pub fn write_scene(
                     let mut clip =
                         crate::env::scene::Clip::new(&g.polygon, &centres[g.program], &mut w);
                     turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
-                        .map_err(|e| OutputError::Diagnostic(runtime_diagnostic(&e, prog)))?;
+                        .map_err(|e| OutputError::Diagnostic(e.diagnostic(prog)))?;
                 }
                 w.end_guide();
             }

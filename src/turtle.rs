@@ -9,12 +9,17 @@
 //! Must not know output formats: it only calls the sink.
 
 use crate::compile::{Action, Program, Sym};
-use crate::derive::{DeriveError, ModString};
+use crate::derive::{DeriveError, Limits, ModString};
 use crate::vm::{Random, VmError};
 use glam::DVec3;
 
 /// How deep interpretation rules may expand into each other.
 pub const MAX_INTERPRET_DEPTH: usize = 64;
+
+/// The most modules interpretation rules may expand one module of the string
+/// into (a leaf, a flower: tens to thousands). The whole drawing is bounded by
+/// the module limit as well.
+pub const MAX_EXPANSION: usize = 1_000_000;
 
 /// Where the geometry goes.
 pub trait Sink {
@@ -169,7 +174,8 @@ pub fn interpret(
     interpret_from(prog, s, seed, State::default(), sink)
 }
 
-/// Interprets from a given start state (a seed's position and heading).
+/// Interprets from a given start state (a seed's position and heading), with
+/// the default limits.
 pub fn interpret_from(
     prog: &Program,
     s: &ModString,
@@ -177,7 +183,24 @@ pub fn interpret_from(
     start: State,
     sink: &mut dyn Sink,
 ) -> Result<Drawn, DeriveError> {
+    interpret_limited(prog, s, seed, start, Limits::default(), sink)
+}
+
+/// Interprets from a start state. The modules interpretation rules expand into
+/// count against `limits.max_modules`, with the string's own: a rule that
+/// doubles at every level cannot run for hours.
+pub fn interpret_limited(
+    prog: &Program,
+    s: &ModString,
+    seed: u64,
+    start: State,
+    limits: Limits,
+    sink: &mut dyn Sink,
+) -> Result<Drawn, DeriveError> {
     let mut t = Turtle {
+        expanded: s.len(),
+        max_modules: limits.max_modules,
+        expanded_here: 0,
         prog,
         sink,
         state: start,
@@ -202,6 +225,7 @@ pub fn interpret_from(
         p += n;
         t.module_index = i;
         if has_interp && !prog.interpret[sym as usize].is_empty() {
+            t.expanded_here = 0;
             t.expand(sym, params, i as u64, 0)?;
         } else {
             t.module(sym, params);
@@ -224,6 +248,11 @@ struct Turtle<'a> {
     cands: Vec<(usize, f64)>,
     /// Index of the module being interpreted (for query answers).
     module_index: usize,
+    /// Modules interpreted so far, expansions included, and the most allowed.
+    expanded: usize,
+    max_modules: usize,
+    /// Modules the current module of the string has expanded into.
+    expanded_here: usize,
 }
 
 impl Turtle<'_> {
@@ -308,6 +337,20 @@ impl Turtle<'_> {
             self.module(sym, params);
             return Ok(());
         };
+        self.expanded = self.expanded.saturating_add(rule.succ.len());
+        self.expanded_here = self.expanded_here.saturating_add(rule.succ.len());
+        if self.expanded > self.max_modules || self.expanded_here > MAX_EXPANSION {
+            let one = self.expanded_here > MAX_EXPANSION;
+            return Err(DeriveError::TooMuchDrawing {
+                limit: if one { MAX_EXPANSION } else { self.max_modules },
+                module: one.then(|| {
+                    self.prog.symbols.info[sym as usize]
+                        .name
+                        .text()
+                        .into_owned()
+                }),
+            });
+        }
         for e in &rule.succ {
             // Up to 16 parameters live on the stack; more go to the heap.
             let mut small = [0.0f64; 16];

@@ -1,11 +1,13 @@
 //! Expression checking: names, types (number or boolean), calls, and constant
-//! evaluation of what must be known before derivation.
+//! evaluation (through the compiler and VM) of what must be known before derivation.
 
 use super::Checker;
 use crate::ast::{BinOp, Expr, ExprKind, UnOp};
 use crate::builtins;
 use crate::diagnostic::{Code, Diagnostic};
 use crate::span::Span;
+use crate::vm::expr::{ExprError, Known, evaluate};
+use crate::vm::{Fault, Random};
 use std::cell::Cell;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -32,6 +34,20 @@ pub enum Value {
     Num(f64),
     Bool(bool),
 }
+
+impl Value {
+    /// The value as the VM holds it: booleans are 0 and 1.
+    pub fn as_f64(self) -> f64 {
+        match self {
+            Value::Num(x) => x,
+            Value::Bool(b) => f64::from(u8::from(b)),
+        }
+    }
+}
+
+/// The derivation "step" of the random stream constants draw from: apart from
+/// every step the derivation and the turtle use.
+pub const CONST_STEP: u32 = u32::MAX - 1;
 
 /// Names in scope for an expression besides the constants: parameters.
 #[derive(Default)]
@@ -262,46 +278,71 @@ impl Checker<'_> {
     }
 
     /// The value of an expression made only of literals, constants and
-    /// deterministic functions; `None` otherwise.
+    /// functions, through the compiler and the VM (the one evaluator); `None`
+    /// if it uses a parameter of `env`, an unknown name, draws random numbers
+    /// or fails (a division by zero).
+    pub fn eval_in(&self, e: &Expr, env: &Env) -> Option<Value> {
+        match self.evaluate(e, env, u64::MAX) {
+            Ok((v, false)) => Some(v),
+            _ => None,
+        }
+    }
+
+    /// `eval_in` with no parameters in scope.
     pub fn eval(&self, e: &Expr) -> Option<Value> {
-        Some(match &e.kind {
-            ExprKind::Num(v) => Value::Num(*v),
-            ExprKind::Bool(b) => Value::Bool(*b),
-            ExprKind::Var(n) => return self.consts.get(n.as_str()).and_then(|c| c.value),
-            ExprKind::Error => return None,
-            ExprKind::Unary(UnOp::Neg, a) => Value::Num(-num(self.eval(a)?)?),
-            ExprKind::Unary(UnOp::Not, a) => Value::Bool(!boolean(self.eval(a)?)?),
-            ExprKind::Binary(op, a, b) => {
-                let (x, y) = (self.eval(a)?, self.eval(b)?);
-                match op {
-                    BinOp::Or => Value::Bool(boolean(x)? || boolean(y)?),
-                    BinOp::And => Value::Bool(boolean(x)? && boolean(y)?),
-                    BinOp::Eq => Value::Bool(x == y),
-                    BinOp::Ne => Value::Bool(x != y),
-                    _ => {
-                        let (x, y) = (num(x)?, num(y)?);
-                        match op {
-                            BinOp::Lt => Value::Bool(x < y),
-                            BinOp::Le => Value::Bool(x <= y),
-                            BinOp::Gt => Value::Bool(x > y),
-                            BinOp::Ge => Value::Bool(x >= y),
-                            BinOp::Add => Value::Num(x + y),
-                            BinOp::Sub => Value::Num(x - y),
-                            BinOp::Mul => Value::Num(x * y),
-                            BinOp::Div => Value::Num(x / y),
-                            BinOp::Rem => Value::Num(x % y),
-                            BinOp::Pow => Value::Num(x.powf(y)),
-                            _ => return None,
-                        }
-                    }
-                }
+        self.eval_in(e, &Env::new())
+    }
+
+    /// Evaluates a parameterless expression, drawing random numbers from the
+    /// constants' stream `stream` of the run's seed. Returns the value (typed
+    /// by the checker's type of `e`) and whether it is random.
+    pub fn evaluate(&self, e: &Expr, env: &Env, stream: u64) -> Result<(Value, bool), ExprError> {
+        let lookup = |name: &str| -> Option<Known> {
+            if env.find(name).is_some() {
+                return None;
             }
-            ExprKind::Call(f, args) => {
-                let vals: Option<Vec<f64>> =
-                    args.iter().map(|a| self.eval(a).and_then(num)).collect();
-                Value::Num(builtins::eval(&f.name, &vals?)?)
+            let c = self.consts.get(name)?;
+            Some(Known {
+                value: c.value?.as_f64(),
+                random: c.random,
+            })
+        };
+        let mut rng = Random::new(self.seed, CONST_STEP, stream);
+        let out = evaluate(e, &lookup, &mut rng)?;
+        let v = if self.is_bool(e, env) {
+            Value::Bool(out.value != 0.0)
+        } else {
+            Value::Num(out.value)
+        };
+        Ok((v, out.random))
+    }
+
+    /// Whether an expression is boolean (its type, without reporting anything).
+    fn is_bool(&self, e: &Expr, env: &Env) -> bool {
+        match &e.kind {
+            ExprKind::Bool(_) => true,
+            ExprKind::Var(n) => match env.find(n) {
+                Some(p) => p.ty == Ty::Bool,
+                None => self
+                    .consts
+                    .get(n.as_str())
+                    .is_some_and(|c| c.ty == Ty::Bool),
+            },
+            ExprKind::Unary(UnOp::Not, _) => true,
+            ExprKind::Binary(op, _, _) => {
+                matches!(op, BinOp::And | BinOp::Or | BinOp::Eq | BinOp::Ne) || op.is_comparison()
             }
-        })
+            _ => false,
+        }
+    }
+
+    /// Records the value of a parameterless numeric expression that may draw
+    /// random numbers (a seed's arguments), drawn from a stream of its own.
+    pub fn record_value(&mut self, e: &Expr) {
+        if let Ok((Value::Num(v), _)) = self.evaluate(e, &Env::new(), u64::from(e.span.start) << 32)
+        {
+            self.values.insert(e.span, v);
+        }
     }
 
     /// Checks an expression that must be a number known before derivation
@@ -313,16 +354,26 @@ impl Checker<'_> {
         if ty != Ty::Num || self.diags.len() > before {
             return None;
         }
-        match self.eval(e) {
-            Some(Value::Num(v)) if v.is_finite() => Some(v),
-            Some(_) => {
+        match self.evaluate(e, &env, u64::MAX) {
+            Ok((Value::Num(v), false)) => {
+                self.values.insert(e.span, v);
+                Some(v)
+            }
+            Ok((Value::Bool(_), false)) => None,
+            Err(ExprError::Vm(err)) => {
                 self.diags.push(
-                    Diagnostic::error(Code::OutOfRange, format!("{what} is not a finite number"))
-                        .primary(e.span, "this evaluates to infinity or NaN"),
+                    Diagnostic::error(
+                        match err.fault {
+                            Fault::DivisionByZero => Code::DivisionByZero,
+                            Fault::NotFinite => Code::OutOfRange,
+                        },
+                        format!("{what} is not a finite number"),
+                    )
+                    .primary(err.span, err.fault.label()),
                 );
                 None
             }
-            None => {
+            _ => {
                 self.diags.push(
                     Diagnostic::error(
                         Code::NotConstant,
@@ -355,20 +406,6 @@ impl Checker<'_> {
             return None;
         }
         Some(v as i64)
-    }
-}
-
-fn num(v: Value) -> Option<f64> {
-    match v {
-        Value::Num(x) => Some(x),
-        Value::Bool(_) => None,
-    }
-}
-
-fn boolean(v: Value) -> Option<bool> {
-    match v {
-        Value::Bool(b) => Some(b),
-        Value::Num(_) => None,
     }
 }
 

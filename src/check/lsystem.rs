@@ -485,6 +485,11 @@ impl<'a> Checker<'a> {
     }
 
     fn module_args(&mut self, m: &Module, env: &Env) {
+        // A declared module's count is checked at its declaration (E0406) and
+        // against it here (E0401).
+        if !matches!(&m.name, ModName::Name(n) if self.modules.contains_key(n.as_str())) {
+            self.too_many_params(m.arity(), m.span);
+        }
         for a in m.args.iter().flatten() {
             self.expect(a, env, Ty::Num);
         }

@@ -8,12 +8,17 @@ mod expr;
 mod lsystem;
 mod scene;
 
-pub use expr::{Env, Ty, Value, distance, suggest};
+pub use expr::{CONST_STEP, Env, Ty, Value, distance, suggest};
 
 use crate::ast::{ConstDecl, Expr, ExprKind, File, Item};
 use crate::diagnostic::{Code, Diagnostic};
 use crate::span::Span;
+use crate::vm::Fault;
+use crate::vm::expr::ExprError;
 use std::collections::{BTreeMap, HashMap, HashSet};
+
+/// The most parameters a module may have (its count is stored in a byte).
+pub const MAX_PARAMS: usize = 255;
 
 /// A `-D NAME=VALUE` from the command line, as typed.
 #[derive(Clone, Debug)]
@@ -39,13 +44,39 @@ impl Override {
 #[derive(Debug, Default)]
 pub struct Checked {
     pub diagnostics: Vec<Diagnostic>,
-    /// Constant values known at check time (overrides applied).
-    pub consts: BTreeMap<String, f64>,
+    /// Every constant with a value (overrides applied; random ones drawn from
+    /// the seed the checker was given).
+    pub consts: BTreeMap<String, Constant>,
+    /// The value of every expression that must be known before derivation
+    /// (settings, polygon and seed coordinates, headings, token counts, edge
+    /// indices, element widths), by the expression's span.
+    pub values: HashMap<Span, f64>,
+}
+
+/// A constant's value and whether it was drawn from the run's generator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Constant {
+    pub value: Value,
+    pub random: bool,
 }
 
 impl Checked {
     pub fn has_errors(&self) -> bool {
         self.diagnostics.iter().any(Diagnostic::is_error)
+    }
+
+    /// A constant as the compiler sees it (booleans as 0 and 1).
+    pub fn lookup(&self, name: &str) -> Option<crate::vm::expr::Known> {
+        self.consts.get(name).map(|c| crate::vm::expr::Known {
+            value: c.value.as_f64(),
+            random: c.random,
+        })
+    }
+
+    /// The value the checker computed for an expression that must be known
+    /// before derivation.
+    pub fn value_of(&self, e: &Expr) -> Option<f64> {
+        self.values.get(&e.span).copied()
     }
 }
 
@@ -54,6 +85,8 @@ struct ConstInfo<'a> {
     span: Span,
     ty: Ty,
     value: Option<Value>,
+    /// Drawn from the run's generator (directly or through another constant).
+    random: bool,
 }
 
 struct ModuleInfo {
@@ -75,11 +108,18 @@ struct Checker<'a> {
     lsystem_params: Vec<String>,
     /// Unknown query names already reported in this lsystem.
     reported_queries: HashSet<String>,
+    /// The run's seed, for constants that draw random numbers.
+    seed: u64,
+    /// Values of expressions that must be known before derivation.
+    values: HashMap<Span, f64>,
 }
 
-/// Checks a parsed file. `overrides` are the command line's `-D` values.
-pub fn check(file: &File, overrides: &[Override]) -> Checked {
+/// Checks a parsed file. `overrides` are the command line's `-D` values;
+/// random constants draw from `seed` (the run's `--seed`).
+pub fn check(file: &File, overrides: &[Override], seed: u64) -> Checked {
     let mut c = Checker {
+        seed,
+        values: HashMap::new(),
         diags: Vec::new(),
         consts: HashMap::new(),
         used_consts: HashSet::new(),
@@ -104,9 +144,15 @@ pub fn check(file: &File, overrides: &[Override]) -> Checked {
     let consts = c
         .consts
         .iter()
-        .filter_map(|(k, v)| match v.value {
-            Some(Value::Num(x)) => Some((k.to_string(), x)),
-            _ => None,
+        .filter_map(|(k, v)| {
+            let value = v.value?;
+            Some((
+                k.to_string(),
+                Constant {
+                    value,
+                    random: v.random,
+                },
+            ))
         })
         .collect();
     let mut diagnostics = c.diags;
@@ -114,6 +160,7 @@ pub fn check(file: &File, overrides: &[Override]) -> Checked {
     Checked {
         diagnostics,
         consts,
+        values: c.values,
     }
 }
 
@@ -135,6 +182,7 @@ impl<'a> Checker<'a> {
                         continue;
                     }
                     self.check_param_names(&m.params);
+                    self.too_many_params(m.params.len(), m.name.span);
                     self.modules.insert(
                         &m.name.name,
                         ModuleInfo {
@@ -180,6 +228,20 @@ impl<'a> Checker<'a> {
         }
     }
 
+    /// A module string stores a module's parameter count in a byte.
+    fn too_many_params(&mut self, n: usize, span: Span) {
+        if n > MAX_PARAMS {
+            self.diags.push(
+                Diagnostic::error(
+                    Code::TooManyParameters,
+                    format!("a module takes at most {MAX_PARAMS} parameters; this one has {n}"),
+                )
+                .primary(span, format!("{n} parameters"))
+                .help("group the values differently, or keep some in constants"),
+            );
+        }
+    }
+
     fn check_param_names(&mut self, params: &[crate::ast::Ident]) {
         for (i, p) in params.iter().enumerate() {
             if let Some(first) = params[..i]
@@ -209,6 +271,7 @@ impl<'a> Checker<'a> {
                     span: c.name.span,
                     ty: Ty::Err,
                     value: None,
+                    random: false,
                 },
             );
         }
@@ -222,19 +285,7 @@ impl<'a> Checker<'a> {
                 (*n, refs)
             })
             .collect();
-        let mut state: HashMap<&str, u8> = HashMap::new(); // 1 visiting, 2 done
-        let mut sorted: Vec<&'a str> = Vec::new();
-        let mut in_cycle: HashSet<String> = HashSet::new();
-        for &n in &order {
-            self.visit_const(
-                n,
-                &deps,
-                &mut state,
-                &mut Vec::new(),
-                &mut sorted,
-                &mut in_cycle,
-            );
-        }
+        let (sorted, in_cycle) = self.sort_consts(&order, &deps);
         let overridden: HashMap<&str, &Override> =
             overrides.iter().map(|o| (o.name.as_str(), o)).collect();
         for o in overrides {
@@ -256,6 +307,7 @@ impl<'a> Checker<'a> {
                 self.diags.push(d);
             }
         }
+        let index: HashMap<&str, usize> = order.iter().enumerate().map(|(i, n)| (*n, i)).collect();
         for n in sorted {
             let decl = self.consts[n].decl;
             let ty = if in_cycle.contains(n) {
@@ -263,11 +315,25 @@ impl<'a> Checker<'a> {
             } else {
                 self.expr(&decl.value, &Env::new())
             };
-            let mut value = if ty == Ty::Err {
-                None
-            } else {
-                self.eval(&decl.value)
-            };
+            let (mut value, mut random) = (None, false);
+            if ty != Ty::Err {
+                let stream = index.get(n).map_or(u64::MAX, |&i| i as u64);
+                match self.evaluate(&decl.value, &Env::new(), stream) {
+                    Ok((v, r)) => (value, random) = (Some(v), r),
+                    Err(ExprError::Vm(err)) => self.diags.push(
+                        Diagnostic::error(
+                            match err.fault {
+                                Fault::DivisionByZero => Code::DivisionByZero,
+                                Fault::NotFinite => Code::NotFinite,
+                            },
+                            format!("constant `{n}` has no finite value"),
+                        )
+                        .primary(err.span, err.fault.label())
+                        .help("constants are computed before the run; give it a value that is a finite number"),
+                    ),
+                    Err(_) => {}
+                }
+            }
             if let Some(o) = overridden.get(n) {
                 match parse_value(&o.value) {
                     Some(v) => {
@@ -291,6 +357,7 @@ impl<'a> Checker<'a> {
                             );
                         } else {
                             value = Some(v);
+                            random = false;
                         }
                     }
                     None => self.diags.push(
@@ -305,82 +372,99 @@ impl<'a> Checker<'a> {
             if let Some(info) = self.consts.get_mut(n) {
                 info.ty = ty;
                 info.value = value;
+                info.random = random;
             }
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn visit_const(
+    /// The constants in an order where each comes after those it uses (a
+    /// depth-first search in declaration order, with an explicit stack: a chain
+    /// of 100,000 constants must not overflow the thread's stack), and the
+    /// constants on a cycle, each cycle reported once.
+    fn sort_consts(
         &mut self,
-        n: &'a str,
+        order: &[&'a str],
         deps: &HashMap<&str, Vec<(String, Span)>>,
-        state: &mut HashMap<&'a str, u8>,
-        path: &mut Vec<&'a str>,
-        sorted: &mut Vec<&'a str>,
-        in_cycle: &mut HashSet<String>,
-    ) {
-        match state.get(n) {
-            Some(2) => return,
-            Some(1) => {
-                let start = path.iter().position(|p| *p == n).unwrap_or(0);
-                let cycle: Vec<&str> = path[start..].to_vec();
-                if cycle.iter().any(|c| in_cycle.contains(*c)) {
-                    return;
+    ) -> (Vec<&'a str>, HashSet<String>) {
+        let mut state: HashMap<&'a str, u8> = HashMap::new(); // 1 visiting, 2 done
+        let mut sorted: Vec<&'a str> = Vec::new();
+        let mut in_cycle: HashSet<String> = HashSet::new();
+        for &root in order {
+            if state.contains_key(root) {
+                continue;
+            }
+            state.insert(root, 1);
+            let mut stack: Vec<(&'a str, usize)> = vec![(root, 0)];
+            while let Some(top) = stack.last_mut() {
+                let n = top.0;
+                let Some((d, _)) = deps.get(n).and_then(|v| v.get(top.1)) else {
+                    state.insert(n, 2);
+                    sorted.push(n);
+                    stack.pop();
+                    continue;
+                };
+                top.1 += 1;
+                let Some((&key, _)) = self.consts.get_key_value(d.as_str()) else {
+                    continue;
+                };
+                match state.get(key) {
+                    Some(2) => {}
+                    Some(_) => {
+                        let start = stack.iter().position(|(p, _)| *p == key).unwrap_or(0);
+                        let cycle: Vec<&str> = stack[start..].iter().map(|(p, _)| *p).collect();
+                        self.report_cycle(&cycle, &mut in_cycle);
+                    }
+                    None => {
+                        state.insert(key, 1);
+                        stack.push((key, 0));
+                    }
                 }
-                let first = self.consts[cycle[0]].span;
-                if cycle.len() == 1 {
-                    self.diags.push(
-                        Diagnostic::error(
-                            Code::ConstCycle,
-                            format!("constant `{}` is defined in terms of itself", cycle[0]),
-                        )
-                        .primary(first, "its value uses its own name")
-                        .help("give it a value that does not refer to itself"),
-                    );
-                    in_cycle.insert(cycle[0].to_string());
-                    return;
-                }
-                let mut d = Diagnostic::error(
+            }
+        }
+        (sorted, in_cycle)
+    }
+
+    fn report_cycle(&mut self, cycle: &[&str], in_cycle: &mut HashSet<String>) {
+        if cycle.is_empty() || cycle.iter().any(|c| in_cycle.contains(*c)) {
+            return;
+        }
+        let first = self.consts[cycle[0]].span;
+        if cycle.len() == 1 {
+            self.diags.push(
+                Diagnostic::error(
                     Code::ConstCycle,
-                    format!(
-                        "constants {} are defined in terms of each other",
-                        cycle
-                            .iter()
-                            .map(|c| format!("`{c}`"))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    ),
+                    format!("constant `{}` is defined in terms of itself", cycle[0]),
                 )
-                .primary(first, "this constant depends on itself");
-                for c in &cycle[1..] {
-                    d = d.secondary(self.consts[c].span, "which depends on this one");
-                }
-                let mut chain: Vec<&str> = cycle.clone();
-                chain.push(cycle[0]);
-                d = d
-                    .note(format!("the cycle: {}", chain.join(" → ")))
-                    .help("give one of them a value that does not refer back");
-                self.diags.push(d);
-                for c in cycle {
-                    in_cycle.insert(c.to_string());
-                }
-                return;
-            }
-            _ => {}
+                .primary(first, "its value uses its own name")
+                .help("give it a value that does not refer to itself"),
+            );
+            in_cycle.insert(cycle[0].to_string());
+            return;
         }
-        state.insert(n, 1);
-        path.push(n);
-        let ds: Vec<String> = deps
-            .get(n)
-            .map_or(Vec::new(), |v| v.iter().map(|(s, _)| s.clone()).collect());
-        for d in ds {
-            if let Some((&key, _)) = self.consts.get_key_value(d.as_str()) {
-                self.visit_const(key, deps, state, path, sorted, in_cycle);
-            }
+        let mut d = Diagnostic::error(
+            Code::ConstCycle,
+            format!(
+                "constants {} are defined in terms of each other",
+                cycle
+                    .iter()
+                    .map(|c| format!("`{c}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        )
+        .primary(first, "this constant depends on itself");
+        for c in &cycle[1..] {
+            d = d.secondary(self.consts[c].span, "which depends on this one");
         }
-        path.pop();
-        state.insert(n, 2);
-        sorted.push(n);
+        let mut chain: Vec<&str> = cycle.to_vec();
+        chain.push(cycle[0]);
+        d = d
+            .note(format!("the cycle: {}", chain.join(" → ")))
+            .help("give one of them a value that does not refer back");
+        self.diags.push(d);
+        for c in cycle {
+            in_cycle.insert(c.to_string());
+        }
     }
 
     fn unused(&mut self, file: &File) {

@@ -205,7 +205,9 @@ impl<'a> Checker<'a> {
                 }
                 let given = seed.args.as_ref().map_or(0, Vec::len);
                 for a in seed.args.iter().flatten() {
-                    self.expect(a, &Env::new(), Ty::Num);
+                    if self.expect(a, &Env::new(), Ty::Num) == Ty::Num {
+                        self.record_value(a);
+                    }
                 }
                 if let Some((sys_span, Some(want))) = system
                     && given != want

@@ -131,7 +131,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         ));
         return 2;
     }
-    let mut fe = frontend::run(&src.text, src.diagnostics.clone(), &ovr);
+    let mut fe = frontend::run_seeded(&src.text, src.diagnostics.clone(), &ovr, args.seed);
     reporter.emit(&fe.diagnostics, &src.name, &src.text);
     if fe.has_errors() {
         return 1;
@@ -184,12 +184,8 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
                 print!("{}", p.disassemble());
                 0
             }
-            Err(m) => {
-                reporter.emit(
-                    &[Diagnostic::error(Code::UnknownSystem, m)],
-                    &src.name,
-                    &src.text,
-                );
+            Err(e) => {
+                reporter.emit(&[e.diagnostic()], &src.name, &src.text);
                 1
             }
         };

@@ -5,15 +5,12 @@
 //! successor templates, constant folding, and the D0L fast-path table. Must not
 //! report user mistakes the checker can find: it runs only on checked files.
 
-mod expr;
-
 use crate::ast::{File, Item, Lsystem, ModName, Module, Rule, Stmt};
 use crate::check::Checked;
+use crate::diagnostic::{Code as DiagCode, Diagnostic};
 use crate::span::Span;
-use crate::vm::{Chunk, Code, Op};
+use crate::vm::{Chunk, Code, ExprCompiler, ExprError, Op};
 use std::collections::HashMap;
-
-pub use expr::ExprCompiler;
 
 /// A symbol id: index into `Symbols`.
 pub type Sym = u16;
@@ -152,8 +149,69 @@ pub struct Program {
     pub is_3d: bool,
 }
 
+impl Program {
+    /// Whether the program draws random numbers while deriving (a random
+    /// function, or a choice between weighted rules): then the same string may
+    /// rewrite differently at each step.
+    pub fn draws_random(&self) -> bool {
+        self.chunk
+            .code
+            .iter()
+            .any(|op| matches!(op, Op::Rand | Op::Uniform | Op::Normal))
+            || self.rules.iter().flatten().any(|r| r.weight.is_some())
+    }
+}
+
+/// Why a checked file could not be compiled.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CompileError {
+    #[error("the file has no lsystem to run")]
+    NoLsystem,
+    #[error("there is no lsystem `{name}`; the file has: {}", available.join(", "))]
+    UnknownSystem {
+        name: String,
+        available: Vec<String>,
+    },
+    #[error("`{module}` has more than 255 parameters")]
+    TooManyParameters { module: String, span: Span },
+    #[error("the program uses more than 65535 distinct modules")]
+    TooManySymbols { span: Span },
+    #[error(transparent)]
+    Expr(#[from] ExprError),
+}
+
+impl CompileError {
+    /// The error as a diagnostic pointing into the program.
+    pub fn diagnostic(&self) -> Diagnostic {
+        match self {
+            CompileError::NoLsystem => Diagnostic::error(DiagCode::NoLsystem, self.to_string())
+                .primary(Span::default(), "the file holds no `lsystem` item")
+                .help("add one, e.g. `lsystem Koch { axiom F; F -> F+F-F-F+F; }`"),
+            CompileError::UnknownSystem { .. } => {
+                Diagnostic::error(DiagCode::UnknownSystem, self.to_string())
+            }
+            CompileError::TooManyParameters { span, .. } => {
+                Diagnostic::error(DiagCode::TooManyParameters, self.to_string())
+                    .primary(*span, "this module has too many parameters")
+                    .help("pass fewer values: a module takes at most 255 parameters")
+            }
+            CompileError::TooManySymbols { span } => Diagnostic::error(
+                DiagCode::TooManySymbols,
+                self.to_string(),
+            )
+            .primary(*span, "this is module number 65536")
+            .help("a program may use at most 65535 distinct modules (name and parameter count)"),
+            CompileError::Expr(e) => e.diagnostic(),
+        }
+    }
+}
+
 /// Compiles the lsystem called `name` (or the first one) of a checked file.
-pub fn compile(file: &File, checked: &Checked, name: Option<&str>) -> Result<Program, String> {
+pub fn compile(
+    file: &File,
+    checked: &Checked,
+    name: Option<&str>,
+) -> Result<Program, CompileError> {
     let systems: Vec<&Lsystem> = file
         .items
         .stmts
@@ -168,20 +226,16 @@ pub fn compile(file: &File, checked: &Checked, name: Option<&str>) -> Result<Pro
             .iter()
             .find(|l| l.name.name == n)
             .copied()
-            .ok_or_else(|| {
-                let names: Vec<&str> = systems.iter().map(|l| l.name.name.as_str()).collect();
-                format!(
-                    "there is no lsystem `{n}`; the file has: {}",
-                    names.join(", ")
-                )
+            .ok_or_else(|| CompileError::UnknownSystem {
+                name: n.to_string(),
+                available: systems.iter().map(|l| l.name.name.clone()).collect(),
             })?,
-        None => *systems.first().ok_or("the file has no lsystem to run")?,
+        None => *systems.first().ok_or(CompileError::NoLsystem)?,
     };
     Compiler::new(file, checked).lsystem(ls)
 }
 
 struct Compiler<'a> {
-    file: &'a File,
     checked: &'a Checked,
     symbols: Symbols,
     chunk: Chunk,
@@ -245,7 +299,7 @@ impl<'a> Compiler<'a> {
                             def.stroke = Some(s.clone())
                         }
                         ("width", crate::ast::PropValue::Expr(x)) => {
-                            def.width = ExprCompiler::fold_const(x, checked)
+                            def.width = checked.value_of(x)
                         }
                         _ => {}
                     }
@@ -255,7 +309,6 @@ impl<'a> Compiler<'a> {
             }
         }
         Compiler {
-            file,
             checked,
             symbols: Symbols::default(),
             chunk: Chunk::default(),
@@ -266,18 +319,20 @@ impl<'a> Compiler<'a> {
     }
 
     /// The symbol of a module as it appears in a string (queries with outputs padded).
-    fn intern(&mut self, name: &ModName, arity: usize) -> Result<Sym, String> {
+    fn intern(&mut self, name: &ModName, arity: usize, span: Span) -> Result<Sym, CompileError> {
         let name = match name {
             ModName::Cut => ModName::Symbol('%'),
             n => n.clone(),
         };
-        let a = u8::try_from(arity)
-            .map_err(|_| format!("`{}` has more than 255 parameters", name.text()))?;
+        let a = u8::try_from(arity).map_err(|_| CompileError::TooManyParameters {
+            module: name.text().to_string(),
+            span,
+        })?;
         if let Some(&s) = self.symbols.map.get(&(name.clone(), a)) {
             return Ok(s);
         }
         if self.symbols.info.len() >= MAX_SYMBOLS {
-            return Err("the program uses more than 65535 distinct modules".to_string());
+            return Err(CompileError::TooManySymbols { span });
         }
         let element = match &name {
             ModName::Name(n) => self.element_index.get(n).copied(),
@@ -305,10 +360,11 @@ impl<'a> Compiler<'a> {
         &mut self,
         ms: &[Module],
         env: &HashMap<String, u16>,
-    ) -> Result<Vec<Emit>, String> {
+    ) -> Result<Vec<Emit>, CompileError> {
         let mut out = Vec::with_capacity(ms.len());
         for m in ms {
-            let sym = self.intern(&m.name, Self::written_arity(m))?;
+            let sym = self.intern(&m.name, Self::written_arity(m), m.span)?;
+            let checked = self.checked;
             let mut args = Vec::new();
             if let ModName::Query(q) = &m.name {
                 let k = crate::query::lookup(q).map_or(0, |q| q.outputs.len());
@@ -320,7 +376,7 @@ impl<'a> Compiler<'a> {
             }
             for a in m.args.iter().flatten() {
                 args.push(
-                    ExprCompiler::new(&mut self.chunk, self.file, self.checked, env).compile(a),
+                    ExprCompiler::new(&mut self.chunk, &|n| checked.lookup(n), env).compile(a)?,
                 );
             }
             out.push(Emit { sym, args });
@@ -328,7 +384,7 @@ impl<'a> Compiler<'a> {
         Ok(out)
     }
 
-    fn rule(&mut self, r: &Rule) -> Result<(Sym, CompiledRule), String> {
+    fn rule(&mut self, r: &Rule) -> Result<(Sym, CompiledRule), CompileError> {
         let mut env: HashMap<String, u16> = HashMap::new();
         let mut slot: u16 = 0;
         let mut bind = |m: &Module, env: &mut HashMap<String, u16>| -> u16 {
@@ -354,29 +410,32 @@ impl<'a> Compiler<'a> {
             let s = bind(m, &mut env);
             right.push((m, s));
         }
-        let pred = self.intern(&r.pred.name, r.pred.arity())?;
+        let pred = self.intern(&r.pred.name, r.pred.arity(), r.pred.span)?;
         let mut lp = Vec::new();
         for (m, s) in left {
             lp.push(Pattern {
-                sym: self.intern(&m.name, m.arity())?,
+                sym: self.intern(&m.name, m.arity(), m.span)?,
                 slot: s,
             });
         }
         let mut rp = Vec::new();
         for (m, s) in right {
             rp.push(Pattern {
-                sym: self.intern(&m.name, m.arity())?,
+                sym: self.intern(&m.name, m.arity(), m.span)?,
                 slot: s,
             });
         }
+        let checked = self.checked;
         let cond = r
             .cond
             .as_ref()
-            .map(|c| ExprCompiler::new(&mut self.chunk, self.file, self.checked, &env).compile(c));
+            .map(|c| ExprCompiler::new(&mut self.chunk, &|n| checked.lookup(n), &env).compile(c))
+            .transpose()?;
         let weight = r
             .weight
             .as_ref()
-            .map(|w| ExprCompiler::new(&mut self.chunk, self.file, self.checked, &env).compile(w));
+            .map(|w| ExprCompiler::new(&mut self.chunk, &|n| checked.lookup(n), &env).compile(w))
+            .transpose()?;
         let succ = self.emit_list(&r.succ, &env)?;
         Ok((
             pred,
@@ -396,7 +455,7 @@ impl<'a> Compiler<'a> {
         ))
     }
 
-    fn lsystem(mut self, ls: &Lsystem) -> Result<Program, String> {
+    fn lsystem(mut self, ls: &Lsystem) -> Result<Program, CompileError> {
         let mut angle = 90.0;
         let mut step = 1.0;
         let mut derive = 1u32;
@@ -404,13 +463,9 @@ impl<'a> Compiler<'a> {
         let mut ignore_mods: Vec<&Module> = Vec::new();
         for s in &ls.body.stmts {
             match &s.node {
-                Stmt::Angle(e) => {
-                    angle = ExprCompiler::fold_const(e, self.checked).unwrap_or(angle)
-                }
-                Stmt::Step(e) => step = ExprCompiler::fold_const(e, self.checked).unwrap_or(step),
-                Stmt::Derive(e) => {
-                    derive = ExprCompiler::fold_const(e, self.checked).map_or(derive, |v| v as u32)
-                }
+                Stmt::Angle(e) => angle = self.checked.value_of(e).unwrap_or(angle),
+                Stmt::Step(e) => step = self.checked.value_of(e).unwrap_or(step),
+                Stmt::Derive(e) => derive = self.checked.value_of(e).map_or(derive, |v| v as u32),
                 Stmt::Axiom(ms) => axiom_mods = ms,
                 Stmt::Ignore(ms) => ignore_mods.extend(ms.iter()),
                 _ => {}

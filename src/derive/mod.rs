@@ -10,7 +10,8 @@
 mod context;
 
 use crate::compile::{Action, CompiledRule, Program, Sym};
-use crate::vm::{Random, VmError};
+use crate::diagnostic::{Code, Diagnostic};
+use crate::vm::{Fault, Random, VmError};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -59,25 +60,133 @@ impl Default for Limits {
     }
 }
 
-#[derive(Clone, Debug, PartialEq)]
+/// The most derivation steps a run may take (`derive` and `-n` alike).
+pub const MAX_STEPS: u32 = 1_000_000;
+
+/// Why deriving or interpreting stopped. Every variant says the same thing on
+/// every run and thread count: a count is given only where it is exact.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum DeriveError {
-    /// Step `step` would produce `modules` modules, over the limit.
+    /// Step `step` would produce `modules` modules (when known exactly: the
+    /// D0L forecast), over the limit.
+    #[error("{}", too_many_modules(*.step, *.modules, *.limit))]
     TooManyModules {
         step: u32,
-        modules: usize,
+        modules: Option<usize>,
         limit: usize,
     },
-    /// Step `step` would need about `bytes` bytes, over the limit.
+    /// Step `step` would need about `bytes` bytes (when known exactly), over the limit.
+    #[error("{}", too_much_memory(*.step, *.bytes, *.limit))]
     TooMuchMemory {
         step: u32,
-        bytes: usize,
+        bytes: Option<usize>,
         limit: usize,
     },
     /// An expression failed while deriving step `step` (0: the axiom;
     /// `u32::MAX`: while interpreting).
+    #[error("{error} {}", when(*.step))]
     Vm { step: u32, error: VmError },
     /// Interpretation rules expanded into each other `depth` times.
+    #[error("interpretation rules expand `{module}` more than {depth} levels deep")]
     InterpretTooDeep { module: String, depth: usize },
+    /// Interpretation rules expanded into more modules than the limit (of the
+    /// whole drawing, or of one `module` of the string).
+    #[error("{}", too_much_drawing(*.limit, .module.as_deref()))]
+    TooMuchDrawing {
+        limit: usize,
+        module: Option<String>,
+    },
+    /// More steps were asked for than `MAX_STEPS`.
+    #[error("{steps} derivation steps were asked for; the most is {limit}")]
+    TooManySteps { steps: u64, limit: u32 },
+}
+
+fn when(step: u32) -> String {
+    match step {
+        0 => "while evaluating the axiom".to_string(),
+        u32::MAX => "while drawing (in an interpretation rule)".to_string(),
+        s => format!("in derivation step {s}"),
+    }
+}
+
+fn too_many_modules(step: u32, modules: Option<usize>, limit: usize) -> String {
+    match modules {
+        Some(n) => format!(
+            "derivation step {step} would produce {n} modules, more than the limit of {limit}"
+        ),
+        None => {
+            format!("derivation step {step} would produce more than {limit} modules, the limit")
+        }
+    }
+}
+
+fn too_much_drawing(limit: usize, module: Option<&str>) -> String {
+    match module {
+        Some(m) => format!("interpretation rules expand one `{m}` into more than {limit} modules"),
+        None => {
+            format!("interpretation rules would draw more than {limit} modules, the module limit")
+        }
+    }
+}
+
+fn too_much_memory(step: u32, bytes: Option<usize>, limit: usize) -> String {
+    match bytes {
+        Some(b) => format!(
+            "derivation step {step} would need about {} MiB, more than the limit of {} MiB",
+            b >> 20,
+            limit >> 20
+        ),
+        None => format!(
+            "derivation step {step} would need more than {} MiB, the limit",
+            limit >> 20
+        ),
+    }
+}
+
+impl DeriveError {
+    /// The failure as a diagnostic pointing into the program: at the
+    /// expression that failed, or at the lsystem's name for a limit.
+    pub fn diagnostic(&self, prog: &Program) -> Diagnostic {
+        let msg = self.to_string();
+        match self {
+            DeriveError::Vm { error, .. } => {
+                let code = match error.fault {
+                    Fault::DivisionByZero => Code::DivisionByZero,
+                    Fault::NotFinite => Code::NotFinite,
+                };
+                let help = match error.fault {
+                    Fault::DivisionByZero => {
+                        "guard the rule with a condition, e.g. `A(x) : x != 0 -> …`"
+                    }
+                    Fault::NotFinite => {
+                        "check the operands: a square root or logarithm of a negative number, or a value that overflows"
+                    }
+                };
+                Diagnostic::error(code, msg)
+                    .primary(error.span, error.fault.label())
+                    .help(help)
+            }
+            DeriveError::TooManyModules { .. } => Diagnostic::error(Code::TooManyModules, msg)
+                .primary(prog.name_span, "this lsystem grows too fast")
+                .help("derive fewer steps with -n, or raise the limit with --max-modules"),
+            DeriveError::TooMuchMemory { .. } => Diagnostic::error(Code::TooMuchMemory, msg)
+                .primary(prog.name_span, "this lsystem grows too fast")
+                .help("derive fewer steps with -n, or raise the limit with --max-memory"),
+            DeriveError::InterpretTooDeep { .. } => Diagnostic::error(Code::InterpretTooDeep, msg)
+                .primary(prog.name_span, "an `interpret` rule produces a module that is interpreted again, endlessly")
+                .help("interpretation rules must end in modules that draw; a rule like `interpret A -> B; interpret B -> A;` never does"),
+            DeriveError::TooMuchDrawing { module, .. } => Diagnostic::error(Code::TooMuchDrawing, msg)
+                .primary(prog.name_span, "its `interpret` rules expand modules into more and more modules")
+                .help(if module.is_some() {
+                    "an interpretation rule should draw a bounded figure (a leaf, a flower): end its recursion with a condition on a parameter that decreases"
+                } else {
+                    "derive fewer steps, or raise the limit with --max-modules"
+                }),
+            DeriveError::TooManySteps { limit, .. } => Diagnostic::error(Code::TooManySteps, msg)
+                .primary(prog.name_span, "this lsystem would be derived that often")
+                .help(format!("ask for at most {limit} steps with -n")),
+        }
+    }
 }
 
 /// Appends a successor (or the axiom) with its parameters evaluated on `slots`.
@@ -130,15 +239,30 @@ pub fn derive(
     limits: Limits,
     progress: &(dyn Fn(u32, usize) + Sync),
 ) -> Result<ModString, DeriveError> {
+    if steps > MAX_STEPS {
+        return Err(DeriveError::TooManySteps {
+            steps: u64::from(steps),
+            limit: MAX_STEPS,
+        });
+    }
     if let Some(table) = &prog.d0l
         && !prog.has_cut
     {
         d0l_forecast(table, &start, steps, limits)?;
     }
+    let settles = !prog.draws_random();
     let mut s = start;
     for k in 1..=steps {
-        s = step(prog, &s, k, seed, limits)?;
+        let next = step(prog, &s, k, seed, limits)?;
+        // A program without random draws that rewrites a string into itself
+        // does so at every later step: stop deriving, the string is final.
+        let fixed = settles && next == s;
+        s = next;
         progress(k, s.len());
+        if fixed {
+            progress(steps, s.len());
+            break;
+        }
     }
     Ok(s)
 }
@@ -171,7 +295,7 @@ fn d0l_forecast(
         std::mem::swap(&mut counts, &mut next);
         let total = counts.iter().fold(0u128, |a, &c| a.saturating_add(c));
         let total = usize::try_from(total).unwrap_or(usize::MAX);
-        check_limits(step, total, 0, limits)?;
+        check_limits(step, total, 0, limits, true)?;
         // Once every count is 0 or fixed, later steps cannot grow: stop early.
         if counts == next {
             break;
@@ -199,16 +323,20 @@ pub fn step(
     })
 }
 
+/// Checks a step's size against the limits. `exact`: the counts are the
+/// step's whole output (then the message gives them); otherwise they are a
+/// running total that depends on how threads interleave, and it does not.
 fn check_limits(
     step: u32,
     modules: usize,
     params: usize,
     limits: Limits,
+    exact: bool,
 ) -> Result<(), DeriveError> {
     if modules > limits.max_modules {
         return Err(DeriveError::TooManyModules {
             step,
-            modules,
+            modules: exact.then_some(modules),
             limit: limits.max_modules,
         });
     }
@@ -218,7 +346,7 @@ fn check_limits(
     if bytes > limits.max_bytes {
         return Err(DeriveError::TooMuchMemory {
             step,
-            bytes,
+            bytes: exact.then_some(bytes),
             limit: limits.max_bytes,
         });
     }
@@ -242,7 +370,7 @@ fn d0l_step(
         .iter()
         .try_fold(0usize, |a, &c| a.checked_add(c))
         .unwrap_or(usize::MAX);
-    check_limits(step, total, 0, limits)?;
+    check_limits(step, total, 0, limits, true)?;
     let mut out = vec![0 as Sym; total];
     let mut slices = Vec::with_capacity(counts.len());
     let mut rest: &mut [Sym] = &mut out;
@@ -400,7 +528,10 @@ fn parametric_step(
     }
     let total: usize = outs.iter().map(|o| o.syms.len()).sum();
     let total_params: usize = outs.iter().map(|o| o.params.len()).sum();
-    check_limits(step, total, total_params, limits)?;
+    // Whether a chunk stopped early on the running total depends on timing, so
+    // this check does not print its exact count either: the message is the same
+    // on every run.
+    check_limits(step, total, total_params, limits, false)?;
     // Join the chunks' outputs in parallel, each into its own slice.
     let mut syms = vec![0 as Sym; total];
     let mut params = vec![0.0; total_params];
@@ -513,7 +644,7 @@ fn rewrite_chunk(
             let now = out.syms.len();
             let total = produced.fetch_add(now - reported, Ordering::Relaxed) + now - reported;
             reported = now;
-            check_limits(step, total, out.params.len(), limits)?;
+            check_limits(step, total, out.params.len(), limits, false)?;
         }
     }
     produced.fetch_add(out.syms.len() - reported, Ordering::Relaxed);

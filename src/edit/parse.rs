@@ -8,7 +8,6 @@
 use super::{EditError, Op, VertexRef};
 use crate::ast::{Expr, ExprKind, File, GuideStmt, Item, Scene, SceneStmt, UnOp};
 use crate::check::{Checked, suggest};
-use crate::compile::ExprCompiler;
 use glam::DVec2;
 
 /// A guide as the edit sees it.
@@ -193,7 +192,7 @@ pub(super) fn literal(e: &Expr) -> Option<f64> {
 
 /// The value of a constant expression (literals, constants, deterministic functions).
 pub(super) fn const_value(e: &Expr, checked: &Checked) -> Option<f64> {
-    literal(e).or_else(|| ExprCompiler::fold_const(e, checked))
+    literal(e).or_else(|| checked.value_of(e))
 }
 
 /// The diagonal of the bounding box of every guide vertex (1 if there is none).

@@ -32,7 +32,6 @@ use super::scene::{Answer, Instance, Outcome, Probe, Scene, collide, query, seed
 use crate::derive::{self, Limits, ModString};
 use crate::diagnostic::Diagnostic;
 use crate::query::QUERIES;
-use crate::run::runtime_diagnostic;
 use crate::turtle;
 use crate::turtle::State;
 use glam::DVec2;
@@ -382,8 +381,7 @@ fn run_unit(
             reserved: Vec::new(),
         };
         for s in &guide.seeds {
-            let string =
-                derive::axiom(prog, &s.args, cfg.seed).map_err(|e| runtime_diagnostic(&e, prog))?;
+            let string = derive::axiom(prog, &s.args, cfg.seed).map_err(|e| e.diagnostic(prog))?;
             l.add(Instance {
                 guide: g,
                 start: seed_state(s.at, s.heading),
@@ -502,7 +500,7 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
             let prog = &scene.programs[scene.guides[inst.guide].program];
             inst.steps += 1;
             let string = derive::step(prog, &inst.string, inst.steps, cfg.seed, cfg.limits)
-                .map_err(|e| runtime_diagnostic(&e, prog))?;
+                .map_err(|e| e.diagnostic(prog))?;
             // An unchanged string draws the same: keep its drawing.
             if string != inst.string {
                 inst.string = string;
@@ -548,7 +546,7 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
             let prog = &scene.programs[scene.guides[inst.guide].program];
             let mut p = Probe::default();
             turtle::interpret_from(prog, &inst.string, cfg.seed, inst.start, &mut p)
-                .map_err(|e| runtime_diagnostic(&e, prog))?;
+                .map_err(|e| e.diagnostic(prog))?;
             *probe = Some(Drawing {
                 grid: Grid::new(p.segments),
                 queries: p.queries,
@@ -630,7 +628,7 @@ fn deliver(
     let prog = &scene.programs[scene.guides[tg].program];
     let mut args = m.pass.clone();
     args.resize(prog.params.len(), 0.0);
-    let string = derive::axiom(prog, &args, cfg.seed).map_err(|e| runtime_diagnostic(&e, prog))?;
+    let string = derive::axiom(prog, &args, cfg.seed).map_err(|e| e.diagnostic(prog))?;
     live[k].add(Instance {
         guide: tg,
         start: seed_state(at, link.heading),

@@ -8,7 +8,7 @@ use super::geometry::{closest_on_segment, crossing, inside, ray_hit, signed_angl
 use super::index::Layers;
 use crate::ast::{File, GuideStmt, Item, LinkStmt, SceneStmt};
 use crate::check::Checked;
-use crate::compile::{self, ExprCompiler, Program};
+use crate::compile::{self, CompileError, Program};
 use crate::derive::{Limits, ModString};
 use crate::diagnostic::{Code, Diagnostic};
 use crate::turtle::{Drawn, Sink, State};
@@ -69,12 +69,41 @@ pub struct Outcome {
     pub guides: Vec<GuideRun>,
 }
 
+/// The value the checker computed for an expression of the scene (it reports
+/// every one it cannot compute, so a checked file has them all).
 fn value(e: &crate::ast::Expr, checked: &Checked) -> f64 {
-    ExprCompiler::fold_const(e, checked).unwrap_or(0.0)
+    checked.value_of(e).unwrap_or(0.0)
+}
+
+/// Why a checked file's scene could not be built.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SceneError {
+    #[error("the file has no scene")]
+    NoScene,
+    #[error("there is no scene `{0}`")]
+    UnknownScene(String),
+    #[error("guide `{0}` has no system")]
+    NoSystem(String),
+    #[error("no guide `{0}`")]
+    UnknownGuide(String),
+    #[error(transparent)]
+    Compile(#[from] CompileError),
+}
+
+impl SceneError {
+    /// The error as a diagnostic. The checker reports all but `Compile`'s
+    /// limits first, so these are rare after a clean check.
+    pub fn diagnostic(&self) -> Diagnostic {
+        match self {
+            SceneError::Compile(e) => e.diagnostic(),
+            SceneError::UnknownGuide(_) => Diagnostic::error(Code::UnknownGuide, self.to_string()),
+            _ => Diagnostic::error(Code::UnknownSystem, self.to_string()),
+        }
+    }
 }
 
 /// Builds the scene called `name` (or the first) of a checked file.
-pub fn build(file: &File, checked: &Checked, name: Option<&str>) -> Result<Scene, String> {
+pub fn build(file: &File, checked: &Checked, name: Option<&str>) -> Result<Scene, SceneError> {
     let scenes: Vec<&crate::ast::Scene> = file
         .items
         .stmts
@@ -89,8 +118,8 @@ pub fn build(file: &File, checked: &Checked, name: Option<&str>) -> Result<Scene
             .iter()
             .find(|s| s.name.name == n)
             .copied()
-            .ok_or_else(|| format!("there is no scene `{n}`"))?,
-        None => *scenes.first().ok_or("the file has no scene")?,
+            .ok_or_else(|| SceneError::UnknownScene(n.to_string()))?,
+        None => *scenes.first().ok_or(SceneError::NoScene)?,
     };
     let mut programs: Vec<Program> = Vec::new();
     let mut by_system: HashMap<String, usize> = HashMap::new();
@@ -120,7 +149,7 @@ pub fn build(file: &File, checked: &Checked, name: Option<&str>) -> Result<Scene
                 GuideStmt::Error => {}
             }
         }
-        let system = system.ok_or_else(|| format!("guide `{}` has no system", g.name.name))?;
+        let system = system.ok_or_else(|| SceneError::NoSystem(g.name.name.clone()))?;
         let program = match by_system.get(&system) {
             Some(&p) => p,
             None => {
@@ -142,10 +171,10 @@ pub fn build(file: &File, checked: &Checked, name: Option<&str>) -> Result<Scene
         let SceneStmt::Link(l) = &st.node else {
             continue;
         };
-        let end = |r: &crate::ast::EdgeRef| -> Result<(usize, usize), String> {
+        let end = |r: &crate::ast::EdgeRef| -> Result<(usize, usize), SceneError> {
             let g = *index
                 .get(&r.guide.name)
-                .ok_or_else(|| format!("no guide `{}`", r.guide.name))?;
+                .ok_or_else(|| SceneError::UnknownGuide(r.guide.name.clone()))?;
             Ok((g, value(&r.index, checked) as usize))
         };
         let (mut tokens, mut heading) = (0u32, 0.0);
@@ -485,9 +514,4 @@ impl Sink for Clip<'_> {
             self.removed += 1;
         }
     }
-}
-
-/// A problem building the scene, as a diagnostic.
-pub fn build_error(msg: String) -> Diagnostic {
-    Diagnostic::error(Code::UnknownSystem, msg)
 }

@@ -19,6 +19,12 @@ const CLI_ONLY: &[Code] = &[
     Code::TooManyModules,
     Code::TooMuchMemory,
     Code::InterpretTooDeep,
+    Code::TooManySymbols,
+    Code::TooManySteps,
+    Code::TooMuchDrawing,
+    Code::DrawingTooLarge,
+    // Only `lsyc run` needs an lsystem: tests/it/hostile.rs.
+    Code::NoLsystem,
 ];
 
 fn expected_codes(text: &str) -> Vec<String> {

@@ -4,6 +4,10 @@
 //! source span each instruction came from), evaluation, and the disassembler.
 //! Must not know about modules or rules: the compiler hands it parameter slots.
 
+pub mod expr;
+
+pub use expr::{ConstLookup, ExprCompiler, ExprError};
+
 use crate::span::Span;
 use std::fmt::Write;
 
@@ -60,15 +64,28 @@ pub enum Op {
 }
 
 /// What a runtime error is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum Fault {
+    #[error("division by zero")]
     DivisionByZero,
     /// The result is NaN or infinite.
+    #[error("an expression is not a finite number")]
     NotFinite,
 }
 
+impl Fault {
+    /// The label under the expression that failed.
+    pub fn label(self) -> &'static str {
+        match self {
+            Fault::DivisionByZero => "this divides by zero",
+            Fault::NotFinite => "this gives infinity or NaN",
+        }
+    }
+}
+
 /// A runtime error with the source span of the instruction that caused it.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error("{fault}")]
 pub struct VmError {
     pub fault: Fault,
     pub span: Span,
@@ -264,7 +281,7 @@ impl Chunk {
                 Op::Call(f) => {
                     let b = &crate::builtins::BUILTINS[f as usize];
                     let at = stack.len().saturating_sub(b.arity);
-                    let v = crate::builtins::eval(b.name, &stack[at..]).unwrap_or(f64::NAN);
+                    let v = (b.eval)(&stack[at..]);
                     stack.truncate(at);
                     if !v.is_finite() {
                         return Err(fault(Fault::NotFinite));
