@@ -11,6 +11,9 @@ use crate::geometry::dist;
 use glam::DVec2;
 use std::collections::HashMap;
 
+/// The most cells along either axis.
+pub const MAX_CELLS_PER_AXIS: usize = 1 << 16;
+
 /// Points in square cells, by cell.
 pub struct PointGrid {
     points: Vec<DVec2>,
@@ -33,17 +36,16 @@ impl PointGrid {
         PointGrid::with_cell(points, cell)
     }
 
-    /// A grid of cells `cell` wide (at least 10⁻¹²): for searches within a
-    /// known distance, that distance.
+    /// A grid of cells `cell` wide: for searches within a known distance, that
+    /// distance. Cells are at least 10⁻¹² wide and at most [`MAX_CELLS_PER_AXIS`]
+    /// span the points (the answers do not depend on the cell size).
     pub fn with_cell(points: &[DVec2], cell: f64) -> PointGrid {
         let (min, size) = extent(points);
-        let cell = if cell.is_finite() {
-            cell.max(1e-12)
-        } else {
-            1.0
-        };
-        let cols = (size.x / cell).floor() as i64 + 1;
-        let rows = (size.y / cell).floor() as i64 + 1;
+        let cell = if cell.is_finite() { cell } else { 1.0 }
+            .max(1e-12)
+            .max(size.x.max(size.y) / MAX_CELLS_PER_AXIS as f64);
+        let cols = ((size.x / cell).floor() as i64).saturating_add(1);
+        let rows = ((size.y / cell).floor() as i64).saturating_add(1);
         let mut g = PointGrid {
             points: points.to_vec(),
             min,
@@ -78,6 +80,14 @@ impl PointGrid {
         let mut found: Vec<(f64, usize)> = Vec::new();
         let mut ring = 0i64;
         loop {
+            // A sparse grid (far-apart points in small cells): once a ring
+            // would visit more cells than there are points, a scan is cheaper
+            // and gives the same answer.
+            if ring > 0
+                && (2 * ring + 1).saturating_mul(2 * ring + 1) > 4 * self.points.len() as i64 + 64
+            {
+                return self.scan(p, k);
+            }
             let (x0, x1) = ((cx - ring).max(0), (cx + ring).min(self.cols - 1));
             let (y0, y1) = ((cy - ring).max(0), (cy + ring).min(self.rows - 1));
             for x in x0..=x1 {
@@ -115,6 +125,18 @@ impl PointGrid {
         }
         found.truncate(k);
         found.into_iter().map(|(_, i)| i).collect()
+    }
+
+    /// The `k` nearest points by a scan of all, ordered as [`Self::nearest`].
+    fn scan(&self, p: DVec2, k: usize) -> Vec<usize> {
+        let mut all: Vec<(f64, usize)> = self
+            .points
+            .iter()
+            .enumerate()
+            .map(|(i, q)| (q.distance_squared(p), i))
+            .collect();
+        all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        all.into_iter().take(k).map(|(_, i)| i).collect()
     }
 
     /// The points within distance `r` of `p` ([`dist`] ≤ r), by index.
@@ -177,5 +199,21 @@ mod tests {
                 assert_eq!(g.within(p, r), scan, "cell {cell}, {p}");
             }
         }
+    }
+
+    #[test]
+    fn far_apart_points_and_tiny_cells_neither_overflow_nor_hang() {
+        let pts = [
+            DVec2::new(-1e150, 0.0),
+            DVec2::ZERO,
+            DVec2::new(1e150, 1e150),
+        ];
+        let g = PointGrid::with_cell(&pts, 1e-4);
+        assert_eq!(g.within(DVec2::ZERO, 1e-4), vec![1]);
+        assert_eq!(g.nearest(DVec2::new(2e150, 1e150), 2), vec![2, 1]);
+        let huge = [DVec2::new(f64::MAX, 0.0), DVec2::new(-f64::MAX, 0.0)];
+        let g = PointGrid::with_cell(&huge, 1.0);
+        assert_eq!(g.nearest(DVec2::ZERO, 1), vec![0]);
+        assert_eq!(g.within(DVec2::new(f64::MAX, 0.0), 1.0), vec![0]);
     }
 }
