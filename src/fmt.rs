@@ -56,26 +56,7 @@ pub fn format_expr(e: &Expr) -> String {
 /// Negative values get a leading `-` (which parses as unary minus); NaN and the
 /// infinities, which no literal can spell, print as `(0 / 0)`, `(1 / 0)`, `(-1 / 0)`.
 pub fn format_number(v: f64) -> String {
-    if v.is_nan() {
-        return "(0 / 0)".to_string();
-    }
-    if v.is_infinite() {
-        return if v > 0.0 { "(1 / 0)" } else { "(-1 / 0)" }.to_string();
-    }
-    if v == 0.0 {
-        return "0".to_string();
-    }
-    let a = v.abs();
-    let digits = if !(1e-4..1e15).contains(&a) {
-        format!("{a:e}")
-    } else {
-        format!("{a}")
-    };
-    if v < 0.0 {
-        format!("-{digits}")
-    } else {
-        digits
-    }
+    crate::number::source(v)
 }
 
 /// Prints a string literal with the escapes the lexer knows: `\\ \" \n \t`.

@@ -105,41 +105,29 @@ impl<'a> Checker<'a> {
     }
 
     fn path_data(&mut self, s: &str, span: Span) {
-        let mut count = 0usize;
-        for seg in svgtypes::PathParser::from(s) {
-            match seg {
-                Ok(_) => count += 1,
-                Err(e) => {
-                    // svgtypes counts characters from 1; the string starts after its quote.
-                    let at = match &e {
-                        svgtypes::Error::UnexpectedData(p)
-                        | svgtypes::Error::InvalidNumber(p)
-                        | svgtypes::Error::InvalidChar(_, p)
-                        | svgtypes::Error::InvalidString(_, p) => Some(*p),
-                        _ => None,
-                    };
-                    let place = at
-                        .and_then(|p| s.char_indices().nth(p.saturating_sub(1)))
-                        .filter(|_| !s.contains('\\'))
-                        .map_or(span, |(b, c)| {
-                            let start = span.start as usize + 1 + b;
-                            Span::new(start, start + c.len_utf8())
-                        });
-                    self.diags.push(
-                        Diagnostic::error(Code::InvalidPath, "invalid SVG path data")
-                            .primary(place, e.to_string())
-                            .help("path data is SVG's `d` attribute: commands M L H V C S Q T A Z with numbers"),
-                    );
-                    return;
-                }
+        match crate::path::parse(s) {
+            Err(e) => {
+                // The string starts after its quote; escapes shift the source.
+                let place = e
+                    .offset
+                    .and_then(|b| Some((b, s.get(b..)?.chars().next()?)))
+                    .filter(|_| !s.contains('\\'))
+                    .map_or(span, |(b, c)| {
+                        let start = span.start as usize + 1 + b;
+                        Span::new(start, start + c.len_utf8())
+                    });
+                self.diags.push(
+                    Diagnostic::error(Code::InvalidPath, "invalid SVG path data")
+                        .primary(place, e.to_string())
+                        .help("path data is SVG's `d` attribute: commands M L H V C S Q T A Z with numbers"),
+                );
             }
-        }
-        if count == 0 {
-            self.diags.push(
+            Ok(path) if path.elements().is_empty() => self.diags.push(
                 Diagnostic::error(Code::InvalidPath, "the path is empty")
                     .primary(span, "no drawing commands")
                     .help("start with a move, e.g. \"M0 0 L0 10\""),
-            );
+            ),
+            Ok(_) => {}
         }
     }
 

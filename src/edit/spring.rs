@@ -27,10 +27,9 @@
 //! pinned nothing is touched, and a system whose pinned particles sit where they
 //! were has zero gradient and is returned unchanged.
 
+pub use crate::geometry::dist;
+use glam::DVec2;
 use std::collections::{BTreeMap, HashMap};
-
-/// A 2D point or vector.
-pub type P2 = [f64; 2];
 
 /// A spring between two particles.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,7 +46,7 @@ pub struct Spring {
 #[derive(Clone, Debug, Default)]
 pub struct System {
     /// Rest positions x⁰.
-    pub rest: Vec<P2>,
+    pub rest: Vec<DVec2>,
     pub springs: Vec<Spring>,
     /// The spring joining each pair (a < b), by index.
     index: HashMap<(usize, usize), usize>,
@@ -80,7 +79,7 @@ impl Default for Params {
 /// The positions the solver found and how it got there.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Solution {
-    pub positions: Vec<P2>,
+    pub positions: Vec<DVec2>,
     /// Newton iterations run.
     pub iterations: usize,
     /// Whether the tolerance was reached before `max_iterations`.
@@ -106,16 +105,11 @@ impl System {
         self.springs.push(Spring { a, b, rest, k });
     }
 
-    /// Moves the pinned particles to their targets and relaxes the free ones.
-    pub fn solve(&self, pins: &BTreeMap<usize, P2>, params: &Params) -> Solution {
+    /// The variables: the free particles reached through springs from a pinned
+    /// one, in index order (`free`), and each particle's index among them
+    /// (`var`, `usize::MAX` for the others).
+    fn variables(&self, pins: &BTreeMap<usize, DVec2>) -> (Vec<usize>, Vec<usize>) {
         let n = self.rest.len();
-        let mut x = self.rest.clone();
-        for (&i, &t) in pins {
-            if i < n {
-                x[i] = t;
-            }
-        }
-        // The variables: particles reached through springs from a pinned one.
         let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
         for s in &self.springs {
             adj[s.a].push(s.b);
@@ -143,6 +137,19 @@ impl System {
                 free.push(i);
             }
         }
+        (var, free)
+    }
+
+    /// Moves the pinned particles to their targets and relaxes the free ones.
+    pub fn solve(&self, pins: &BTreeMap<usize, DVec2>, params: &Params) -> Solution {
+        let n = self.rest.len();
+        let mut x = self.rest.clone();
+        for (&i, &t) in pins {
+            if i < n {
+                x[i] = t;
+            }
+        }
+        let (var, free) = self.variables(pins);
         let springs: Vec<Spring> = self
             .springs
             .iter()
@@ -202,7 +209,7 @@ impl System {
             let mut accepted = false;
             for _ in 0..40 {
                 for (v, &i) in free.iter().enumerate() {
-                    trial[i] = [x[i][0] + alpha * p[2 * v], x[i][1] + alpha * p[2 * v + 1]];
+                    trial[i] = DVec2::new(x[i].x + alpha * p[2 * v], x[i].y + alpha * p[2 * v + 1]);
                 }
                 if problem.energy(&trial) <= e0 + 1e-4 * alpha * slope {
                     accepted = true;
@@ -230,12 +237,8 @@ impl System {
     }
 }
 
-pub fn dist(a: P2, b: P2) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
-}
-
 struct Problem<'a> {
-    rest: &'a [P2],
+    rest: &'a [DVec2],
     springs: &'a [Spring],
     var: &'a [usize],
     free: &'a [usize],
@@ -244,7 +247,7 @@ struct Problem<'a> {
 }
 
 impl Problem<'_> {
-    fn energy(&self, x: &[P2]) -> f64 {
+    fn energy(&self, x: &[DVec2]) -> f64 {
         let mut e = 0.0;
         for s in self.springs {
             let d = dist(x[s.a], x[s.b]) - s.rest;
@@ -262,7 +265,7 @@ impl Problem<'_> {
     /// springs treated as isotropic. A translation carries a guide hanging from a
     /// dragged vertex along; a local drag fades with distance. Nothing pinned
     /// away from its rest position gives u = 0 exactly.
-    fn initial_guess(&self, x: &mut [P2]) {
+    fn initial_guess(&self, x: &mut [DVec2]) {
         let m = self.free.len();
         let mut diag = vec![[self.w, 0.0, 0.0, self.w]; m];
         let mut off = Vec::new();
@@ -277,8 +280,8 @@ impl Problem<'_> {
                 }
             }
             let pull = |v: usize, other: usize, rhs: &mut [f64]| {
-                rhs[2 * v] += s.k * (x[other][0] - self.rest[other][0]);
-                rhs[2 * v + 1] += s.k * (x[other][1] - self.rest[other][1]);
+                rhs[2 * v] += s.k * (x[other].x - self.rest[other].x);
+                rhs[2 * v + 1] += s.k * (x[other].y - self.rest[other].y);
             };
             match (va != usize::MAX, vb != usize::MAX) {
                 (true, true) => off.push((va, vb, block)),
@@ -290,26 +293,26 @@ impl Problem<'_> {
         let neg: Vec<f64> = rhs.iter().map(|v| -v).collect();
         let u = Hessian { diag, off }.solve_neg(&neg);
         for (v, &i) in self.free.iter().enumerate() {
-            x[i] = [self.rest[i][0] + u[2 * v], self.rest[i][1] + u[2 * v + 1]];
+            x[i] = DVec2::new(self.rest[i].x + u[2 * v], self.rest[i].y + u[2 * v + 1]);
         }
     }
 
     /// The unit direction from b to a and the length, or `None` when they coincide.
-    fn direction(&self, x: &[P2], s: &Spring) -> (Option<P2>, f64) {
-        let d = [x[s.a][0] - x[s.b][0], x[s.a][1] - x[s.b][1]];
-        let l = d[0].hypot(d[1]);
+    fn direction(&self, x: &[DVec2], s: &Spring) -> (Option<DVec2>, f64) {
+        let d = x[s.a] - x[s.b];
+        let l = d.x.hypot(d.y);
         if l <= 1e-12 * self.size {
             (None, l)
         } else {
-            (Some([d[0] / l, d[1] / l]), l)
+            (Some(d / l), l)
         }
     }
 
-    fn gradient(&self, x: &[P2]) -> Vec<f64> {
+    fn gradient(&self, x: &[DVec2]) -> Vec<f64> {
         let mut g = vec![0.0; 2 * self.free.len()];
         for (v, &i) in self.free.iter().enumerate() {
-            g[2 * v] = self.w * (x[i][0] - self.rest[i][0]);
-            g[2 * v + 1] = self.w * (x[i][1] - self.rest[i][1]);
+            g[2 * v] = self.w * (x[i].x - self.rest[i].x);
+            g[2 * v + 1] = self.w * (x[i].y - self.rest[i].y);
         }
         for s in self.springs {
             let (Some(n), l) = self.direction(x, s) else {
@@ -322,18 +325,18 @@ impl Problem<'_> {
             let va = self.var[s.a];
             let vb = self.var[s.b];
             if va != usize::MAX {
-                g[2 * va] += f * n[0];
-                g[2 * va + 1] += f * n[1];
+                g[2 * va] += f * n.x;
+                g[2 * va + 1] += f * n.y;
             }
             if vb != usize::MAX {
-                g[2 * vb] -= f * n[0];
-                g[2 * vb + 1] -= f * n[1];
+                g[2 * vb] -= f * n.x;
+                g[2 * vb + 1] -= f * n.y;
             }
         }
         g
     }
 
-    fn hessian(&self, x: &[P2]) -> Hessian {
+    fn hessian(&self, x: &[DVec2]) -> Hessian {
         let m = self.free.len();
         let mut diag = vec![[self.w, 0.0, 0.0, self.w]; m];
         let mut off = Vec::new();
@@ -343,7 +346,7 @@ impl Problem<'_> {
             let block = match self.direction(x, s) {
                 (Some(n), l) => {
                     let t = 1.0 - s.rest / l;
-                    let nn = [n[0] * n[0], n[0] * n[1], n[1] * n[0], n[1] * n[1]];
+                    let nn = [n.x * n.x, n.x * n.y, n.y * n.x, n.y * n.y];
                     [
                         s.k * (nn[0] + t * (1.0 - nn[0])),
                         s.k * (nn[1] * (1.0 - t)),
@@ -477,13 +480,18 @@ pub fn polygon_springs(n: usize) -> Vec<(usize, usize, bool)> {
 mod tests {
     use super::*;
 
-    fn square(sys: &mut System, at: P2, side: f64) -> Vec<usize> {
+    /// A point.
+    fn pt(x: f64, y: f64) -> DVec2 {
+        DVec2::new(x, y)
+    }
+
+    fn square(sys: &mut System, at: DVec2, side: f64) -> Vec<usize> {
         let base = sys.rest.len();
         sys.rest.extend([
             at,
-            [at[0] + side, at[1]],
-            [at[0] + side, at[1] + side],
-            [at[0], at[1] + side],
+            pt(at.x + side, at.y),
+            pt(at.x + side, at.y + side),
+            pt(at.x, at.y + side),
         ]);
         for (a, b, _) in polygon_springs(4) {
             sys.add_spring(base + a, base + b, 1.0);
@@ -501,13 +509,13 @@ mod tests {
     #[test]
     fn nothing_dragged_stays_exactly_at_rest() {
         let mut sys = System::default();
-        square(&mut sys, [0.0, 0.0], 10.0);
-        square(&mut sys, [10.0, 0.0], 7.3);
+        square(&mut sys, pt(0.0, 0.0), 10.0);
+        square(&mut sys, pt(10.0, 0.0), 7.3);
         let sol = sys.solve(&BTreeMap::new(), &params());
         assert_eq!(sol.positions, sys.rest);
         assert_eq!(sol.free, 0);
         // Pinned where they are: the gradient is zero, nothing moves by a bit.
-        let pins: BTreeMap<usize, P2> = [(0, sys.rest[0]), (5, sys.rest[5])].into();
+        let pins: BTreeMap<usize, DVec2> = [(0, sys.rest[0]), (5, sys.rest[5])].into();
         let sol = sys.solve(&pins, &params());
         assert_eq!(sol.positions, sys.rest);
         assert!(sol.converged);
@@ -517,8 +525,8 @@ mod tests {
     #[test]
     fn dragged_vertex_lands_exactly_on_its_target() {
         let mut sys = System::default();
-        square(&mut sys, [0.0, 0.0], 10.0);
-        let target = [3.162_277_660_168_379_5, -27.182_818_284];
+        square(&mut sys, pt(0.0, 0.0), 10.0);
+        let target = pt(3.162_277_660_168_379_5, -27.182_818_284);
         let sol = sys.solve(&[(2, target)].into(), &params());
         assert_eq!(sol.positions[2], target);
         assert!(sol.converged);
@@ -527,8 +535,8 @@ mod tests {
     #[test]
     fn a_rigid_guide_keeps_its_edge_lengths_when_dragged_by_one_vertex() {
         let mut sys = System::default();
-        square(&mut sys, [0.0, 0.0], 10.0);
-        let sol = sys.solve(&[(2, [40.0, 25.0])].into(), &params());
+        square(&mut sys, pt(0.0, 0.0), 10.0);
+        let sol = sys.solve(&[(2, pt(40.0, 25.0))].into(), &params());
         assert!(sol.converged);
         for s in &sys.springs {
             let l = dist(sol.positions[s.a], sol.positions[s.b]);
@@ -543,8 +551,8 @@ mod tests {
         // It followed: every vertex moved most of the way.
         for i in 0..4 {
             let d = [
-                sol.positions[i][0] - sys.rest[i][0],
-                sol.positions[i][1] - sys.rest[i][1],
+                sol.positions[i].x - sys.rest[i].x,
+                sol.positions[i].y - sys.rest[i].y,
             ];
             assert!(d[0] > 20.0 && d[1] > 10.0, "vertex {i} moved by {d:?}");
         }
@@ -555,20 +563,20 @@ mod tests {
         // Two squares sharing an edge (particles 1 and 2 of the first), and a third
         // square far away with no spring to them.
         let mut sys = System::default();
-        square(&mut sys, [0.0, 0.0], 10.0);
+        square(&mut sys, pt(0.0, 0.0), 10.0);
         let base = sys.rest.len();
-        sys.rest.extend([[20.0, 0.0], [20.0, 10.0]]);
+        sys.rest.extend([pt(20.0, 0.0), pt(20.0, 10.0)]);
         let second = [1, base, base + 1, 2];
         for (a, b, _) in polygon_springs(4) {
             sys.add_spring(second[a], second[b], 1.0);
         }
-        let far = square(&mut sys, [100.0, 100.0], 5.0);
-        let pins: BTreeMap<usize, P2> = [(0, [0.0, -5.0]), (3, [0.0, 5.0])].into();
+        let far = square(&mut sys, pt(100.0, 100.0), 5.0);
+        let pins: BTreeMap<usize, DVec2> = [(0, pt(0.0, -5.0)), (3, pt(0.0, 5.0))].into();
         let sol = sys.solve(&pins, &params());
         // The second square moved with the first through the shared particles.
         for i in [1, 2, base, base + 1] {
             assert!(
-                (sol.positions[i][1] - sys.rest[i][1] + 5.0).abs() < 0.5,
+                (sol.positions[i].y - sys.rest[i].y + 5.0).abs() < 0.5,
                 "particle {i}: {:?}",
                 sol.positions[i]
             );
@@ -581,12 +589,12 @@ mod tests {
     #[test]
     fn stiff_springs_hold_their_length_better() {
         let mut soft = System::default();
-        square(&mut soft, [0.0, 0.0], 10.0);
+        square(&mut soft, pt(0.0, 0.0), 10.0);
         let mut stiff = soft.clone();
         stiff.add_spring(0, 1, 100.0);
         // Pull vertices 1 and 2 apart from 0 and 3.
-        let pins: BTreeMap<usize, P2> =
-            [(0, [0.0, 0.0]), (3, [0.0, 10.0]), (2, [16.0, 10.0])].into();
+        let pins: BTreeMap<usize, DVec2> =
+            [(0, pt(0.0, 0.0)), (3, pt(0.0, 10.0)), (2, pt(16.0, 10.0))].into();
         let a = soft.solve(&pins, &params());
         let b = stiff.solve(&pins, &params());
         let ea = (dist(a.positions[0], a.positions[1]) - 10.0).abs();
@@ -597,18 +605,18 @@ mod tests {
     #[test]
     fn deterministic() {
         let mut sys = System::default();
-        square(&mut sys, [0.0, 0.0], 10.0);
-        square(&mut sys, [10.0, 0.0], 10.0);
+        square(&mut sys, pt(0.0, 0.0), 10.0);
+        square(&mut sys, pt(10.0, 0.0), 10.0);
         sys.add_spring(1, 4, 1.0);
         sys.add_spring(2, 7, 1.0);
-        let pins: BTreeMap<usize, P2> = [(0, [-3.0, 7.5]), (6, [30.0, 30.0])].into();
+        let pins: BTreeMap<usize, DVec2> = [(0, pt(-3.0, 7.5)), (6, pt(30.0, 30.0))].into();
         let a = sys.solve(&pins, &params());
         for _ in 0..5 {
             let b = sys.solve(&pins, &params());
             let bits = |s: &Solution| -> Vec<u64> {
                 s.positions
                     .iter()
-                    .flat_map(|p| [p[0].to_bits(), p[1].to_bits()])
+                    .flat_map(|p| [p.x.to_bits(), p.y.to_bits()])
                     .collect()
             };
             assert_eq!(bits(&a), bits(&b));
@@ -616,13 +624,13 @@ mod tests {
     }
 
     /// The rank of the rigidity matrix is 2n − 3 for a rigid framework.
-    fn rigidity_rank(pts: &[P2], bars: &[(usize, usize, bool)]) -> usize {
+    fn rigidity_rank(pts: &[DVec2], bars: &[(usize, usize, bool)]) -> usize {
         let cols = 2 * pts.len();
         let mut m: Vec<Vec<f64>> = bars
             .iter()
             .map(|&(a, b, _)| {
                 let mut row = vec![0.0; cols];
-                let d = [pts[a][0] - pts[b][0], pts[a][1] - pts[b][1]];
+                let d = [pts[a].x - pts[b].x, pts[a].y - pts[b].y];
                 row[2 * a] = d[0];
                 row[2 * a + 1] = d[1];
                 row[2 * b] = -d[0];
@@ -658,11 +666,11 @@ mod tests {
     fn polygon_springs_make_polygons_rigid() {
         for n in 3..=24 {
             // A slightly irregular convex polygon (regular ones can be special).
-            let pts: Vec<P2> = (0..n)
+            let pts: Vec<DVec2> = (0..n)
                 .map(|i| {
                     let a = i as f64 / n as f64 * std::f64::consts::TAU;
                     let r = 10.0 + (i * 7 % 5) as f64 * 0.37;
-                    [r * a.cos(), r * a.sin()]
+                    pt(r * a.cos(), r * a.sin())
                 })
                 .collect();
             let bars = polygon_springs(n);

@@ -436,11 +436,12 @@ pub fn element_centres(prog: &Program) -> Vec<DVec2> {
 /// heading): the middle of its outline's bounding box, or the origin for a path
 /// that encloses nothing.
 pub fn outline_centre(path: &str) -> DVec2 {
-    crate::render::obj::outline_from_path(path)
-        .and_then(|o| {
-            let mut pts = o.points.iter().map(|&[x, y]| DVec2::new(x, y));
-            let first = pts.next()?;
-            let (lo, hi) = pts.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    crate::path::largest_outline(path)
+        .and_then(|pts| {
+            let first = *pts.first()?;
+            let (lo, hi) = pts
+                .iter()
+                .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
             Some((lo + hi) * 0.5)
         })
         .unwrap_or(DVec2::ZERO)

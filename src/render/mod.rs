@@ -149,38 +149,8 @@ impl Sink for BoundsSink<'_> {
     }
 }
 
-/// The bounding box of SVG path data in its own coordinates, if it has points.
+/// The bounding box of SVG path data in its own coordinates (control points
+/// included), if it reads and has points.
 pub fn path_bounds(d: &str) -> Option<[f64; 4]> {
-    let mut b = [
-        f64::INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-    ];
-    let mut any = false;
-    for seg in svgtypes::SimplifyingPathParser::from(d) {
-        let Ok(seg) = seg else { return None };
-        use svgtypes::SimplePathSegment as S;
-        let pts: Vec<(f64, f64)> = match seg {
-            S::MoveTo { x, y } | S::LineTo { x, y } => vec![(x, y)],
-            S::CurveTo {
-                x1,
-                y1,
-                x2,
-                y2,
-                x,
-                y,
-            } => vec![(x1, y1), (x2, y2), (x, y)],
-            S::Quadratic { x1, y1, x, y } => vec![(x1, y1), (x, y)],
-            S::ClosePath => vec![],
-        };
-        for (x, y) in pts {
-            any = true;
-            b[0] = b[0].min(x);
-            b[1] = b[1].min(y);
-            b[2] = b[2].max(x);
-            b[3] = b[3].max(y);
-        }
-    }
-    any.then_some(b)
+    crate::path::control_bounds(&crate::path::parse(d).ok()?)
 }

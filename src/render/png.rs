@@ -39,25 +39,24 @@ pub fn parse_color(s: &str) -> Option<[u8; 3]> {
         .map(|c| [c.red, c.green, c.blue])
 }
 
+/// An element's outline as tiny-skia draws it; `None` for bad or empty data.
 fn element_path(d: &str) -> Option<tiny_skia::Path> {
+    use kurbo::PathEl as E;
+    let f = |p: kurbo::Point| (p.x as f32, p.y as f32);
     let mut pb = PathBuilder::new();
-    for seg in svgtypes::SimplifyingPathParser::from(d) {
-        use svgtypes::SimplePathSegment as S;
-        match seg.ok()? {
-            S::MoveTo { x, y } => pb.move_to(x as f32, y as f32),
-            S::LineTo { x, y } => pb.line_to(x as f32, y as f32),
-            S::CurveTo {
-                x1,
-                y1,
-                x2,
-                y2,
-                x,
-                y,
-            } => pb.cubic_to(
-                x1 as f32, y1 as f32, x2 as f32, y2 as f32, x as f32, y as f32,
-            ),
-            S::Quadratic { x1, y1, x, y } => pb.quad_to(x1 as f32, y1 as f32, x as f32, y as f32),
-            S::ClosePath => pb.close(),
+    for el in crate::path::parse(d).ok()?.elements() {
+        match *el {
+            E::MoveTo(a) => pb.move_to(f(a).0, f(a).1),
+            E::LineTo(a) => pb.line_to(f(a).0, f(a).1),
+            E::CurveTo(a, b, c) => {
+                let ((ax, ay), (bx, by), (cx, cy)) = (f(a), f(b), f(c));
+                pb.cubic_to(ax, ay, bx, by, cx, cy)
+            }
+            E::QuadTo(a, b) => {
+                let ((ax, ay), (bx, by)) = (f(a), f(b));
+                pb.quad_to(ax, ay, bx, by)
+            }
+            E::ClosePath => pb.close(),
         }
     }
     pb.finish()

@@ -4,6 +4,7 @@
 
 use super::{Bounds, View, palette};
 use crate::compile::ElementDef;
+use crate::number::{write_decimals, write_fixed};
 use crate::turtle::Sink;
 use glam::{DVec2, DVec3};
 use std::io::{self, Write};
@@ -57,7 +58,7 @@ impl<W: Write> SvgWriter<W> {
         };
         let num = |v: f64| {
             let mut b = Vec::new();
-            write_num(&mut b, v, decimals);
+            write_decimals(&mut b, v, decimals);
             String::from_utf8(b).unwrap_or_default()
         };
         let mut head = String::new();
@@ -160,9 +161,9 @@ impl<W: Write> SvgWriter<W> {
                 buf.push(b' ');
             }
             let q = self.view.project(p);
-            write_num(buf, q.x, self.decimals);
+            write_decimals(buf, q.x, self.decimals);
             buf.push(b',');
-            write_num(buf, -q.y, self.decimals);
+            write_decimals(buf, -q.y, self.decimals);
         }
     }
 
@@ -202,13 +203,13 @@ impl<W: Write> SvgWriter<W> {
             xml(to)
         )
         .into_bytes();
-        write_num(&mut buf, pa.x, self.decimals);
+        write_decimals(&mut buf, pa.x, self.decimals);
         buf.extend_from_slice(b"\" y1=\"");
-        write_num(&mut buf, -pa.y, self.decimals);
+        write_decimals(&mut buf, -pa.y, self.decimals);
         buf.extend_from_slice(b"\" x2=\"");
-        write_num(&mut buf, pb.x, self.decimals);
+        write_decimals(&mut buf, pb.x, self.decimals);
         buf.extend_from_slice(b"\" y2=\"");
-        write_num(&mut buf, -pb.y, self.decimals);
+        write_decimals(&mut buf, -pb.y, self.decimals);
         buf.extend_from_slice(b"\"/>\n");
         self.write(&buf);
     }
@@ -259,7 +260,7 @@ impl<W: Write> Sink for SvgWriter<W> {
         buf.push(b'"');
         if width > 0.0 {
             buf.extend_from_slice(b" stroke-width=\"");
-            write_num(&mut buf, width, self.decimals + 1);
+            write_decimals(&mut buf, width, self.decimals + 1);
             buf.push(b'"');
         }
         buf.extend_from_slice(b" d=\"M");
@@ -308,7 +309,7 @@ impl<W: Write> Sink for SvgWriter<W> {
             if k > 0 {
                 buf.push(b' ');
             }
-            write_num(&mut buf, v, if k < 4 { d } else { self.decimals });
+            write_decimals(&mut buf, v, if k < 4 { d } else { self.decimals });
         }
         buf.extend_from_slice(b")\"/>\n");
         self.write(&buf);
@@ -321,119 +322,4 @@ pub fn xml(s: &str) -> String {
         .replace('"', "&quot;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
-}
-
-/// Writes the fixed-point integer `n` (units of 10^-decimals) as a decimal
-/// number, trailing zeros dropped, without allocating.
-pub fn write_fixed(buf: &mut Vec<u8>, n: i64, decimals: usize) {
-    if n == 0 {
-        buf.push(b'0');
-        return;
-    }
-    if n < 0 {
-        buf.push(b'-');
-    }
-    let mut m = n.unsigned_abs();
-    let mut digits = [0u8; 24];
-    let mut len = 0;
-    while m > 0 || len <= decimals {
-        digits[len] = b'0' + (m % 10) as u8;
-        m /= 10;
-        len += 1;
-    }
-    // digits[..len] holds the number backwards; the first `decimals` are the fraction.
-    let mut frac_start = 0;
-    while frac_start < decimals && digits[frac_start] == b'0' {
-        frac_start += 1;
-    }
-    for k in (decimals..len).rev() {
-        buf.push(digits[k]);
-    }
-    if frac_start < decimals {
-        buf.push(b'.');
-        for k in (frac_start..decimals).rev() {
-            buf.push(digits[k]);
-        }
-    }
-}
-
-/// Writes `v` with at most `decimals` decimals, trailing zeros dropped.
-pub fn write_num(buf: &mut Vec<u8>, v: f64, decimals: usize) {
-    if !v.is_finite() {
-        buf.push(b'0');
-        return;
-    }
-    let scale = 10f64.powi(decimals as i32);
-    let r = (v * scale).round();
-    if r.abs() >= 9.0e15 {
-        buf.extend_from_slice(format!("{v}").as_bytes());
-        return;
-    }
-    let mut n = r as i64;
-    if n == 0 {
-        buf.push(b'0');
-        return;
-    }
-    if n < 0 {
-        buf.push(b'-');
-        n = -n;
-    }
-    let n = n as u64;
-    let p = 10u64.pow(decimals as u32);
-    let (int, mut frac) = (n / p, n % p);
-    buf.extend_from_slice(int.to_string().as_bytes());
-    if frac != 0 {
-        let mut digits = decimals;
-        while frac % 10 == 0 {
-            frac /= 10;
-            digits -= 1;
-        }
-        buf.push(b'.');
-        let s = frac.to_string();
-        for _ in s.len()..digits {
-            buf.push(b'0');
-        }
-        buf.extend_from_slice(s.as_bytes());
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::write_num;
-
-    fn n(v: f64, d: usize) -> String {
-        let mut b = Vec::new();
-        write_num(&mut b, v, d);
-        String::from_utf8(b).unwrap_or_default()
-    }
-
-    fn f(n: i64, d: usize) -> String {
-        let mut b = Vec::new();
-        super::write_fixed(&mut b, n, d);
-        String::from_utf8(b).unwrap_or_default()
-    }
-
-    #[test]
-    fn fixed_point_numbers() {
-        assert_eq!(f(0, 3), "0");
-        assert_eq!(f(1500, 3), "1.5");
-        assert_eq!(f(-1250, 3), "-1.25");
-        assert_eq!(f(41, 3), "0.041");
-        assert_eq!(f(-1, 3), "-0.001");
-        assert_eq!(f(12, 0), "12");
-        assert_eq!(f(120, 1), "12");
-        assert_eq!(f(i64::MIN + 1, 2).len(), 21);
-    }
-
-    #[test]
-    fn numbers_are_short_and_exact_enough() {
-        assert_eq!(n(0.0, 3), "0");
-        assert_eq!(n(1.5, 3), "1.5");
-        assert_eq!(n(-1.25, 3), "-1.25");
-        assert_eq!(n(0.0004, 3), "0");
-        assert_eq!(n(0.0405, 3), "0.041");
-        assert_eq!(n(12.0, 0), "12");
-        assert_eq!(n(-0.001, 3), "-0.001");
-        assert_eq!(n(1.23456, 2), "1.23");
-    }
 }

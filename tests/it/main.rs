@@ -6,6 +6,7 @@ mod corpus;
 mod diagnostics;
 mod edit;
 mod evaluator;
+mod geometry;
 mod guided;
 mod hostile;
 mod infer;

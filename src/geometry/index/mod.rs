@@ -1,0 +1,14 @@
+//! The spatial indexes, one module: uniform grids over points (`PointGrid`:
+//! the k nearest, those within a distance) and over segments (`SegmentGrid`:
+//! first crossing, nearest segment, first ray hit).
+//!
+//! Owns: every spatial search of the crate. Each search returns exactly what a
+//! scan of all items would, ties broken by the lower index, so an index changes
+//! speed, never answers (and never depends on thread count or hash order).
+//! Must not know what the points and segments stand for.
+
+pub mod points;
+pub mod segments;
+
+pub use points::PointGrid;
+pub use segments::SegmentGrid;

@@ -1,0 +1,450 @@
+//! A uniform grid over segments: the index behind crossing, nearest-segment
+//! and ray queries (the environment's `?X`, `?D_A` and `?N_A` over what a
+//! guide drew).
+//!
+//! Owns: choosing the cells (about one per segment, never smaller than the mean
+//! segment length, at most `MAX_CELLS_PER_AXIS` a side), registering each
+//! segment in the cells along it, and the three searches. Every search returns
+//! exactly what a scan of all segments would (ties go to the lowest index), so
+//! the index changes speed, never answers. Segments that touch the asking point
+//! (a turtle's own last segment) are skipped, as the scan skips them. Must not
+//! know guides or systems.
+
+use crate::geometry::{closest_on_segment, crossing, ray_hit};
+use glam::DVec2;
+
+/// The grid never has more than this many cells along an axis.
+pub const MAX_CELLS_PER_AXIS: usize = 2048;
+
+/// With fewer segments than this, the grid is one cell.
+pub const SCAN_BELOW_SEGMENTS: usize = 32;
+
+/// A segment touching the asking point within this distance is the asker's own.
+pub const TOUCH: f64 = 1e-9;
+
+/// Whether segment `s` touches `p` (and so is skipped by queries from `p`).
+pub fn touches(s: &(DVec2, DVec2), p: DVec2) -> bool {
+    (s.0 - p).length() <= TOUCH || (s.1 - p).length() <= TOUCH
+}
+
+/// Segments in a grid of cells; see the module note.
+pub struct SegmentGrid {
+    segs: Vec<(DVec2, DVec2)>,
+    min: DVec2,
+    max: DVec2,
+    /// Cell sizes (0 along an axis with one cell of zero extent).
+    cell: DVec2,
+    inv: DVec2,
+    nx: usize,
+    ny: usize,
+    /// Length of the pieces a segment or ray is walked in: no longer than a
+    /// cell along any axis with more than one cell.
+    stride: f64,
+    /// Cell `c` holds `items[start[c]..start[c + 1]]`.
+    start: Vec<u32>,
+    items: Vec<u32>,
+}
+
+/// A margin around every walked piece, so that rounding never hides a cell.
+fn margin(p: DVec2) -> f64 {
+    1e-9 * (1.0 + p.x.abs().max(p.y.abs()))
+}
+
+impl SegmentGrid {
+    /// Indexes `segs` (the grid keeps them). Segments with a coordinate that
+    /// is not finite are left out (they cross nothing).
+    pub fn new(segs: Vec<(DVec2, DVec2)>) -> SegmentGrid {
+        let finite = |s: &(DVec2, DVec2)| s.0.is_finite() && s.1.is_finite();
+        let mut min = DVec2::splat(f64::INFINITY);
+        let mut max = DVec2::splat(f64::NEG_INFINITY);
+        let mut len = 0.0;
+        let mut n = 0usize;
+        for s in segs.iter().filter(|s| finite(s)) {
+            min = min.min(s.0).min(s.1);
+            max = max.max(s.0).max(s.1);
+            len += (s.1 - s.0).length();
+            n += 1;
+        }
+        let mut grid = SegmentGrid {
+            segs,
+            min,
+            max,
+            cell: DVec2::ZERO,
+            inv: DVec2::ZERO,
+            nx: 0,
+            ny: 0,
+            stride: f64::INFINITY,
+            start: Vec::new(),
+            items: Vec::new(),
+        };
+        if n == 0 {
+            return grid;
+        }
+        let size = max - min;
+        // A few segments: a scan of one cell is cheaper than sorting them into cells.
+        if n < SCAN_BELOW_SEGMENTS || !size.is_finite() {
+            return grid.single(min, max);
+        }
+        // About one cell per segment, and cells at least as long as a mean segment.
+        let c = (len / n as f64)
+            .max((size.x * size.y / n as f64).sqrt())
+            .max(1e-12);
+        let count = |extent: f64| -> usize {
+            if extent <= 0.0 {
+                1
+            } else {
+                ((extent / c).ceil() as usize).clamp(1, MAX_CELLS_PER_AXIS)
+            }
+        };
+        let (nx, ny) = (count(size.x), count(size.y));
+        let cell = DVec2::new(size.x / nx as f64, size.y / ny as f64);
+        let inv = DVec2::new(
+            if nx > 1 { 1.0 / cell.x } else { 0.0 },
+            if ny > 1 { 1.0 / cell.y } else { 0.0 },
+        );
+        let mut stride = f64::INFINITY;
+        if nx > 1 {
+            stride = stride.min(cell.x);
+        }
+        if ny > 1 {
+            stride = stride.min(cell.y);
+        }
+        grid.min = min;
+        grid.max = max;
+        grid.cell = cell;
+        grid.inv = inv;
+        grid.nx = nx;
+        grid.ny = ny;
+        grid.stride = stride;
+        grid.fill();
+        grid
+    }
+
+    /// One cell holding every finite segment (also when the span is beyond the
+    /// range of numbers).
+    fn single(mut self, min: DVec2, max: DVec2) -> SegmentGrid {
+        self.min = min;
+        self.max = max;
+        self.nx = 1;
+        self.ny = 1;
+        self.items = (0..self.segs.len() as u32)
+            .filter(|&i| {
+                let s = &self.segs[i as usize];
+                s.0.is_finite() && s.1.is_finite()
+            })
+            .collect();
+        self.start = vec![0, self.items.len() as u32];
+        self
+    }
+
+    /// Registers every finite segment in the cells along it (counting sort:
+    /// one pass counts, one pass places).
+    fn fill(&mut self) {
+        let cells = self.nx * self.ny;
+        let mut start = vec![0u32; cells + 1];
+        let mut scratch = Vec::new();
+        self.each_cell(&mut scratch, |c, _| start[c as usize + 1] += 1);
+        for c in 0..cells {
+            start[c + 1] += start[c];
+        }
+        let mut at = start.clone();
+        let mut items = vec![0u32; start[cells] as usize];
+        self.each_cell(&mut scratch, |c, i| {
+            items[at[c as usize] as usize] = i;
+            at[c as usize] += 1;
+        });
+        self.start = start;
+        self.items = items;
+    }
+
+    /// Calls `f(cell, segment)` for every cell of every finite segment. A
+    /// segment within one cell's stride is registered in the cells of its box
+    /// (no margin: queries widen their own boxes), a longer one piece by piece.
+    fn each_cell(&self, scratch: &mut Vec<u32>, mut f: impl FnMut(u32, u32)) {
+        for (i, s) in self.segs.iter().enumerate() {
+            if !(s.0.is_finite() && s.1.is_finite()) {
+                continue;
+            }
+            let (lo, hi) = (s.0.min(s.1), s.0.max(s.1));
+            if hi.x - lo.x <= self.stride && hi.y - lo.y <= self.stride {
+                let (c0, c1) = (self.col(lo.x), self.col(hi.x));
+                let (r0, r1) = (self.row(lo.y), self.row(hi.y));
+                for r in r0..=r1 {
+                    for c in c0..=c1 {
+                        f((r * self.nx + c) as u32, i as u32);
+                    }
+                }
+            } else {
+                scratch.clear();
+                self.walk(s.0, s.1, scratch);
+                for &c in scratch.iter() {
+                    f(c, i as u32);
+                }
+            }
+        }
+    }
+
+    fn col(&self, x: f64) -> usize {
+        (((x - self.min.x) * self.inv.x).floor().max(0.0) as usize).min(self.nx - 1)
+    }
+
+    fn row(&self, y: f64) -> usize {
+        (((y - self.min.y) * self.inv.y).floor().max(0.0) as usize).min(self.ny - 1)
+    }
+
+    /// The cells whose boxes meet the box of `a`–`b` widened by a margin, or
+    /// nothing when that box misses the grid.
+    fn boxed(&self, a: DVec2, b: DVec2, out: &mut Vec<u32>) -> bool {
+        let m = margin(a).max(margin(b));
+        let lo = a.min(b) - DVec2::splat(m);
+        let hi = a.max(b) + DVec2::splat(m);
+        if hi.x < self.min.x || hi.y < self.min.y || lo.x > self.max.x || lo.y > self.max.y {
+            return false;
+        }
+        let (c0, c1) = (self.col(lo.x), self.col(hi.x));
+        let (r0, r1) = (self.row(lo.y), self.row(hi.y));
+        for r in r0..=r1 {
+            for c in c0..=c1 {
+                out.push((r * self.nx + c) as u32);
+            }
+        }
+        true
+    }
+
+    /// The cells along `a`–`b`, each once: the segment is walked in pieces no
+    /// longer than a cell, so a long segment touches few cells per piece.
+    fn walk(&self, a: DVec2, b: DVec2, out: &mut Vec<u32>) {
+        let len = (b - a).length();
+        let pieces = if self.stride.is_finite() && len > self.stride {
+            ((len / self.stride).ceil() as usize).min(4 * MAX_CELLS_PER_AXIS)
+        } else {
+            1
+        };
+        if pieces == 1 {
+            // One box: its cells are distinct already.
+            self.boxed(a, b, out);
+            return;
+        }
+        let first = out.len();
+        for k in 0..pieces {
+            let p = a.lerp(b, k as f64 / pieces as f64);
+            let q = a.lerp(b, (k + 1) as f64 / pieces as f64);
+            self.boxed(p, q, out);
+        }
+        out[first..].sort_unstable();
+        let mut w = first;
+        for r in first..out.len() {
+            if r == first || out[r] != out[w - 1] {
+                out[w] = out[r];
+                w += 1;
+            }
+        }
+        out.truncate(w);
+    }
+
+    /// How many cells the grid has (0 when it holds no finite segment).
+    pub fn cells(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// The indexed segments, in their order.
+    pub fn segs(&self) -> &[(DVec2, DVec2)] {
+        &self.segs
+    }
+
+    /// The smallest distance from `p` to the box of the segments.
+    pub fn box_distance(&self, p: DVec2) -> f64 {
+        (self.min - p).max(p - self.max).max(DVec2::ZERO).length()
+    }
+
+    fn cell_items(&self, c: u32) -> &[u32] {
+        let c = c as usize;
+        &self.items[self.start[c] as usize..self.start[c + 1] as usize]
+    }
+
+    /// The lowest-indexed segment that `p`–`q` crosses (beyond its very start),
+    /// not counting segments touching `p`.
+    pub fn first_crossing(&self, p: DVec2, q: DVec2) -> Option<usize> {
+        if self.nx == 0 || !(p.is_finite() && q.is_finite()) {
+            return None;
+        }
+        if self.nx * self.ny == 1 {
+            return self.items.iter().map(|&i| i as usize).find(|&i| {
+                let s = &self.segs[i];
+                !touches(s, p) && crossing(p, q, s.0, s.1).is_some_and(|t| t > 1e-6)
+            });
+        }
+        let mut cells = Vec::new();
+        self.walk(p, q, &mut cells);
+        let mut cands: Vec<u32> = cells
+            .iter()
+            .flat_map(|&c| self.cell_items(c).iter().copied())
+            .collect();
+        cands.sort_unstable();
+        cands.dedup();
+        cands.into_iter().map(|i| i as usize).find(|&i| {
+            let s = &self.segs[i];
+            !touches(s, p) && crossing(p, q, s.0, s.1).is_some_and(|t| t > 1e-6)
+        })
+    }
+
+    /// The closest segment to `p` not touching it: (distance, closest point,
+    /// index), the lowest index among equally close ones.
+    pub fn nearest(&self, p: DVec2) -> Option<(f64, DVec2, usize)> {
+        if self.nx == 0 || !p.is_finite() {
+            return None;
+        }
+        let (ci, cj) = (self.col(p.x), self.row(p.y));
+        let mut best: Option<(f64, DVec2, usize)> = None;
+        let better = |d: f64, i: usize, b: &Option<(f64, DVec2, usize)>| match b {
+            None => true,
+            Some((bd, _, bi)) => d.total_cmp(bd).then(i.cmp(bi)).is_lt(),
+        };
+        let visit = |col: usize, row: usize, best: &mut Option<(f64, DVec2, usize)>| {
+            for &i in self.cell_items((row * self.nx + col) as u32) {
+                let i = i as usize;
+                let s = &self.segs[i];
+                if touches(s, p) {
+                    continue;
+                }
+                let c = closest_on_segment(p, s.0, s.1);
+                let d = (c - p).length();
+                if better(d, i, best) {
+                    *best = Some((d, c, i));
+                }
+            }
+        };
+        for r in 0..self.nx.max(self.ny) {
+            let (c0, c1) = (ci.saturating_sub(r), (ci + r).min(self.nx - 1));
+            let (r0, r1) = (cj.saturating_sub(r), (cj + r).min(self.ny - 1));
+            // Only the ring at distance r: the inside was searched before.
+            let top = cj + r < self.ny;
+            let bottom = r > 0 && cj >= r;
+            for col in c0..=c1 {
+                if bottom {
+                    visit(col, cj - r, &mut best);
+                }
+                if top {
+                    visit(col, cj + r, &mut best);
+                }
+            }
+            let inner = (
+                cj.saturating_sub(r.saturating_sub(1)),
+                (cj + r).saturating_sub(1).min(self.ny - 1),
+            );
+            if r > 0 {
+                for row in inner.0..=inner.1 {
+                    if ci >= r {
+                        visit(ci - r, row, &mut best);
+                    }
+                    if ci + r < self.nx {
+                        visit(ci + r, row, &mut best);
+                    }
+                }
+            }
+            // Whatever lies beyond the searched block is at least this far away.
+            let mut bound = f64::INFINITY;
+            if c0 > 0 {
+                bound = bound.min(p.x - (self.min.x + c0 as f64 * self.cell.x));
+            }
+            if c1 + 1 < self.nx {
+                bound = bound.min(self.min.x + (c1 + 1) as f64 * self.cell.x - p.x);
+            }
+            if r0 > 0 {
+                bound = bound.min(p.y - (self.min.y + r0 as f64 * self.cell.y));
+            }
+            if r1 + 1 < self.ny {
+                bound = bound.min(self.min.y + (r1 + 1) as f64 * self.cell.y - p.y);
+            }
+            if bound == f64::INFINITY {
+                break;
+            }
+            if let Some((d, _, _)) = best
+                && d < bound - margin(p) * 16.0
+            {
+                break;
+            }
+        }
+        best
+    }
+
+    /// The first segment hit by the ray from `p` along unit `dir`, not farther
+    /// than `limit`: (distance, index), the lowest index among equal distances.
+    /// Segments touching `p` are skipped.
+    pub fn ray(&self, p: DVec2, dir: DVec2, limit: f64) -> Option<(f64, usize)> {
+        if self.nx == 0 || !(p.is_finite() && dir.is_finite()) {
+            return None;
+        }
+        if dir.length_squared() == 0.0 {
+            return None;
+        }
+        // The part of the ray inside the grid's box (widened by a margin).
+        let m = DVec2::splat(margin(self.min).max(margin(self.max)) * 16.0);
+        let (lo, hi) = (self.min - m, self.max + m);
+        let (mut enter, mut exit) = (0.0f64, f64::INFINITY);
+        for (o, d, a, b) in [(p.x, dir.x, lo.x, hi.x), (p.y, dir.y, lo.y, hi.y)] {
+            if d == 0.0 {
+                if o < a || o > b {
+                    return None;
+                }
+            } else {
+                let (t0, t1) = ((a - o) / d, (b - o) / d);
+                enter = enter.max(t0.min(t1));
+                exit = exit.min(t0.max(t1));
+            }
+        }
+        if enter.is_nan() || exit.is_nan() || enter > exit || enter > limit {
+            return None;
+        }
+        // One piece when there is one cell; else pieces of a cell's length.
+        let (stride, pieces) = if self.stride.is_finite() && self.nx * self.ny > 1 {
+            let across = (exit.min(limit) - enter) / self.stride;
+            (
+                self.stride,
+                (across.ceil().max(0.0) as usize).min(8 * MAX_CELLS_PER_AXIS) + 2,
+            )
+        } else {
+            (f64::INFINITY, 1)
+        };
+        let mut best: Option<(f64, usize)> = None;
+        let mut cells = Vec::new();
+        let mut cands: Vec<u32> = Vec::new();
+        for k in 0..pieces {
+            let t0 = enter + k as f64 * stride;
+            if t0 > limit || t0 > exit {
+                break;
+            }
+            let t1 = t0 + stride;
+            cells.clear();
+            if pieces == 1 {
+                cells.extend(0..(self.nx * self.ny) as u32);
+            } else if !self.boxed(p + dir * t0, p + dir * t1, &mut cells) {
+                break;
+            }
+            cands.clear();
+            for &c in &cells {
+                cands.extend_from_slice(self.cell_items(c));
+            }
+            cands.sort_unstable();
+            cands.dedup();
+            for &i in &cands {
+                let i = i as usize;
+                let s = &self.segs[i];
+                if touches(s, p) {
+                    continue;
+                }
+                if let Some(t) = ray_hit(p, dir, s.0, s.1)
+                    && t <= limit
+                    && best.is_none_or(|(bt, bi)| t.total_cmp(&bt).then(i.cmp(&bi)).is_lt())
+                {
+                    best = Some((t, i));
+                }
+            }
+            // A hit not yet seen lies beyond this piece.
+            if best.is_some_and(|(t, _)| t < t1 - margin(p + dir * t1) * 16.0) {
+                break;
+            }
+        }
+        best
+    }
+}
