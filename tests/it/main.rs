@@ -10,6 +10,7 @@ mod geometry;
 mod guided;
 mod hostile;
 mod infer;
+mod layers;
 mod run;
 mod scene;
 mod sketch;
