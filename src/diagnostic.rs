@@ -325,7 +325,14 @@ fn to_codespan(d: &Diagnostic, source_len: usize) -> cs::Diagnostic<()> {
             };
             cs::Label::new(style, (), start..end).with_message(l.message.clone())
         })
-        .collect();
+        .collect::<Vec<_>>();
+    // A diagnostic about the whole file (no place in it) still names the file:
+    // codespan prints the location of a label, so it gets an empty one at 1:1.
+    let labels = if labels.is_empty() && source_len > 0 {
+        vec![cs::Label::primary((), 0..0)]
+    } else {
+        labels
+    };
     let mut notes = d.notes.clone();
     if let Some(h) = &d.help {
         notes.push(format!("help: {h}"));
