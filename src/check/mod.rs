@@ -288,25 +288,7 @@ impl<'a> Checker<'a> {
         let (sorted, in_cycle) = self.sort_consts(&order, &deps);
         let overridden: HashMap<&str, &Override> =
             overrides.iter().map(|o| (o.name.as_str(), o)).collect();
-        for o in overrides {
-            if !self.consts.contains_key(o.name.as_str()) {
-                let mut d = Diagnostic::error(
-                    Code::BadOverride,
-                    format!("`-D {}`: the program has no constant `{}`", o.name, o.name),
-                );
-                let names: Vec<&str> = self.consts.keys().copied().collect();
-                if let Some(s) = suggest(&o.name, names.iter().copied()) {
-                    d = d.help(format!("did you mean `{s}`?"));
-                } else if names.is_empty() {
-                    d = d.note("the program declares no constants; add `const NAME = VALUE;` to make a value overridable");
-                } else {
-                    let mut names = names;
-                    names.sort_unstable();
-                    d = d.note(format!("its constants are: {}", names.join(", ")));
-                }
-                self.diags.push(d);
-            }
-        }
+        self.unknown_overrides(overrides);
         let index: HashMap<&str, usize> = order.iter().enumerate().map(|(i, n)| (*n, i)).collect();
         for n in sorted {
             let decl = self.consts[n].decl;
@@ -334,40 +316,10 @@ impl<'a> Checker<'a> {
                     Err(_) => {}
                 }
             }
-            if let Some(o) = overridden.get(n) {
-                match parse_value(&o.value) {
-                    Some(v) => {
-                        let vty = match v {
-                            Value::Num(_) => Ty::Num,
-                            Value::Bool(_) => Ty::Bool,
-                        };
-                        if ty != Ty::Err && vty != ty {
-                            self.diags.push(
-                                Diagnostic::error(
-                                    Code::BadOverride,
-                                    format!(
-                                        "`-D {}={}` gives {} a value of the wrong kind",
-                                        o.name, o.value, o.name
-                                    ),
-                                )
-                                .secondary(
-                                    decl.value.span,
-                                    "the constant is defined here with a value of another kind",
-                                ),
-                            );
-                        } else {
-                            value = Some(v);
-                            random = false;
-                        }
-                    }
-                    None => self.diags.push(
-                        Diagnostic::error(
-                            Code::BadOverride,
-                            format!("`-D {}={}`: `{}` is not a number", o.name, o.value, o.value),
-                        )
-                        .help("write the value as a number, e.g. `-D N=7` or `-D angle=22.5`"),
-                    ),
-                }
+            if let Some(o) = overridden.get(n)
+                && let Some(v) = self.override_value(o, ty, decl.value.span)
+            {
+                (value, random) = (Some(v), false);
             }
             if let Some(info) = self.consts.get_mut(n) {
                 info.ty = ty;
@@ -375,6 +327,65 @@ impl<'a> Checker<'a> {
                 info.random = random;
             }
         }
+    }
+
+    /// `-D` overrides that name no constant of the program.
+    fn unknown_overrides(&mut self, overrides: &[Override]) {
+        for o in overrides {
+            if !self.consts.contains_key(o.name.as_str()) {
+                let mut d = Diagnostic::error(
+                    Code::BadOverride,
+                    format!("`-D {}`: the program has no constant `{}`", o.name, o.name),
+                );
+                let names: Vec<&str> = self.consts.keys().copied().collect();
+                if let Some(s) = suggest(&o.name, names.iter().copied()) {
+                    d = d.help(format!("did you mean `{s}`?"));
+                } else if names.is_empty() {
+                    d = d.note("the program declares no constants; add `const NAME = VALUE;` to make a value overridable");
+                } else {
+                    let mut names = names;
+                    names.sort_unstable();
+                    d = d.note(format!("its constants are: {}", names.join(", ")));
+                }
+                self.diags.push(d);
+            }
+        }
+    }
+
+    /// The value a `-D` override gives a constant of type `ty` (defined at
+    /// `def`), or `None` (reported) if it is not a value of that kind.
+    fn override_value(&mut self, o: &Override, ty: Ty, def: Span) -> Option<Value> {
+        let Some(v) = parse_value(&o.value) else {
+            self.diags.push(
+                Diagnostic::error(
+                    Code::BadOverride,
+                    format!("`-D {}={}`: `{}` is not a number", o.name, o.value, o.value),
+                )
+                .help("write the value as a number, e.g. `-D N=7` or `-D angle=22.5`"),
+            );
+            return None;
+        };
+        let vty = match v {
+            Value::Num(_) => Ty::Num,
+            Value::Bool(_) => Ty::Bool,
+        };
+        if ty != Ty::Err && vty != ty {
+            self.diags.push(
+                Diagnostic::error(
+                    Code::BadOverride,
+                    format!(
+                        "`-D {}={}` gives {} a value of the wrong kind",
+                        o.name, o.value, o.name
+                    ),
+                )
+                .secondary(
+                    def,
+                    "the constant is defined here with a value of another kind",
+                ),
+            );
+            return None;
+        }
+        Some(v)
     }
 
     /// The constants in an order where each comes after those it uses (a
