@@ -176,6 +176,7 @@ fn a_million_nested_brackets() {
         "]".repeat(n)
     );
     generated("brackets.lsy", &text, &["run"], None);
+    generated("brackets.lsy", &text, &["fmt"], None);
 }
 
 #[test]
