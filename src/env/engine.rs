@@ -1,14 +1,18 @@
 //! Running a scene: the Open L-system loop over every seeded system, tokens
 //! that are reserved, used or released, messages, and the incremental rerun.
 //!
-//! Owns: grouping guides into *units* (guides that reach each other through
-//! links with tokens; a unit runs as one), running units in link order so that
-//! every unit knows the messages it receives, the derive → interpret → answer
-//! loop of one unit, the token states of Guided Procedural Modeling §3.3.2,
-//! and the cache of unit results keyed on everything a unit reads (its
-//! guides' polygons, programs, seeds and links, and its incoming messages),
-//! so that `Runner::run` after an edit recomputes only the changed guides and
-//! those downstream of them whose incoming messages changed.
+//! Owns: the entry `run` and what a run produces (`Instance`, `Outcome`,
+//! `GuideRun`, `Message`, `TokenEvent`); grouping guides into *units* (guides
+//! that reach each other through links with tokens; a unit runs as one),
+//! running units in link order so that every unit knows the messages it
+//! receives, the derive → interpret → answer loop of one unit, the token
+//! states of Guided Procedural Modeling §3.3.2, and the cache of unit results
+//! keyed on everything a unit reads (its guides' polygons, programs, seeds and
+//! links, and its incoming messages), so that `Runner::run` after an edit
+//! recomputes only the changed guides and those downstream of them whose
+//! incoming messages changed. Must not build scenes (`scene`), compute a query
+//! answer itself (`query`) or clip drawings (`clip`); nothing else in `env`
+//! imports it.
 //!
 //! One step of a unit, for step t ≥ 1:
 //! 1. every system with steps left derives once;
@@ -26,17 +30,75 @@
 //! Seeds start at step 0 (answered before the first derivation). A unit ends
 //! when none of its systems derives and no message is still to come.
 
-use super::geometry::{closest_on_segment, crossing};
 use super::index::{Grid, Layers};
-use super::scene::{Answer, Instance, Outcome, Probe, Scene, collide, query, seed_state};
+use super::query::{Answer, Probe, collide, query};
+use super::scene::{Link, Scene, seed_state};
 use crate::derive::{self, Limits, ModString};
 use crate::diagnostic::Diagnostic;
+use crate::geometry::{closest_on_segment, crossing};
 use crate::query::{QUERIES, QueryKind};
 use crate::turtle;
 use crate::turtle::State;
 use glam::DVec2;
 use rayon::prelude::*;
 use std::collections::HashMap;
+
+/// The most derivation steps a scene runs, whatever its systems say.
+pub const MAX_SCENE_STEPS: u32 = 100_000;
+
+/// One running L-system: a seed in a guide and its string.
+#[derive(Clone)]
+pub struct Instance {
+    pub guide: usize,
+    pub start: State,
+    pub string: ModString,
+    pub steps: u32,
+}
+
+/// What a scene run produced.
+pub struct Outcome {
+    pub instances: Vec<Instance>,
+    pub steps: u32,
+    pub queries: u64,
+    pub messages: u64,
+    /// Per guide: its messages, token events and counts (its systems are in
+    /// `instances`, not repeated here).
+    pub guides: Vec<GuideRun>,
+}
+
+/// Runs a scene to the end: until no system is still deriving (see
+/// the module note for the order of events). The links' `used` counts are filled in.
+pub fn run(
+    scene: &mut Scene,
+    seed: u64,
+    limits: Limits,
+    max_steps: Option<u32>,
+) -> Result<Outcome, Diagnostic> {
+    let cfg = Config {
+        seed,
+        limits,
+        cap: max_steps.unwrap_or(MAX_SCENE_STEPS).min(MAX_SCENE_STEPS),
+    };
+    let (out, _) = execute(scene, cfg, &[], &mut Cache::default())?;
+    out.count_used(&mut scene.links);
+    Ok(out)
+}
+
+impl Outcome {
+    /// Writes into each link how many of its tokens were used.
+    pub fn count_used(&self, links: &mut [Link]) {
+        for l in links.iter_mut() {
+            l.used = 0;
+        }
+        for e in self.guides.iter().flat_map(|g| &g.tokens) {
+            if e.token == Token::Used
+                && let Some(l) = links.get_mut(e.link)
+            {
+                l.used += 1;
+            }
+        }
+    }
+}
 
 /// A message over a link, sent at `step` by guide `from_guide`.
 #[derive(Clone, Debug, PartialEq)]
