@@ -6,7 +6,7 @@
 //! answer queries or draw: those read the model (`engine`, `query`, `clip`)
 //! and this module imports nothing else from `env`.
 
-use crate::ast::{File, GuideStmt, Item, LinkStmt, SceneStmt};
+use crate::ast::{self, File, GuideStmt, Item, LinkStmt, SceneStmt};
 use crate::check::Checked;
 use crate::compile::{self, CompileError, Program};
 use crate::diagnostic::{Code, Diagnostic};
@@ -46,7 +46,7 @@ pub struct Scene {
 }
 
 /// every one it cannot compute, so a checked file has them all).
-fn value(e: &crate::ast::Expr, checked: &Checked) -> f64 {
+fn value(e: &ast::Expr, checked: &Checked) -> f64 {
     checked.value_of(e).unwrap_or(0.0)
 }
 
@@ -79,7 +79,20 @@ impl SceneError {
 
 /// Builds the scene called `name` (or the first) of a checked file.
 pub fn build(file: &File, checked: &Checked, name: Option<&str>) -> Result<Scene, SceneError> {
-    let scenes: Vec<&crate::ast::Scene> = file
+    let scene = pick(file, name)?;
+    let (guides, programs, index) = guides(file, checked, scene)?;
+    let links = links(checked, scene, &index)?;
+    Ok(Scene {
+        name: scene.name.name.clone(),
+        guides,
+        links,
+        programs,
+    })
+}
+
+/// The scene called `name` of a file, or its first.
+fn pick<'a>(file: &'a File, name: Option<&str>) -> Result<&'a ast::Scene, SceneError> {
+    let scenes: Vec<&ast::Scene> = file
         .items
         .stmts
         .iter()
@@ -88,14 +101,22 @@ pub fn build(file: &File, checked: &Checked, name: Option<&str>) -> Result<Scene
             _ => None,
         })
         .collect();
-    let scene = match name {
+    match name {
         Some(n) => scenes
             .iter()
             .find(|s| s.name.name == n)
             .copied()
-            .ok_or_else(|| SceneError::UnknownScene(n.to_string()))?,
-        None => *scenes.first().ok_or(SceneError::NoScene)?,
-    };
+            .ok_or_else(|| SceneError::UnknownScene(n.to_string())),
+        None => scenes.first().copied().ok_or(SceneError::NoScene),
+    }
+}
+
+/// A scene's guides in order, the programs of their systems (each system
+/// compiled once) and the guides' indices by name.
+type Guides = (Vec<Guide>, Vec<Program>, HashMap<String, usize>);
+
+/// The guides of a scene, with their compiled systems.
+fn guides(file: &File, checked: &Checked, scene: &ast::Scene) -> Result<Guides, SceneError> {
     let mut programs: Vec<Program> = Vec::new();
     let mut by_system: HashMap<String, usize> = HashMap::new();
     let mut guides = Vec::new();
@@ -104,26 +125,7 @@ pub fn build(file: &File, checked: &Checked, name: Option<&str>) -> Result<Scene
         let SceneStmt::Guide(g) = &st.node else {
             continue;
         };
-        let mut polygon = Vec::new();
-        let mut system = None;
-        let mut seeds = Vec::new();
-        for gs in &g.body.stmts {
-            match &gs.node {
-                GuideStmt::Polygon(pts) => {
-                    polygon = pts
-                        .iter()
-                        .map(|p| DVec2::new(value(&p.x, checked), value(&p.y, checked)))
-                        .collect();
-                }
-                GuideStmt::System(s) => system = Some(s.name.clone()),
-                GuideStmt::Seed(s) => seeds.push(Seed {
-                    at: DVec2::new(value(&s.at.x, checked), value(&s.at.y, checked)),
-                    heading: s.heading.as_ref().map_or(0.0, |h| value(h, checked)),
-                    args: s.args.iter().flatten().map(|a| value(a, checked)).collect(),
-                }),
-                GuideStmt::Error => {}
-            }
-        }
+        let (polygon, system, seeds) = guide_settings(g, checked);
         let system = system.ok_or_else(|| SceneError::NoSystem(g.name.name.clone()))?;
         let program = match by_system.get(&system) {
             Some(&p) => p,
@@ -141,12 +143,46 @@ pub fn build(file: &File, checked: &Checked, name: Option<&str>) -> Result<Scene
             seeds,
         });
     }
+    Ok((guides, programs, index))
+}
+
+/// A guide's polygon, the name of its system (the last given) and its seeds.
+fn guide_settings(g: &ast::Guide, checked: &Checked) -> (Vec<DVec2>, Option<String>, Vec<Seed>) {
+    let mut polygon = Vec::new();
+    let mut system = None;
+    let mut seeds = Vec::new();
+    for gs in &g.body.stmts {
+        match &gs.node {
+            GuideStmt::Polygon(pts) => {
+                polygon = pts
+                    .iter()
+                    .map(|p| DVec2::new(value(&p.x, checked), value(&p.y, checked)))
+                    .collect();
+            }
+            GuideStmt::System(s) => system = Some(s.name.clone()),
+            GuideStmt::Seed(s) => seeds.push(Seed {
+                at: DVec2::new(value(&s.at.x, checked), value(&s.at.y, checked)),
+                heading: s.heading.as_ref().map_or(0.0, |h| value(h, checked)),
+                args: s.args.iter().flatten().map(|a| value(a, checked)).collect(),
+            }),
+            GuideStmt::Error => {}
+        }
+    }
+    (polygon, system, seeds)
+}
+
+/// The links of a scene, between the guides of `index`.
+fn links(
+    checked: &Checked,
+    scene: &ast::Scene,
+    index: &HashMap<String, usize>,
+) -> Result<Vec<Link>, SceneError> {
     let mut links = Vec::new();
     for st in &scene.body.stmts {
         let SceneStmt::Link(l) = &st.node else {
             continue;
         };
-        let end = |r: &crate::ast::EdgeRef| -> Result<(usize, usize), SceneError> {
+        let end = |r: &ast::EdgeRef| -> Result<(usize, usize), SceneError> {
             let g = *index
                 .get(&r.guide.name)
                 .ok_or_else(|| SceneError::UnknownGuide(r.guide.name.clone()))?;
@@ -168,12 +204,7 @@ pub fn build(file: &File, checked: &Checked, name: Option<&str>) -> Result<Scene
             heading,
         });
     }
-    Ok(Scene {
-        name: scene.name.name.clone(),
-        guides,
-        links,
-        programs,
-    })
+    Ok(links)
 }
 
 /// The turtle state of a seed: at its point, heading rotated `deg` from +y.
