@@ -66,8 +66,9 @@ pub struct Outcome {
     pub guides: Vec<GuideRun>,
 }
 
-/// Runs a scene to the end: until no system is still deriving (see
-/// the module note for the order of events). The links' `used` counts are filled in.
+/// Runs a scene to the end: until no system is still deriving (see the
+/// module note for the order of events). The links' `used` counts are filled
+/// in.
 pub fn run(
     scene: &mut Scene,
     seed: u64,
@@ -773,6 +774,7 @@ fn answer(
         .collect();
     for (li, k, (answers, crossings)) in answered {
         let l = &mut live[li];
+        // A system that will not draw again makes no reservation.
         if write_answers(scene, l, k, answers) {
             reserve(scene, l, k, crossings, used, t);
         }

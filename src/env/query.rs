@@ -36,11 +36,12 @@ impl Sink for Probe {
     }
 }
 
+/// The edges of a polygon: (index, start, end), the last closing it.
 fn edges(poly: &[DVec2]) -> impl Iterator<Item = (usize, DVec2, DVec2)> + '_ {
     (0..poly.len()).map(move |i| (i, poly[i], poly[(i + 1) % poly.len()]))
 }
 
-/// Runs a scene to the end: until no system is still deriving (see
+/// The outputs of one query module (at most four numbers).
 #[derive(Clone, Copy)]
 pub(crate) struct Answer {
     values: [f64; 4],

@@ -45,6 +45,7 @@ pub struct Scene {
     pub programs: Vec<Program>,
 }
 
+/// The value the checker computed for an expression of the scene (it reports
 /// every one it cannot compute, so a checked file has them all).
 fn value(e: &ast::Expr, checked: &Checked) -> f64 {
     checked.value_of(e).unwrap_or(0.0)
