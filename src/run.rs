@@ -298,7 +298,7 @@ fn program_centres(scene: &crate::env::scene::Scene) -> Vec<Vec<glam::DVec2>> {
     scene
         .programs
         .iter()
-        .map(crate::env::scene::element_centres)
+        .map(crate::env::clip::element_centres)
         .collect()
 }
 
@@ -315,8 +315,7 @@ fn draw_scene(
         let prog = &r.scene.programs[g.program];
         for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
             // Counts and bounds of what the centre rule keeps.
-            let mut clip =
-                crate::env::scene::Clip::new(&g.polygon, &centres[g.program], &mut *sink);
+            let mut clip = crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut *sink);
             turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
                 .map_err(|e| e.diagnostic(prog))?;
             let d = clip.kept;
@@ -449,7 +448,7 @@ fn scene_svg(
         w.begin_guide(names[gi]);
         let prog = &r.scene.programs[g.program];
         for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
-            let mut clip = crate::env::scene::Clip::new(&g.polygon, &centres[g.program], &mut w);
+            let mut clip = crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut w);
             turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
                 .map_err(|e| OutputError::Diagnostic(e.diagnostic(prog)))?;
         }

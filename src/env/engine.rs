@@ -1,14 +1,18 @@
 //! Running a scene: the Open L-system loop over every seeded system, tokens
 //! that are reserved, used or released, messages, and the incremental rerun.
 //!
-//! Owns: grouping guides into *units* (guides that reach each other through
-//! links with tokens; a unit runs as one), running units in link order so that
-//! every unit knows the messages it receives, the derive → interpret → answer
-//! loop of one unit, the token states of Guided Procedural Modeling §3.3.2,
-//! and the cache of unit results keyed on everything a unit reads (its
-//! guides' polygons, programs, seeds and links, and its incoming messages),
-//! so that `Runner::run` after an edit recomputes only the changed guides and
-//! those downstream of them whose incoming messages changed.
+//! Owns: the entry `run` and what a run produces (`Instance`, `Outcome`,
+//! `GuideRun`, `Message`, `TokenEvent`); grouping guides into *units* (guides
+//! that reach each other through links with tokens; a unit runs as one),
+//! running units in link order so that every unit knows the messages it
+//! receives, the derive → interpret → answer loop of one unit, the token
+//! states of Guided Procedural Modeling §3.3.2, and the cache of unit results
+//! keyed on everything a unit reads (its guides' polygons, programs, seeds and
+//! links, and its incoming messages), so that `Runner::run` after an edit
+//! recomputes only the changed guides and those downstream of them whose
+//! incoming messages changed. Must not build scenes (`scene`), compute a query
+//! answer itself (`query`) or clip drawings (`clip`); nothing else in `env`
+//! imports it.
 //!
 //! One step of a unit, for step t ≥ 1:
 //! 1. every system with steps left derives once;
@@ -26,17 +30,76 @@
 //! Seeds start at step 0 (answered before the first derivation). A unit ends
 //! when none of its systems derives and no message is still to come.
 
-use super::geometry::{closest_on_segment, crossing};
 use super::index::{Grid, Layers};
-use super::scene::{Answer, Instance, Outcome, Probe, Scene, collide, query, seed_state};
+use super::query::{Answer, Probe, collide, query};
+use super::scene::{Link, Scene, seed_state};
 use crate::derive::{self, Limits, ModString};
 use crate::diagnostic::Diagnostic;
+use crate::geometry::{closest_on_segment, crossing};
 use crate::query::{QUERIES, QueryKind};
 use crate::turtle;
 use crate::turtle::State;
 use glam::DVec2;
 use rayon::prelude::*;
 use std::collections::HashMap;
+
+/// The most derivation steps a scene runs, whatever its systems say.
+pub const MAX_SCENE_STEPS: u32 = 100_000;
+
+/// One running L-system: a seed in a guide and its string.
+#[derive(Clone)]
+pub struct Instance {
+    pub guide: usize,
+    pub start: State,
+    pub string: ModString,
+    pub steps: u32,
+}
+
+/// What a scene run produced.
+pub struct Outcome {
+    pub instances: Vec<Instance>,
+    pub steps: u32,
+    pub queries: u64,
+    pub messages: u64,
+    /// Per guide: its messages, token events and counts (its systems are in
+    /// `instances`, not repeated here).
+    pub guides: Vec<GuideRun>,
+}
+
+/// Runs a scene to the end: until no system is still deriving (see the
+/// module note for the order of events). The links' `used` counts are filled
+/// in.
+pub fn run(
+    scene: &mut Scene,
+    seed: u64,
+    limits: Limits,
+    max_steps: Option<u32>,
+) -> Result<Outcome, Diagnostic> {
+    let cfg = Config {
+        seed,
+        limits,
+        cap: max_steps.unwrap_or(MAX_SCENE_STEPS).min(MAX_SCENE_STEPS),
+    };
+    let (out, _) = execute(scene, cfg, &[], &mut Cache::default())?;
+    out.count_used(&mut scene.links);
+    Ok(out)
+}
+
+impl Outcome {
+    /// Writes into each link how many of its tokens were used.
+    pub fn count_used(&self, links: &mut [Link]) {
+        for l in links.iter_mut() {
+            l.used = 0;
+        }
+        for e in self.guides.iter().flat_map(|g| &g.tokens) {
+            if e.token == Token::Used
+                && let Some(l) = links.get_mut(e.link)
+            {
+                l.used += 1;
+            }
+        }
+    }
+}
 
 /// A message over a link, sent at `step` by guide `from_guide`.
 #[derive(Clone, Debug, PartialEq)]
@@ -209,27 +272,7 @@ pub fn execute(
 ) -> Result<(Outcome, Vec<bool>), Diagnostic> {
     let n = scene.guides.len();
     let units = units(scene);
-    // Levels: a unit runs after every unit that sends it messages; the units
-    // of one level run in parallel.
-    let mut unit_of = vec![0; n];
-    for (u, members) in units.iter().enumerate() {
-        for &g in members {
-            unit_of[g] = u;
-        }
-    }
-    let mut level = vec![0usize; units.len()];
-    for u in 0..units.len() {
-        for l in scene
-            .links
-            .iter()
-            .filter(|l| l.tokens > 0 && l.from.0 < n && l.to.0 < n)
-        {
-            let (a, b) = (unit_of[l.from.0], unit_of[l.to.0]);
-            if b == u && a != u {
-                level[u] = level[u].max(level[a] + 1);
-            }
-        }
-    }
+    let (unit_of, level) = levels(scene, &units);
     let mut sent: Vec<Vec<Message>> = vec![Vec::new(); n];
     let mut fresh = vec![false; n];
     let mut keep = HashMap::new();
@@ -237,17 +280,7 @@ pub fn execute(
     for lv in 0..=top {
         let mut jobs = Vec::new();
         for (u, unit) in units.iter().enumerate().filter(|(u, _)| level[*u] == lv) {
-            // Messages into this unit from the units before it.
-            let mut inbox: Vec<Message> = scene
-                .links
-                .iter()
-                .enumerate()
-                .filter(|(_, l)| {
-                    l.to.0 < n && unit_of[l.to.0] == u && l.from.0 < n && unit_of[l.from.0] != u
-                })
-                .flat_map(|(li, l)| sent[l.from.0].iter().filter(move |m| m.link == li).cloned())
-                .collect();
-            inbox.sort_by_key(|m| (m.step, m.from_guide, m.seq));
+            let inbox = inbox(scene, &unit_of, u, &sent);
             let key = unit_key(scene, cfg, revs, unit, &inbox);
             let cached = match cache.units.remove(unit) {
                 Some((k, r)) if k == key => Some(r),
@@ -271,8 +304,58 @@ pub fn execute(
             keep.insert(unit.clone(), (key, result));
         }
     }
+    let out = outcome(n, &keep);
+    cache.units = keep;
+    Ok((out, fresh))
+}
+
+/// Per guide its unit, and per unit its level: a unit runs after every unit
+/// that sends it messages; the units of one level run in parallel.
+fn levels(scene: &Scene, units: &[Vec<usize>]) -> (Vec<usize>, Vec<usize>) {
+    let n = scene.guides.len();
+    let mut unit_of = vec![0; n];
+    for (u, members) in units.iter().enumerate() {
+        for &g in members {
+            unit_of[g] = u;
+        }
+    }
+    let mut level = vec![0usize; units.len()];
+    for u in 0..units.len() {
+        for l in scene
+            .links
+            .iter()
+            .filter(|l| l.tokens > 0 && l.from.0 < n && l.to.0 < n)
+        {
+            let (a, b) = (unit_of[l.from.0], unit_of[l.to.0]);
+            if b == u && a != u {
+                level[u] = level[u].max(level[a] + 1);
+            }
+        }
+    }
+    (unit_of, level)
+}
+
+/// The messages into unit `u` from the units before it (`sent`, per guide),
+/// by step, sending guide and sending order.
+fn inbox(scene: &Scene, unit_of: &[usize], u: usize, sent: &[Vec<Message>]) -> Vec<Message> {
+    let n = scene.guides.len();
+    let mut inbox: Vec<Message> = scene
+        .links
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| {
+            l.to.0 < n && unit_of[l.to.0] == u && l.from.0 < n && unit_of[l.from.0] != u
+        })
+        .flat_map(|(li, l)| sent[l.from.0].iter().filter(move |m| m.link == li).cloned())
+        .collect();
+    inbox.sort_by_key(|m| (m.step, m.from_guide, m.seq));
+    inbox
+}
+
+/// The outcome of a run from the results of its units, in guide order.
+fn outcome(n: usize, keep: &HashMap<Vec<usize>, (Vec<u64>, Vec<GuideRun>)>) -> Outcome {
     let mut runs: Vec<Option<&GuideRun>> = vec![None; n];
-    for (unit, (_, result)) in &keep {
+    for (unit, (_, result)) in keep {
         for (&g, r) in unit.iter().zip(result) {
             runs[g] = Some(r);
         }
@@ -296,8 +379,7 @@ pub fn execute(
             ..*r
         });
     }
-    cache.units = keep;
-    Ok((out, fresh))
+    out
 }
 
 /// Everything a unit's run reads, as numbers: equal keys, equal results.
@@ -368,6 +450,41 @@ fn run_unit(
     unit: &[usize],
     inbox: &[Message],
 ) -> Result<Vec<GuideRun>, Diagnostic> {
+    let mut live = start(scene, cfg, unit)?;
+    let mut used = vec![0u32; scene.links.len()];
+    answer(scene, cfg, &mut live, &used, 0)?;
+    let mut next = 0; // the first message of `inbox` not yet delivered
+    let mut t = 1;
+    while t <= cfg.cap {
+        let any = derive_all(scene, cfg, &mut live, t)?;
+        if !any {
+            // Idle: wait for the next message from outside, if any.
+            match inbox.get(next) {
+                None => break,
+                Some(m) if m.step > t => {
+                    t = m.step;
+                    continue;
+                }
+                Some(_) => {}
+            }
+        }
+        interpret(scene, cfg, &mut live)?;
+        let mut outgoing = Vec::new();
+        for l in &mut live {
+            settle(scene, l, &mut used, t, &mut outgoing);
+        }
+        for m in &arriving(scene, unit, inbox, &mut next, outgoing, t) {
+            deliver(scene, cfg, unit, &mut live, m)?;
+        }
+        answer(scene, cfg, &mut live, &used, t)?;
+        t += 1;
+    }
+    release_all(&mut live, t.min(cfg.cap));
+    Ok(live.into_iter().map(|l| l.run).collect())
+}
+
+/// The guides of a unit with their explicit seeds' systems.
+fn start(scene: &Scene, cfg: Config, unit: &[usize]) -> Result<Vec<Live>, Diagnostic> {
     let mut live: Vec<Live> = Vec::with_capacity(unit.len());
     for &g in unit {
         let guide = &scene.guides[g];
@@ -391,54 +508,42 @@ fn run_unit(
         }
         live.push(l);
     }
-    let mut used = vec![0u32; scene.links.len()];
-    answer(scene, cfg, &mut live, &used, 0)?;
-    let mut next = 0; // the first message of `inbox` not yet delivered
-    let mut t = 1;
-    while t <= cfg.cap {
-        let any = derive_all(scene, cfg, &mut live, t)?;
-        if !any {
-            // Idle: wait for the next message from outside, if any.
-            match inbox.get(next) {
-                None => break,
-                Some(m) if m.step > t => {
-                    t = m.step;
-                    continue;
-                }
-                Some(_) => {}
-            }
+    Ok(live)
+}
+
+/// This step's messages into the unit: from outside (`inbox` from `next`
+/// on, which moves past them), then from inside (`outgoing`), ordered by
+/// sending guide and sending order.
+fn arriving(
+    scene: &Scene,
+    unit: &[usize],
+    inbox: &[Message],
+    next: &mut usize,
+    outgoing: Vec<Message>,
+    t: u32,
+) -> Vec<Message> {
+    let mut arriving: Vec<Message> = Vec::new();
+    while *next < inbox.len() && inbox[*next].step <= t {
+        if inbox[*next].step == t {
+            arriving.push(inbox[*next].clone());
         }
-        interpret(scene, cfg, &mut live)?;
-        let mut outgoing = Vec::new();
-        for l in &mut live {
-            settle(scene, l, &mut used, t, &mut outgoing);
-        }
-        // This step's messages into the unit: from outside, then from inside,
-        // ordered by sending guide and sending order.
-        let mut arriving: Vec<Message> = Vec::new();
-        while next < inbox.len() && inbox[next].step <= t {
-            if inbox[next].step == t {
-                arriving.push(inbox[next].clone());
-            }
-            next += 1;
-        }
-        arriving.extend(
-            outgoing
-                .into_iter()
-                .filter(|m| unit.binary_search(&scene.links[m.link].to.0).is_ok()),
-        );
-        arriving.sort_by_key(|m| (m.from_guide, m.seq));
-        for m in &arriving {
-            deliver(scene, cfg, unit, &mut live, m)?;
-        }
-        answer(scene, cfg, &mut live, &used, t)?;
-        t += 1;
+        *next += 1;
     }
-    // Reservations nobody will settle: the tokens are free again.
-    for l in &mut live {
+    arriving.extend(
+        outgoing
+            .into_iter()
+            .filter(|m| unit.binary_search(&scene.links[m.link].to.0).is_ok()),
+    );
+    arriving.sort_by_key(|m| (m.from_guide, m.seq));
+    arriving
+}
+
+/// Reservations nobody will settle: the tokens are free again at `step`.
+fn release_all(live: &mut [Live], step: u32) {
+    for l in live {
         for r in std::mem::take(&mut l.reserved) {
             l.run.tokens.push(TokenEvent {
-                step: t.min(cfg.cap),
+                step,
                 link: r.link,
                 token: Token::Released,
                 instance: r.instance,
@@ -446,7 +551,6 @@ fn run_unit(
             });
         }
     }
-    Ok(live.into_iter().map(|l| l.run).collect())
 }
 
 impl Live {
@@ -657,10 +761,33 @@ fn answer(
     t: u32,
 ) -> Result<(), Diagnostic> {
     interpret(scene, cfg, live)?;
-    let _ = t;
-    // Per guide: the grids of its systems' drawings, ids running on.
-    let layers: Vec<Layers> = live
-        .iter()
+    let layers = layers(live);
+    let answered: Vec<(usize, usize, Answers)> = fresh_drawings(live)
+        .into_par_iter()
+        .map(|(li, k, drawing)| {
+            (
+                li,
+                k,
+                answer_system(scene, &live[li], &layers[li], k, drawing),
+            )
+        })
+        .collect();
+    for (li, k, (answers, crossings)) in answered {
+        let l = &mut live[li];
+        // A system that will not draw again makes no reservation.
+        if write_answers(scene, l, k, answers) {
+            reserve(scene, l, k, crossings, used, t);
+        }
+    }
+    for l in live.iter_mut() {
+        l.fresh.iter_mut().for_each(|f| *f = false);
+    }
+    Ok(())
+}
+
+/// Per guide: the grids of its systems' drawings, ids running on.
+fn layers(live: &[Live]) -> Vec<Layers<'_>> {
+    live.iter()
         .map(|l| {
             let mut off = 0;
             let mut parts = Vec::with_capacity(l.probes.len());
@@ -670,8 +797,12 @@ fn answer(
             }
             Layers { parts }
         })
-        .collect();
-    type Answered = (usize, usize, Vec<(usize, usize, Answer)>, Vec<Crossing>);
+        .collect()
+}
+
+/// The drawings of the fresh systems that met query modules: (guide in the
+/// unit, system in the guide, drawing).
+fn fresh_drawings(live: &[Live]) -> Vec<(usize, usize, &Drawing)> {
     let mut jobs = Vec::new();
     for (li, l) in live.iter().enumerate() {
         for (k, (p, &f)) in l.probes.iter().zip(&l.fresh).enumerate() {
@@ -682,100 +813,109 @@ fn answer(
             }
         }
     }
-    let answered: Vec<Answered> = jobs
-        .into_par_iter()
-        .map(|(li, k, probe)| {
-            let l = &live[li];
-            let gi = l.guide;
-            let inst = &l.run.instances[k];
-            let prog = &scene.programs[scene.guides[gi].program];
-            let offsets = param_offsets(prog, &inst.string);
-            let grid = Some(&layers[li]);
-            let mut answers = Vec::with_capacity(probe.queries.len());
-            let mut crossings = Vec::new();
-            for &(module, kind, state) in &probe.queries {
-                let q = &QUERIES[kind as usize];
-                let at = offsets[module] as usize;
-                let arity = prog.symbols.arity(inst.string.syms[module]);
-                let own = &inst.string.params[at..at + arity];
-                let ans = match q.kind {
-                    QueryKind::Collision => {
-                        let delta = own.get(q.outputs.len()).copied().unwrap_or(0.0);
-                        let (ans, edge) = collide(scene, grid, gi, &state, delta);
-                        if let Some(edge) = edge {
-                            crossings.push(Crossing {
-                                module,
-                                edge,
-                                from: state.pos.truncate(),
-                                dir: state.h.truncate().normalize_or_zero(),
-                                pass: own
-                                    .get(q.outputs.len()..)
-                                    .map_or(Vec::new(), <[f64]>::to_vec),
-                            });
-                        }
-                        ans
-                    }
-                    kind => query(scene, grid, gi, kind, &state),
-                };
-                answers.push((at, arity, ans));
+    jobs
+}
+
+/// A system's answers, each with where its parameters start and how many
+/// they are, and the `?X` that would cross a guide edge.
+type Answers = (Vec<(usize, usize, Answer)>, Vec<Crossing>);
+
+/// Answers every query module that system `k` of guide `l` met in `drawing`.
+fn answer_system(scene: &Scene, l: &Live, layers: &Layers, k: usize, drawing: &Drawing) -> Answers {
+    let gi = l.guide;
+    let inst = &l.run.instances[k];
+    let prog = &scene.programs[scene.guides[gi].program];
+    let offsets = param_offsets(prog, &inst.string);
+    let grid = Some(layers);
+    let mut answers = Vec::with_capacity(drawing.queries.len());
+    let mut crossings = Vec::new();
+    for &(module, kind, state) in &drawing.queries {
+        let q = &QUERIES[kind as usize];
+        let at = offsets[module] as usize;
+        let arity = prog.symbols.arity(inst.string.syms[module]);
+        let own = &inst.string.params[at..at + arity];
+        let ans = match q.kind {
+            QueryKind::Collision => {
+                let delta = own.get(q.outputs.len()).copied().unwrap_or(0.0);
+                let (ans, edge) = collide(scene, grid, gi, &state, delta);
+                if let Some(edge) = edge {
+                    crossings.push(Crossing {
+                        module,
+                        edge,
+                        from: state.pos.truncate(),
+                        dir: state.h.truncate().normalize_or_zero(),
+                        pass: own
+                            .get(q.outputs.len()..)
+                            .map_or(Vec::new(), <[f64]>::to_vec),
+                    });
+                }
+                ans
             }
-            (li, k, answers, crossings)
-        })
-        .collect();
-    for (li, k, answers, crossings) in answered {
-        let l = &mut live[li];
-        let prog = &scene.programs[scene.guides[l.guide].program];
-        let inst = &mut l.run.instances[k];
-        l.run.queries += answers.len() as u64;
-        for (at, arity, ans) in answers {
-            for (slot, v) in inst.string.params[at..at + arity]
-                .iter_mut()
-                .zip(ans.values())
-            {
-                *slot = *v;
-            }
-        }
-        if queries_interpreted(prog) {
-            // Its drawing may read the answers: draw it again when needed.
-            l.probes[k] = None;
-        }
-        if inst.steps >= prog.derive {
-            continue; // it will not draw again: no reservation
-        }
-        for c in crossings {
-            // Every link that starts at the crossed edge and has a free token (an
-            // edge may fan out to several guides), in scene order.
-            let free: Vec<usize> = (0..scene.links.len())
-                .filter(|&i| {
-                    let link = &scene.links[i];
-                    link.from == (l.guide, c.edge)
-                        && used[i] as usize + l.reserved.iter().filter(|r| r.link == i).count()
-                            < link.tokens as usize
-                })
-                .collect();
-            for link in free {
-                l.run.tokens.push(TokenEvent {
-                    step: t,
-                    link,
-                    token: Token::Reserved,
-                    instance: k,
-                    module: c.module,
-                });
-                l.reserved.push(Reservation {
-                    link,
-                    instance: k,
-                    module: c.module,
-                    from: c.from,
-                    dir: c.dir,
-                    pass: c.pass.clone(),
-                });
-            }
+            kind => query(scene, grid, gi, kind, &state),
+        };
+        answers.push((at, arity, ans));
+    }
+    (answers, crossings)
+}
+
+/// Writes the answers into system `k`'s string (its drawing is dropped when
+/// it may read them); whether the system will draw again (and so may reserve).
+fn write_answers(
+    scene: &Scene,
+    l: &mut Live,
+    k: usize,
+    answers: Vec<(usize, usize, Answer)>,
+) -> bool {
+    let prog = &scene.programs[scene.guides[l.guide].program];
+    let inst = &mut l.run.instances[k];
+    l.run.queries += answers.len() as u64;
+    for (at, arity, ans) in answers {
+        for (slot, v) in inst.string.params[at..at + arity]
+            .iter_mut()
+            .zip(ans.values())
+        {
+            *slot = *v;
         }
     }
-    for l in live.iter_mut() {
-        l.fresh.iter_mut().for_each(|f| *f = false);
+    if queries_interpreted(prog) {
+        // Its drawing may read the answers: draw it again when needed.
+        l.probes[k] = None;
     }
-    Ok(())
+    inst.steps < prog.derive
+}
+
+/// Reserves, for each crossing of system `k`, a free token of every link
+/// that starts at the crossed edge.
+fn reserve(scene: &Scene, l: &mut Live, k: usize, crossings: Vec<Crossing>, used: &[u32], t: u32) {
+    for c in crossings {
+        // Every link that starts at the crossed edge and has a free token (an
+        // edge may fan out to several guides), in scene order.
+        let free: Vec<usize> = (0..scene.links.len())
+            .filter(|&i| {
+                let link = &scene.links[i];
+                link.from == (l.guide, c.edge)
+                    && used[i] as usize + l.reserved.iter().filter(|r| r.link == i).count()
+                        < link.tokens as usize
+            })
+            .collect();
+        for link in free {
+            l.run.tokens.push(TokenEvent {
+                step: t,
+                link,
+                token: Token::Reserved,
+                instance: k,
+                module: c.module,
+            });
+            l.reserved.push(Reservation {
+                link,
+                instance: k,
+                module: c.module,
+                from: c.from,
+                dir: c.dir,
+                pass: c.pass.clone(),
+            });
+        }
+    }
 }
 
 /// Whether module `sym` never changes: no rules, not a query, not `cut`.

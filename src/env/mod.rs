@@ -2,16 +2,30 @@
 //! links between guide edges that carry tokens and send messages, and the
 //! answers to query modules.
 //!
-//! Owns: building a runnable scene from a checked file (`scene::build`), the
-//! answers to queries and the centre rule that clips each guide's drawing
-//! (`scene`), the derive–interpret–answer loop of Měch & Prusinkiewicz (1996)
-//! over all active L-systems with token states, messages and incremental reruns
-//! (`engine`, run through `scene::run`), the spatial index of drawn segments
-//! (`index`), and geometry helpers. Must not parse or print programs.
+//! Files, each named for what it owns:
+//! - `scene` — the scene model (`Scene`, `Guide`, `Seed`, `Link`), building it
+//!   from a checked file (`build`, `SceneError`) and a seed's turtle
+//!   (`seed_state`);
+//! - `index` — the layers of segments drawn in a guide (`Grid`, `Layers`);
+//! - `query` — the answers to query modules (`Probe`, `Answer`, `query`,
+//!   `collide`);
+//! - `clip` — the centre rule (`Clip`, `element_centres`, `outline_centre`);
+//! - `engine` — the derive–interpret–answer loop of Měch & Prusinkiewicz
+//!   (1996) over all active L-systems with token states, messages and
+//!   incremental reruns (`execute`, `Runner`), and the entry `run`.
+//!
+//! Who may call whom (a DAG; an arrow reads "imports"): `engine` → `query`,
+//! `scene`, `index`; `query` → `scene`, `index`. `scene`, `index` and `clip`
+//! import nothing from `env`. Plane geometry comes from `crate::geometry`.
+//!
+//! Must not parse or print programs.
 
+pub mod clip;
 pub mod engine;
-pub mod geometry;
 pub mod index;
+pub mod query;
 pub mod scene;
 
-pub use scene::{Outcome, Scene, build, run};
+pub use clip::{Clip, element_centres, outline_centre};
+pub use engine::{Config, Instance, MAX_SCENE_STEPS, Outcome, Runner, run};
+pub use scene::{Guide, Scene, SceneError, build};

@@ -24,7 +24,7 @@ fn the_environment_and_the_crate_give_the_same_answers() {
     let square = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y].map(|p| p * 10.0);
     for p in points(200, 3) {
         let p = p * 0.15 - DVec2::splat(1.0);
-        assert_eq!(lsyc::env::geometry::inside(p, &square), inside(p, &square));
+        assert_eq!(lsyc::geometry::inside(p, &square), inside(p, &square));
     }
     assert_eq!(signed_area(&square), 100.0);
     assert_eq!(centroid(&square), DVec2::splat(5.0));
@@ -77,7 +77,7 @@ fn bad_path_data_is_one_error_with_a_place() {
     for d in ["M0 0 L10 x", "", "Z", "M"] {
         assert_eq!(lsyc::render::path_bounds(d), None, "{d}");
         assert_eq!(path::largest_outline(d), None, "{d}");
-        assert_eq!(lsyc::env::scene::outline_centre(d), DVec2::ZERO, "{d}");
+        assert_eq!(lsyc::env::clip::outline_centre(d), DVec2::ZERO, "{d}");
         assert_eq!(lsyc::render::obj::outline_from_path(d), None, "{d}");
     }
 }

@@ -3,8 +3,8 @@
 //! recomputes only changed guides and those downstream.
 
 use glam::{DVec2, DVec3};
-use lsyc::env::engine::{Config, Runner, Token, TokenEvent};
-use lsyc::env::scene::{MAX_SCENE_STEPS, Outcome, Scene};
+use lsyc::env::engine::{Config, MAX_SCENE_STEPS, Outcome, Runner, Token, TokenEvent};
+use lsyc::env::scene::Scene;
 use lsyc::frontend;
 
 fn build(text: &str) -> Scene {
@@ -324,10 +324,10 @@ fn the_urban_layout_fills_every_district_and_keeps_the_centre_rule() {
             let m = at + step * 0.5;
             let on_edge = (0..poly.len()).any(|i| {
                 let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
-                (lsyc::env::geometry::closest_on_segment(m, a, b) - m).length() < 0.02
+                (lsyc::geometry::closest_on_segment(m, a, b) - m).length() < 0.02
             });
             assert!(
-                lsyc::env::geometry::inside(m, poly) || on_edge,
+                lsyc::geometry::inside(m, poly) || on_edge,
                 "a segment of `{}` ends at {} with its middle {m} outside",
                 r.scene.guides[g].name,
                 at + step

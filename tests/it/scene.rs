@@ -3,9 +3,9 @@
 
 use crate::support::root;
 use glam::DVec2;
-use lsyc::env::geometry::{closest_on_segment, inside};
-use lsyc::env::scene::Instance;
+use lsyc::env::engine::Instance;
 use lsyc::frontend;
+use lsyc::geometry::{closest_on_segment, inside};
 use lsyc::run::{self, Options, SceneRun};
 use std::collections::HashMap;
 
@@ -307,7 +307,7 @@ fn read_layers(svg: &str) -> Layers {
         if line.starts_with("<path id=") {
             let id = attr(line, "id").expect("id").to_string();
             let d = attr(line, "d").expect("path data");
-            local.insert(id, lsyc::env::scene::outline_centre(d));
+            local.insert(id, lsyc::env::clip::outline_centre(d));
             continue;
         }
         if line.starts_with("<g class=\"guide-content\"") {
