@@ -274,6 +274,22 @@ pub struct SceneRun {
     pub scene: crate::env::Scene,
     pub outcome: crate::env::Outcome,
     pub derive_ms: f64,
+    /// The run's limits, which drawing honours too.
+    pub limits: Limits,
+}
+
+impl SceneRun {
+    /// Interprets one system of the scene into `sink`, within the run's limits.
+    fn interpret(
+        &self,
+        inst: &crate::env::Instance,
+        seed: u64,
+        sink: &mut dyn crate::turtle::Sink,
+    ) -> Result<Drawn, Diagnostic> {
+        let prog = &self.scene.programs[self.scene.guides[inst.guide].program];
+        turtle::interpret_limited(prog, &inst.string, seed, inst.start, self.limits, sink)
+            .map_err(|e| e.diagnostic(prog))
+    }
 }
 
 /// Builds and runs the scene called `name` (or the first one).
@@ -290,6 +306,7 @@ pub fn run_scene(
         scene,
         outcome,
         derive_ms: start.elapsed().as_secs_f64() * 1000.0,
+        limits: opts.limits,
     })
 }
 
@@ -312,12 +329,10 @@ fn draw_scene(
     let mut total = Drawn::default();
     let centres = program_centres(&r.scene);
     for (gi, g) in r.scene.guides.iter().enumerate() {
-        let prog = &r.scene.programs[g.program];
         for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
             // Counts and bounds of what the centre rule keeps.
             let mut clip = crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut *sink);
-            turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
-                .map_err(|e| e.diagnostic(prog))?;
+            r.interpret(inst, seed, &mut clip)?;
             let d = clip.kept;
             total.segments += d.segments;
             total.elements += d.elements;
@@ -446,11 +461,10 @@ fn scene_svg(
     let names: Vec<&str> = r.scene.guides.iter().map(|g| g.name.as_str()).collect();
     for (gi, g) in r.scene.guides.iter().enumerate() {
         w.begin_guide(names[gi]);
-        let prog = &r.scene.programs[g.program];
         for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
             let mut clip = crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut w);
-            turtle::interpret_from(prog, &inst.string, seed, inst.start, &mut clip)
-                .map_err(|e| OutputError::Diagnostic(e.diagnostic(prog)))?;
+            r.interpret(inst, seed, &mut clip)
+                .map_err(OutputError::Diagnostic)?;
         }
         w.end_guide();
     }

@@ -649,7 +649,7 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
         .map(|(inst, probe)| {
             let prog = &scene.programs[scene.guides[inst.guide].program];
             let mut p = Probe::default();
-            turtle::interpret_from(prog, &inst.string, cfg.seed, inst.start, &mut p)
+            turtle::interpret_limited(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut p)
                 .map_err(|e| e.diagnostic(prog))?;
             *probe = Some(Drawing {
                 grid: Grid::new(p.segments),

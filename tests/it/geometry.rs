@@ -20,11 +20,15 @@ fn points(n: usize, mut s: u64) -> Vec<DVec2> {
 }
 
 #[test]
-fn the_environment_and_the_crate_give_the_same_answers() {
+fn polygon_predicates_on_a_square() {
     let square = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y].map(|p| p * 10.0);
     for p in points(200, 3) {
         let p = p * 0.15 - DVec2::splat(1.0);
-        assert_eq!(lsyc::geometry::inside(p, &square), inside(p, &square));
+        // Away from the boundary the answer is plain; on it, the tolerance decides.
+        let margin = p.x.min(p.y).min(10.0 - p.x).min(10.0 - p.y);
+        if margin.abs() > 1e-6 {
+            assert_eq!(inside(p, &square), margin > 0.0, "{p}");
+        }
     }
     assert_eq!(signed_area(&square), 100.0);
     assert_eq!(centroid(&square), DVec2::splat(5.0));
