@@ -6,6 +6,7 @@ mod corpus;
 mod diagnostics;
 mod edit;
 mod guided;
+mod hostile_svg;
 mod infer;
 mod run;
 mod scene;
