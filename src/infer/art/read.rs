@@ -12,7 +12,7 @@
 use crate::infer::strokes::{self, Seg};
 use crate::infer::svg::{self, Refusal};
 use glam::DVec2;
-use usvg::tiny_skia_path::Transform;
+use usvg::tiny_skia_path::{PathVerb, Transform};
 
 /// Coordinates beyond this (in user units) are refused: usvg works in 32-bit
 /// floats, which cannot place such points precisely.
@@ -225,9 +225,18 @@ fn path_elements(
     if !path.is_visible() {
         return Ok(());
     }
-    // The path's own points are fewer than its flattened ones: too many is
-    // refused before its subpaths are built.
-    work.points(path.data().points().len())?;
+    // The path's own points are fewer than its flattened ones, and its
+    // moves count its subpaths: too many is refused before they are built.
+    let data = path.data();
+    work.points(data.points().len())?;
+    let moves = data
+        .verbs()
+        .iter()
+        .filter(|v| **v == PathVerb::Move)
+        .count();
+    if work.subpaths.saturating_add(moves) > MAX_SUBPATHS {
+        return work.subpaths(moves);
+    }
     let t = user.pre_concat(path.abs_transform());
     let scale = f64::from((t.sx * t.sy - t.kx * t.ky).abs()).sqrt();
     let style = Style {

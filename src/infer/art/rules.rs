@@ -528,6 +528,88 @@ fn seq_candidate(
     })
 }
 
+/// The steps between consecutive edges of `group` (an edge into an
+/// instance and an edge out of it, not straight back): the links, and the
+/// change of turn and twist along each, in tolerance units.
+fn step_links(
+    edges: &[Edge],
+    group: &[usize],
+    tol: Tolerance,
+) -> (Vec<(usize, usize)>, Vec<Point>) {
+    let mut out_of: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for &k in group {
+        out_of.entry(edges[k].from).or_default().push(k);
+    }
+    // Steps between consecutive edges.
+    let mut links: Vec<(usize, usize)> = Vec::new();
+    let mut deltas: Vec<Point> = Vec::new();
+    for &k in group {
+        for &f in out_of.get(&edges[k].to).into_iter().flatten() {
+            if edges[f].to == edges[k].from {
+                continue;
+            }
+            let (a, b) = (&edges[k].t, &edges[f].t);
+            let da = wrap(b.alpha - a.alpha) / tol.angle;
+            let db = wrap(b.beta - a.beta) / tol.angle;
+            links.push((k, f));
+            deltas.push([da, 0.0, 0.0, db]);
+        }
+    }
+    (links, deltas)
+}
+
+/// The chains of instances linked by edges whose steps are in cluster `top`
+/// of `dl` (one label per link), node-disjoint, with their transforms.
+fn linear_chains(
+    edges: &[Edge],
+    links: &[(usize, usize)],
+    dl: &[usize],
+    top: usize,
+) -> Vec<(Vec<usize>, Vec<Tr>)> {
+    let mut next: BTreeMap<usize, usize> = BTreeMap::new();
+    let mut has_prev: HashSet<usize> = HashSet::new();
+    let mut used_nodes: HashSet<usize> = HashSet::new();
+    for (i, &(k, f)) in links.iter().enumerate() {
+        if dl[i] != top || next.contains_key(&k) || has_prev.contains(&f) {
+            continue;
+        }
+        next.insert(k, f);
+        has_prev.insert(f);
+    }
+    // Edge chains to instance chains, node-disjoint.
+    let mut chains: Vec<(Vec<usize>, Vec<Tr>)> = Vec::new();
+    let starts: Vec<usize> = next
+        .keys()
+        .copied()
+        .filter(|k| !has_prev.contains(k))
+        .collect();
+    for s in starts {
+        let mut nodes = vec![edges[s].from];
+        let mut in_chain: HashSet<usize> = HashSet::from([edges[s].from]);
+        let mut ts = Vec::new();
+        let mut k = s;
+        let mut seen = HashSet::new();
+        loop {
+            let e = &edges[k];
+            if used_nodes.contains(&e.to) || !seen.insert(k) || in_chain.contains(&e.to) {
+                break;
+            }
+            nodes.push(e.to);
+            in_chain.insert(e.to);
+            ts.push(e.t);
+            match next.get(&k) {
+                Some(&f) => k = f,
+                None => break,
+            }
+        }
+        if ts.len() >= 2 && !used_nodes.contains(&nodes[0]) {
+            used_nodes.extend(nodes.iter().copied());
+            chains.push((nodes, ts));
+        }
+    }
+    chains
+}
+
 /// Chains whose turns change by a constant step: the (d, s) subspace.
 fn linear(
     insts: &[Inst],
@@ -558,25 +640,7 @@ fn linear(
         if group.len() < 3 {
             continue;
         }
-        let mut out_of: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
-        for &k in &group {
-            out_of.entry(edges[k].from).or_default().push(k);
-        }
-        // Steps between consecutive edges.
-        let mut links: Vec<(usize, usize)> = Vec::new();
-        let mut deltas: Vec<Point> = Vec::new();
-        for &k in &group {
-            for &f in out_of.get(&edges[k].to).into_iter().flatten() {
-                if edges[f].to == edges[k].from {
-                    continue;
-                }
-                let (a, b) = (&edges[k].t, &edges[f].t);
-                let da = wrap(b.alpha - a.alpha) / tol.angle;
-                let db = wrap(b.beta - a.beta) / tol.angle;
-                links.push((k, f));
-                deltas.push([da, 0.0, 0.0, db]);
-            }
-        }
+        let (links, deltas) = step_links(edges, &group, tol);
         if links.len() < 2 {
             continue;
         }
@@ -600,45 +664,7 @@ fn linear(
         if sizes[top] < 2 {
             continue;
         }
-        let mut next: BTreeMap<usize, usize> = BTreeMap::new();
-        let mut has_prev: HashSet<usize> = HashSet::new();
-        let mut used_nodes: HashSet<usize> = HashSet::new();
-        for (i, &(k, f)) in links.iter().enumerate() {
-            if dl[i] != top || next.contains_key(&k) || has_prev.contains(&f) {
-                continue;
-            }
-            next.insert(k, f);
-            has_prev.insert(f);
-        }
-        // Edge chains to instance chains, node-disjoint.
-        let mut chains: Vec<(Vec<usize>, Vec<Tr>)> = Vec::new();
-        let starts: Vec<usize> = next
-            .keys()
-            .copied()
-            .filter(|k| !has_prev.contains(k))
-            .collect();
-        for s in starts {
-            let mut nodes = vec![edges[s].from];
-            let mut ts = Vec::new();
-            let mut k = s;
-            let mut seen = HashSet::new();
-            loop {
-                let e = &edges[k];
-                if used_nodes.contains(&e.to) || !seen.insert(k) || nodes.contains(&e.to) {
-                    break;
-                }
-                nodes.push(e.to);
-                ts.push(e.t);
-                match next.get(&k) {
-                    Some(&f) => k = f,
-                    None => break,
-                }
-            }
-            if ts.len() >= 2 && !used_nodes.contains(&nodes[0]) {
-                used_nodes.extend(nodes.iter().copied());
-                chains.push((nodes, ts));
-            }
-        }
+        let mut chains = linear_chains(edges, &links, &dl, top);
         if chains.is_empty() {
             continue;
         }
