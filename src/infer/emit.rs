@@ -214,21 +214,57 @@ fn widths(sk: &Skeleton) -> (f64, Option<f64>, &'static str) {
 
 /// The program for a skeleton and its productions.
 pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
-    let trunk = &sk.branches[0];
     let mut consts = Consts { items: Vec::new() };
-    let mut rng = s.seed_3d.map(SplitMix);
+    let prods = productions(a);
+    let (axiom, kw) = trunk(sk, s, &mut consts);
+    let names = module_names(&prods);
+    let geoms = child_geometry(sk, a, &prods, &names, s.seed_3d);
+    let spread = if s.seed_3d.is_some() && geoms.iter().flatten().any(|g| g.lean != 0.0) {
+        Some(consts.add(
+            "SPREAD",
+            SPREAD,
+            "3D: how far children lean out of the sketch plane (degrees)".into(),
+        ))
+    } else {
+        None
+    };
+    let mut stmts: Vec<Node<Stmt>> = Vec::new();
+    stmts.push(node(Stmt::Derive(Expr::num(sk.height() as f64 + 1.0))));
+    stmts.push(node(Stmt::Axiom(axiom)));
+    let mut decls: Vec<Node<Item>> = Vec::new();
+    let widths = Widths {
+        kw: kw.as_ref(),
+        spread: spread.as_ref(),
+    };
+    for (p, g) in prods.iter().zip(&geoms) {
+        let m = name_of(&names, Child::Id(p.id));
+        decls.push(node(Item::Module(ModuleDecl {
+            name: Ident::new(m.clone()),
+            params: vec![Ident::new("l"), Ident::new("w")],
+        })));
+        stmts.push(rule(sk, a, s, p, g, &m, &widths, &mut consts));
+    }
+    let header = header(sk, a, s, &prods, &names);
+    assemble(&header, consts, decls, stmts, &s.name)
+}
 
-    // The productions to write: the reduced ones, or the trunk alone.
-    let prods: Vec<Production> = if a.reduced.is_empty() {
+/// The productions to write: the reduced ones, or the trunk alone.
+fn productions(a: &Analysis) -> Vec<Production> {
+    if a.reduced.is_empty() {
         vec![Production {
             id: 0,
             succ: Vec::new(),
         }]
     } else {
         a.reduced.clone()
-    };
+    }
+}
 
-    // Placement of the trunk.
+/// The axiom, placing the trunk where the sketch has it, and the constants
+/// of its placement, length and width; also the width ratio of a branch to
+/// its parent, if the sketch has one.
+fn trunk(sk: &Skeleton, s: &Settings, consts: &mut Consts) -> (Vec<Module>, Option<Expr>) {
+    let trunk = &sk.branches[0];
     let base = trunk.points.first().copied().unwrap_or(DVec2::ZERO);
     let (bx, by) = (round(base.x, 1), round(base.y, 1));
     let lean = round(angle(DVec2::Y, trunk.direction(0)), 1);
@@ -274,11 +310,22 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
         )
     });
     axiom.push(named("R", vec![trunk_len, width]));
+    (axiom, kw)
+}
 
-    let names = module_names(&prods);
-    // Children of each rule, measured on its base branch.
+/// The children of each rule, measured on its base branch; in 3D each
+/// leans out of the plane by the sine of its place around the parent
+/// (`seed_3d` seeds the perturbation).
+fn child_geometry(
+    sk: &Skeleton,
+    a: &Analysis,
+    prods: &[Production],
+    names: &HashMap<usize, String>,
+    seed_3d: Option<u64>,
+) -> Vec<Vec<ChildGeom>> {
+    let mut rng = seed_3d.map(SplitMix);
     let mut geoms: Vec<Vec<ChildGeom>> = Vec::new();
-    for p in &prods {
+    for p in prods {
         let b = &sk.branches[a.branch_of.get(p.id).copied().unwrap_or(0)];
         let n = p.succ.len();
         let mut g = Vec::new();
@@ -296,7 +343,7 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
                 None => 0.0,
             };
             g.push(ChildGeom {
-                module: name_of(&names, *c),
+                module: name_of(names, *c),
                 vertex: v,
                 angle: angle(b.heading_at(v), child.direction(0)),
                 ratio: child.length() / b.length().max(f64::MIN_POSITIVE),
@@ -306,120 +353,145 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
         }
         geoms.push(g);
     }
-    let spread = if s.seed_3d.is_some() && geoms.iter().flatten().any(|g| g.lean != 0.0) {
-        Some(consts.add(
-            "SPREAD",
-            SPREAD,
-            "3D: how far children lean out of the sketch plane (degrees)".into(),
-        ))
-    } else {
-        None
+    geoms
+}
+
+/// The constants every rule's children use.
+struct Widths<'a> {
+    /// Width of a branch relative to its parent.
+    kw: Option<&'a Expr>,
+    /// 3D: how far children lean out of the plane.
+    spread: Option<&'a Expr>,
+}
+
+/// The rule of production `p` (module `m`): its branch as sketched, the
+/// children `g` in brackets at their junctions, with their constants.
+#[allow(clippy::too_many_arguments)]
+fn rule(
+    sk: &Skeleton,
+    a: &Analysis,
+    s: &Settings,
+    p: &Production,
+    g: &[ChildGeom],
+    m: &str,
+    widths: &Widths,
+    consts: &mut Consts,
+) -> Node<Stmt> {
+    let base = a.branch_of.get(p.id).copied().unwrap_or(0);
+    let b = &sk.branches[base];
+    let children: Vec<(usize, Vec<Module>)> = g
+        .iter()
+        .enumerate()
+        .map(|(i, c)| (c.vertex, child_bracket(s, m, i, c, widths, consts)))
+        .collect();
+    let mut succ = vec![sym('!', Some(var("w")))];
+    let segs = b.segments().max(1);
+    let total = b.length().max(f64::MIN_POSITIVE);
+    let at = |v: usize, succ: &mut Vec<Module>| {
+        for (cv, br) in &children {
+            if *cv == v {
+                succ.extend(br.iter().cloned());
+            }
+        }
     };
-
-    // Rules.
-    let mut stmts: Vec<Node<Stmt>> = Vec::new();
-    stmts.push(node(Stmt::Derive(Expr::num(sk.height() as f64 + 1.0))));
-    stmts.push(node(Stmt::Axiom(axiom)));
-    let mut decls: Vec<Node<Item>> = Vec::new();
-    for (p, g) in prods.iter().zip(&geoms) {
-        let m = name_of(&names, Child::Id(p.id));
-        decls.push(node(Item::Module(ModuleDecl {
-            name: Ident::new(m.clone()),
-            params: vec![Ident::new("l"), Ident::new("w")],
-        })));
-        let base = a.branch_of.get(p.id).copied().unwrap_or(0);
-        let b = &sk.branches[base];
-        let mut children = Vec::new();
-        for (i, c) in g.iter().enumerate() {
-            let what = format!(
-                "{}'s child {} ({}, {})",
-                m,
-                i + 1,
-                c.module,
-                stroke_name(s, c.stroke)
-            );
-            let ae = consts.add(
-                &format!("{m}_A{}", i + 1),
-                round(c.angle.abs(), 1),
-                format!(
-                    "angle of {what} to it, degrees {}",
-                    if c.angle >= 0.0 { "left" } else { "right" }
-                ),
-            );
-            let ke = consts.add(
-                &format!("{m}_K{}", i + 1),
-                round(c.ratio, 3),
-                format!("length of {what} relative to it"),
-            );
-            let mut bracket = vec![sym('[', None)];
-            bracket.push(sym(if c.angle >= 0.0 { '+' } else { '-' }, Some(ae)));
-            if let Some(sp) = &spread
-                && c.lean != 0.0
-            {
-                let pitch = mul(sp.clone(), Expr::num(c.lean.abs()));
-                bracket.push(sym(if c.lean > 0.0 { '&' } else { '^' }, Some(pitch)));
-            }
-            let w = match &kw {
-                Some(k) => mul(var("w"), k.clone()),
-                None => var("w"),
-            };
-            bracket.push(named(&c.module, vec![mul(var("l"), ke), w]));
-            bracket.push(sym(']', None));
-            children.push((c.vertex, bracket));
+    for k in 0..segs {
+        at(k, &mut succ);
+        if k > 0
+            && let Some(t) = turn(angle(b.direction(k - 1), b.direction(k)))
+        {
+            succ.push(t);
         }
-        let mut succ = vec![sym('!', Some(var("w")))];
-        let segs = b.segments().max(1);
-        let total = b.length().max(f64::MIN_POSITIVE);
-        let at = |v: usize, succ: &mut Vec<Module>| {
-            for (cv, br) in &children {
-                if *cv == v {
-                    succ.extend(br.iter().cloned());
-                }
-            }
+        let len = match (b.points.get(k), b.points.get(k + 1)) {
+            (Some(p), Some(q)) => p.distance(*q),
+            _ => total,
         };
-        for k in 0..segs {
-            at(k, &mut succ);
-            if k > 0
-                && let Some(t) = turn(angle(b.direction(k - 1), b.direction(k)))
-            {
-                succ.push(t);
-            }
-            let len = match (b.points.get(k), b.points.get(k + 1)) {
-                (Some(p), Some(q)) => p.distance(*q),
-                _ => total,
-            };
-            let f = if segs == 1 {
-                var("l")
-            } else {
-                mul(var("l"), Expr::num(round(len / total, 3)))
-            };
-            succ.push(sym('F', Some(f)));
-        }
-        at(segs, &mut succ);
-        let mut rule = node(Stmt::Rule(Rule {
-            label: None,
-            interpret: false,
-            left: None,
-            pred: Module::new(ModName::Name(m.clone()), Some(vec![var("l"), var("w")])),
-            right: None,
-            cond: None,
-            weight: None,
-            succ,
-        }));
-        rule.trivia.leading.push(comment(format!(
-            "{p}: module {m}, drawn like {}{}",
-            stroke_name(s, base),
-            if p.succ.is_empty() {
-                ""
-            } else {
-                ", children at their junctions"
-            }
-        )));
-        rule.trivia.blank_before = true;
-        stmts.push(rule);
+        let f = if segs == 1 {
+            var("l")
+        } else {
+            mul(var("l"), Expr::num(round(len / total, 3)))
+        };
+        succ.push(sym('F', Some(f)));
     }
+    at(segs, &mut succ);
+    let mut rule = node(Stmt::Rule(Rule {
+        label: None,
+        interpret: false,
+        left: None,
+        pred: Module::new(ModName::Name(m.to_string()), Some(vec![var("l"), var("w")])),
+        right: None,
+        cond: None,
+        weight: None,
+        succ,
+    }));
+    rule.trivia.leading.push(comment(format!(
+        "{p}: module {m}, drawn like {}{}",
+        stroke_name(s, base),
+        if p.succ.is_empty() {
+            ""
+        } else {
+            ", children at their junctions"
+        }
+    )));
+    rule.trivia.blank_before = true;
+    rule
+}
 
-    // Header.
+/// `[ +(M_Ai) &(SPREAD * lean) Child(l * M_Ki, w * KW) ]` for child `i`
+/// of module `m`, with its angle and length constants.
+fn child_bracket(
+    s: &Settings,
+    m: &str,
+    i: usize,
+    c: &ChildGeom,
+    widths: &Widths,
+    consts: &mut Consts,
+) -> Vec<Module> {
+    let what = format!(
+        "{}'s child {} ({}, {})",
+        m,
+        i + 1,
+        c.module,
+        stroke_name(s, c.stroke)
+    );
+    let ae = consts.add(
+        &format!("{m}_A{}", i + 1),
+        round(c.angle.abs(), 1),
+        format!(
+            "angle of {what} to it, degrees {}",
+            if c.angle >= 0.0 { "left" } else { "right" }
+        ),
+    );
+    let ke = consts.add(
+        &format!("{m}_K{}", i + 1),
+        round(c.ratio, 3),
+        format!("length of {what} relative to it"),
+    );
+    let mut bracket = vec![sym('[', None)];
+    bracket.push(sym(if c.angle >= 0.0 { '+' } else { '-' }, Some(ae)));
+    if let Some(sp) = widths.spread
+        && c.lean != 0.0
+    {
+        let pitch = mul(sp.clone(), Expr::num(c.lean.abs()));
+        bracket.push(sym(if c.lean > 0.0 { '&' } else { '^' }, Some(pitch)));
+    }
+    let w = match widths.kw {
+        Some(k) => mul(var("w"), k.clone()),
+        None => var("w"),
+    };
+    bracket.push(named(&c.module, vec![mul(var("l"), ke), w]));
+    bracket.push(sym(']', None));
+    bracket
+}
+
+/// The comment header: the sketch, the productions at each stage of
+/// reduction, the modules' names and how to grow the tree.
+fn header(
+    sk: &Skeleton,
+    a: &Analysis,
+    s: &Settings,
+    prods: &[Production],
+    names: &HashMap<usize, String>,
+) -> Vec<String> {
     let mut header = vec![
         format!(
             "Inferred by `lsyc infer --skeleton` from {}{}.",
@@ -444,13 +516,7 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
     }
     let mut named: Vec<String> = prods
         .iter()
-        .map(|p| {
-            format!(
-                "{} is {}",
-                name_of(&names, Child::Id(p.id)),
-                Child::Id(p.id)
-            )
-        })
+        .map(|p| format!("{} is {}", name_of(names, Child::Id(p.id)), Child::Id(p.id)))
         .collect();
     if let Some(last) = named.last_mut() {
         last.push('.');
@@ -475,6 +541,18 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
             "perturbation (seed {seed}); each leans SPREAD times the sine of its angle out of the plane."
         ));
     }
+    header
+}
+
+/// The file: constants (the header on the first), module declarations and
+/// the lsystem `name` with `stmts`.
+fn assemble(
+    header: &[String],
+    consts: Consts,
+    decls: Vec<Node<Item>>,
+    stmts: Vec<Node<Stmt>>,
+    name: &str,
+) -> File {
     let mut items: Vec<Node<Item>> = Vec::new();
     let mut first = true;
     for mut c in consts.items {
@@ -490,7 +568,7 @@ pub fn program(sk: &Skeleton, a: &Analysis, s: &Settings) -> File {
         items.push(d);
     }
     let mut sys = node(Item::Lsystem(Lsystem {
-        name: Ident::new(s.name.clone()),
+        name: Ident::new(name.to_string()),
         params: Vec::new(),
         body: Block {
             stmts,

@@ -14,6 +14,7 @@ pub mod emit;
 pub mod productions;
 pub mod skeleton;
 pub mod strokes;
+pub mod svg;
 
 use crate::ast::File;
 use productions::Analysis;
@@ -57,8 +58,21 @@ pub enum InferError {
     },
     #[error("`{file}` is larger than {} MiB", MAX_SVG_BYTES >> 20)]
     TooLarge { file: String },
-    #[error("`{file}` has {strokes} strokes; lsyc infers trees of up to {MAX_STROKES}")]
-    TooManyStrokes { file: String, strokes: usize },
+    #[error(
+        "`{file}` has more than {MAX_STROKES} strokes; lsyc infers trees of up to {MAX_STROKES}"
+    )]
+    TooManyStrokes { file: String },
+    #[error(
+        "`{file}`: inference from its {elements} elements would need more than {limit} {what}; lsyc stops there (infer a part of the drawing at a time, or fewer, more alike elements)"
+    )]
+    TooMuchWork {
+        file: String,
+        elements: usize,
+        what: &'static str,
+        limit: u64,
+    },
+    #[error("`{file}` is not read: {why}")]
+    Refused { file: String, why: svg::Refusal },
     #[error(
         "`{file}` has nothing to infer from: no paths or shapes with an extent{}",
         if *skipped > 0 { format!(" ({skipped} text, image or empty shapes skipped)") } else { String::new() }
@@ -74,6 +88,23 @@ pub enum InferError {
         art::MAX_ELEMENTS
     )]
     TooManyElements { file: String, elements: usize },
+}
+
+impl InferError {
+    /// The error for a document `svg` refused to read: usvg's own reasons
+    /// keep their wording.
+    pub fn refused(file: &str, why: svg::Refusal) -> InferError {
+        match why {
+            svg::Refusal::NotSvg(why) => InferError::NotSvg {
+                file: file.into(),
+                why,
+            },
+            why => InferError::Refused {
+                file: file.into(),
+                why,
+            },
+        }
+    }
 }
 
 /// For a drawing's file name: the name the header gives (the file's own name)
@@ -107,18 +138,12 @@ pub fn skeleton_from_svg(data: &[u8], name: &str, opts: &Options) -> Result<Infe
     if data.len() > MAX_SVG_BYTES {
         return Err(InferError::TooLarge { file: name.into() });
     }
-    let strokes = strokes::read(data).map_err(|why| InferError::NotSvg {
-        file: name.into(),
-        why,
-    })?;
+    let strokes = strokes::read(data, MAX_STROKES).map_err(|why| InferError::refused(name, why))?;
     if strokes.is_empty() {
         return Err(InferError::NoStrokes { file: name.into() });
     }
     if strokes.len() > MAX_STROKES {
-        return Err(InferError::TooManyStrokes {
-            file: name.into(),
-            strokes: strokes.len(),
-        });
+        return Err(InferError::TooManyStrokes { file: name.into() });
     }
     let sk = skeleton::build(&strokes, opts.epsilon).map_err(|d| InferError::Detached {
         file: name.into(),

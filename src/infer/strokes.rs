@@ -7,6 +7,7 @@
 //! space into the language's y-up world (x, −y), and the stroke width in the
 //! same units. Each subpath is a stroke. Must not decide what a stroke means.
 
+use super::svg::{self, Refusal};
 use glam::DVec2;
 use usvg::tiny_skia_path::{PathSegment, Point, Transform};
 
@@ -52,15 +53,95 @@ impl Stroke {
     }
 }
 
-/// Reads the strokes of an SVG document. Subpaths with no length are skipped
-/// (their numbers are not reused). The error is usvg's reason, for a message.
-pub fn read(data: &[u8]) -> Result<Vec<Stroke>, String> {
-    let tree = usvg::Tree::from_data(data, &usvg::Options::default()).map_err(|e| e.to_string())?;
-    let mut out = Vec::new();
-    let mut number = 0;
+/// The most points (curves flattened) all strokes of a sketch may have together.
+pub const MAX_POINTS: usize = 1_000_000;
+
+/// Reads the strokes of an SVG document, at most `max_strokes + 1` of them
+/// (so that the caller can tell there are too many without reading them
+/// all). Subpaths with no length are skipped (their numbers are not reused).
+/// The error says why the document is not read, for a message.
+pub fn read(data: &[u8], max_strokes: usize) -> Result<Vec<Stroke>, Refusal> {
+    let tree = svg::parse(data)?;
+    let mut r = Reader {
+        out: Vec::new(),
+        number: 0,
+        points: 0,
+        max_strokes,
+    };
     let user = user_space(data, &tree);
-    walk(tree.root(), user, &mut out, &mut number);
-    Ok(out)
+    // Groups depth first, in document order, with an explicit stack.
+    let mut stack = vec![tree.root().children().iter()];
+    while let Some(top) = stack.last_mut() {
+        let Some(node) = top.next() else {
+            stack.pop();
+            continue;
+        };
+        match node {
+            usvg::Node::Group(g) => stack.push(g.children().iter()),
+            usvg::Node::Path(p) => {
+                if !r.path(p, user)? {
+                    break;
+                }
+            }
+            usvg::Node::Image(_) | usvg::Node::Text(_) => {}
+        }
+    }
+    Ok(r.out)
+}
+
+fn too_many_points() -> Refusal {
+    Refusal::TooMany {
+        what: "points (curves flattened)",
+        limit: MAX_POINTS,
+    }
+}
+
+/// The strokes read so far and what they cost.
+struct Reader {
+    out: Vec<Stroke>,
+    number: usize,
+    points: usize,
+    max_strokes: usize,
+}
+
+impl Reader {
+    /// Adds the strokes of `path`; `false` once there are more than enough.
+    fn path(&mut self, path: &usvg::Path, user: Transform) -> Result<bool, Refusal> {
+        let t = user.pre_concat(path.abs_transform());
+        // A width scales with the transform's mean scale factor.
+        let scale = f64::from((t.sx * t.sy - t.kx * t.ky).abs()).sqrt();
+        let width = path
+            .stroke()
+            .map(|s| f64::from(s.width().get()) * scale)
+            .filter(|w| w.is_finite() && *w > 0.0);
+        // The path's own points are fewer than its flattened ones: too many
+        // is refused before its subpaths are built.
+        if self.points.saturating_add(path.data().points().len()) > MAX_POINTS {
+            return Err(too_many_points());
+        }
+        for (k, sub) in subpaths(path, user).into_iter().enumerate() {
+            self.number += 1;
+            let points = flatten(&sub);
+            if points.len() < 2 {
+                continue;
+            }
+            self.points += points.len();
+            if self.points > MAX_POINTS {
+                return Err(too_many_points());
+            }
+            self.out.push(Stroke {
+                number: self.number,
+                id: path.id().to_string(),
+                subpath: k,
+                points,
+                width,
+            });
+            if self.out.len() > self.max_strokes {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
 }
 
 /// The map from usvg's coordinates back to the document's user space: usvg
@@ -93,40 +174,6 @@ pub fn user_space(data: &[u8], tree: &usvg::Tree) -> Transform {
         root_group().unwrap_or_default()
     } else {
         Transform::identity()
-    }
-}
-
-fn walk(group: &usvg::Group, user: Transform, out: &mut Vec<Stroke>, number: &mut usize) {
-    for node in group.children() {
-        match node {
-            usvg::Node::Group(g) => walk(g, user, out, number),
-            usvg::Node::Path(p) => path_strokes(p, user, out, number),
-            usvg::Node::Image(_) | usvg::Node::Text(_) => {}
-        }
-    }
-}
-
-fn path_strokes(path: &usvg::Path, user: Transform, out: &mut Vec<Stroke>, number: &mut usize) {
-    let t = user.pre_concat(path.abs_transform());
-    // A width scales with the transform's mean scale factor.
-    let scale = f64::from((t.sx * t.sy - t.kx * t.ky).abs()).sqrt();
-    let width = path
-        .stroke()
-        .map(|s| f64::from(s.width().get()) * scale)
-        .filter(|w| w.is_finite() && *w > 0.0);
-    for (k, sub) in subpaths(path, user).into_iter().enumerate() {
-        *number += 1;
-        let points = flatten(&sub);
-        if points.len() < 2 {
-            continue;
-        }
-        out.push(Stroke {
-            number: *number,
-            id: path.id().to_string(),
-            subpath: k,
-            points,
-            width,
-        });
     }
 }
 
@@ -251,7 +298,7 @@ mod tests {
             <line x1="0" y1="0" x2="0" y2="0" stroke="black"/>
             <path d="M0 0 C10 0 10 10 20 10 M30 30 L40 40" stroke="black"/>
         </svg>"#;
-        let s = read(svg.as_bytes()).expect("reads");
+        let s = read(svg.as_bytes(), 100).expect("reads");
         assert_eq!(s.len(), 4, "{s:?}");
         assert_eq!(
             s[0].points,
@@ -274,7 +321,7 @@ mod tests {
 
     #[test]
     fn not_svg_is_an_error() {
-        assert!(read(b"hello").is_err());
-        assert!(read(b"<svg").is_err());
+        assert!(read(b"hello", 100).is_err());
+        assert!(read(b"<svg", 100).is_err());
     }
 }

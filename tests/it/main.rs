@@ -9,6 +9,7 @@ mod evaluator;
 mod geometry;
 mod guided;
 mod hostile;
+mod hostile_svg;
 mod infer;
 mod layers;
 mod run;

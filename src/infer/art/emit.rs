@@ -366,9 +366,65 @@ fn describe(names: &Names, s: Sym) -> String {
 pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Settings) -> File {
     let names = Names::new(inst.kinds.len(), g);
     let mut consts = Consts { items: Vec::new() };
-    let mut items: Vec<Node<Item>> = Vec::new();
+    let element_items = kinds(elements, inst, &names);
+    let count_of = count_constants(g, &names, &mut consts);
+    let mut decls: Vec<Node<Item>> = Vec::new();
+    let mut rules: Vec<Node<Stmt>> = Vec::new();
+    for (r, rule) in g.rules.iter().enumerate() {
+        let counted_r = counted(g, r);
+        let name = names.rules[r].clone();
+        decls.push(node(Item::Module(ModuleDecl {
+            name: Ident::new(name.clone()),
+            params: if counted_r {
+                vec![Ident::new("m")]
+            } else {
+                Vec::new()
+            },
+        })));
+        let mut w = RuleWriter {
+            g,
+            names: &names,
+            symmetrize: s.symmetrize,
+            jitter: s.jitter,
+            count_of: &count_of,
+            pred: Module::new(
+                ModName::Name(name.clone()),
+                counted_r.then(|| vec![var("m")]),
+            ),
+            name,
+            out: &mut rules,
+        };
+        match &rule.body {
+            Body::Seq { a, t, delta } if counted_r => {
+                w.sequence(&mut consts, run(g, r), *a, t, delta.as_ref());
+            }
+            Body::Branch { a, t, u } => w.branching(&mut consts, run(g, r), *a, t, u),
+            // A sequence used only with m = 1 is the pair P -> A T A.
+            Body::Seq { a, t, .. } => w.pair(*a, t, *a),
+            Body::Pair { a, t, b } => w.pair(*a, t, *b),
+        }
+    }
+    let (axiom, derive) = axiom(elements, g, &names, &count_of);
+    let mut stmts: Vec<Node<Stmt>> = Vec::new();
+    stmts.push(node(Stmt::Derive(derive)));
+    stmts.push(node(Stmt::Axiom(axiom)));
+    stmts.extend(rules);
+    let mut sys = node(Item::Lsystem(Lsystem {
+        name: Ident::new(s.name.clone()),
+        params: Vec::new(),
+        body: Block {
+            stmts,
+            end_comments: Vec::new(),
+        },
+    }));
+    sys.trivia.blank_before = true;
+    let header = header(elements, inst, g, s, &count_of);
+    assemble(&header, element_items, consts, decls, sys)
+}
 
-    // Elements.
+/// The element kinds as `element` items, each with a comment saying how
+/// many there are and where its outline comes from.
+fn kinds(elements: &[Element], inst: &Instancing, names: &Names) -> Vec<Node<Item>> {
     let mut element_items = Vec::new();
     for (k, kind) in inst.kinds.iter().enumerate() {
         let e = &elements[kind.representative];
@@ -434,14 +490,12 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
         )));
         element_items.push(item);
     }
+    element_items
+}
 
-    // Rules.
-    let mut decls: Vec<Node<Item>> = Vec::new();
-    let mut rules: Vec<Node<Stmt>> = Vec::new();
-    let m = || var("m");
-    let m_minus_1 = || bin(BinOp::Sub, var("m"), Expr::num(1.0));
-    let cond = |op: BinOp| Some(bin(op, var("m"), Expr::num(0.0)));
-    // A count argument: a named constant when the rule is used with one count.
+/// A count argument for each rule: a named constant when the rule is used
+/// with one count.
+fn count_constants(g: &Grammar, names: &Names, consts: &mut Consts) -> Vec<Option<Expr>> {
     let mut count_of: Vec<Option<Expr>> = vec![None; g.rules.len()];
     for (r, rule) in g.rules.iter().enumerate() {
         if counted(g, r) && rule.counts.len() == 1 {
@@ -457,186 +511,204 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
             ));
         }
     }
-    for (r, rule) in g.rules.iter().enumerate() {
-        let name = names.rules[r].clone();
-        let counted_r = counted(g, r);
-        decls.push(node(Item::Module(ModuleDecl {
-            name: Ident::new(name.clone()),
-            params: if counted_r {
-                vec![Ident::new("m")]
-            } else {
-                Vec::new()
-            },
-        })));
-        let child_count = |s: Sym| match s {
-            Sym::Rule(c, _) => count_of[c].clone(),
-            Sym::Element(_) => None,
-        };
-        let scale_units = |t: &Tr| t.d.max(1e-9);
-        let pred = Module::new(
-            ModName::Name(name.clone()),
-            counted_r.then(|| vec![var("m")]),
-        );
-        let mut add_rule = |cond: Option<Expr>, succ: Vec<Module>, note: Option<String>| {
-            let mut n = node(Stmt::Rule(Rule {
-                label: None,
-                interpret: false,
-                left: None,
-                pred: pred.clone(),
-                right: None,
-                cond,
-                weight: None,
-                succ,
-            }));
-            if let Some(note) = note {
-                n.trivia.leading.push(comment(note));
-                n.trivia.blank_before = true;
-            }
-            rules.push(n);
-        };
-        let named_parts = |consts: &mut Consts, t: &Tr, suffix: &str, n: f64| {
-            let round = if s.symmetrize {
-                Round {
-                    angle: 1.5,
-                    d: 0.02 * scale_units(t),
-                    s: 0.01,
-                }
-            } else {
-                Round::new(n, scale_units(t))
-            };
-            let (a, d, sc, b) = round.values(t);
-            let jitter = s.jitter;
-            let mut part = |v: f64, trivial: f64, what: &str, note: &str| {
-                // A scale of 1 stays 1: random scales would compound.
-                let j = jitter
-                    .filter(|_| !(what == "SCALE" && v == 1.0))
-                    .map(|j| match what {
-                        "TURN" | "TWIST" => Jitter::Turn(nice(30.0 * j, 1e-6)),
-                        _ => Jitter::Factor(j),
-                    });
-                if v == trivial && j.is_none() {
-                    Part::Value(v)
-                } else {
-                    Part::Expr(consts.add_jittered(&format!("{name}_{what}{suffix}"), v, j, note))
-                }
-            };
-            (
-                part(a, 0.0, "TURN", "degrees, left positive, before the step"),
-                part(d, 0.0, "STEP", "distance, in the current scale"),
-                part(sc, 1.0, "SCALE", "scale factor per step"),
-                part(b, 0.0, "TWIST", "degrees, left positive, after the step"),
-            )
-        };
-        match &rule.body {
-            Body::Seq { a, t, delta } if counted_r => {
-                let (pa, pd, ps, pb) = named_parts(&mut consts, t, "", run(g, r));
-                let (pa, pb) = match delta {
-                    Some(dl) => {
-                        let n = run(g, r);
-                        let tol = 0.002 / (n * n);
-                        let linear = |consts: &mut Consts, base: Part, step: f64, what: &str| {
-                            let step = nice(step.to_degrees(), tol);
-                            let base = match base {
-                                Part::Value(v) => Expr::num(v),
-                                Part::Expr(e) => e,
-                            };
-                            if step == 0.0 {
-                                return Part::Expr(base);
-                            }
-                            let c = consts.add(
-                                &format!("{name}_D{what}"),
-                                step,
-                                "change of the turn per step of m",
-                            );
-                            Part::Expr(bin(BinOp::Add, base, bin(BinOp::Mul, c, m())))
-                        };
-                        (
-                            linear(&mut consts, pa, dl.alpha, "TURN"),
-                            linear(&mut consts, pb, dl.beta, "TWIST"),
-                        )
-                    }
-                    None => (pa, pb),
-                };
-                let mut succ = placed(&names, g, *a, child_count(*a));
-                succ.extend(transform(pa, pd, ps, pb));
-                succ.push(Module::new(
-                    ModName::Name(name.clone()),
-                    Some(vec![m_minus_1()]),
-                ));
-                add_rule(
-                    cond(BinOp::Gt),
-                    succ,
-                    Some(format!(
-                        "{name}(m): a sequence of m + 1 {}{}",
-                        describe(&names, *a),
-                        if delta.is_some() {
-                            ", turning by a changing angle"
-                        } else {
-                            ""
-                        }
-                    )),
-                );
-                add_rule(
-                    cond(BinOp::Eq),
-                    placed(&names, g, *a, child_count(*a)),
-                    None,
-                );
-            }
+    count_of
+}
 
-            Body::Branch { a, t, u } => {
-                let n = run(g, r);
-                let (ta, td, ts, tb) = named_parts(&mut consts, t, "1", n);
-                let (ua, ud, us, ub) = named_parts(&mut consts, u, "2", n);
-                let mut succ = placed(&names, g, *a, child_count(*a));
-                for (pa, pd, ps, pb) in [(ta, td, ts, tb), (ua, ud, us, ub)] {
-                    succ.push(sym('[', None));
-                    succ.extend(transform(pa, pd, ps, pb));
-                    succ.push(Module::new(
-                        ModName::Name(name.clone()),
-                        Some(vec![m_minus_1()]),
-                    ));
-                    succ.push(sym(']', None));
-                }
-                add_rule(
-                    cond(BinOp::Gt),
-                    succ,
-                    Some(format!(
-                        "{name}(m): {} branching in two, m levels deep",
-                        describe(&names, *a)
-                    )),
-                );
-                add_rule(
-                    cond(BinOp::Eq),
-                    placed(&names, g, *a, child_count(*a)),
-                    None,
-                );
-            }
-            // A sequence used only with m = 1 is the pair P -> A T A.
-            Body::Seq { a, t, .. } | Body::Pair { a, t, b: _ } => {
-                let b = match &rule.body {
-                    Body::Pair { b, .. } => *b,
-                    _ => *a,
-                };
-                let (va, vd, vs, vb) = Round::new(1.0, scale_units(t)).values(t);
-                let mut succ = placed(&names, g, *a, child_count(*a));
-                succ.extend(transform(
-                    Part::Value(va),
-                    Part::Value(vd),
-                    Part::Value(vs),
-                    Part::Value(vb),
-                ));
-                succ.push(module_of(&names, g, b, child_count(b)));
-                let what = if b == *a {
-                    format!("two {}", describe(&names, *a))
-                } else {
-                    format!("{} and {}", describe(&names, *a), describe(&names, b))
-                };
-                add_rule(None, succ, Some(format!("{name}: {what} (a pair)")));
-            }
+fn m_minus_1() -> Expr {
+    bin(BinOp::Sub, var("m"), Expr::num(1.0))
+}
+
+fn m_is(op: BinOp) -> Option<Expr> {
+    Some(bin(op, var("m"), Expr::num(0.0)))
+}
+
+/// Writes the rules of one rule of the grammar, named `name`, into `out`.
+struct RuleWriter<'a> {
+    g: &'a Grammar,
+    names: &'a Names,
+    symmetrize: bool,
+    jitter: Option<f64>,
+    count_of: &'a [Option<Expr>],
+    name: String,
+    /// The predecessor: the name, with `m` if the rule is counted.
+    pred: Module,
+    out: &'a mut Vec<Node<Stmt>>,
+}
+
+impl RuleWriter<'_> {
+    fn child_count(&self, s: Sym) -> Option<Expr> {
+        match s {
+            Sym::Rule(c, _) => self.count_of[c].clone(),
+            Sym::Element(_) => None,
         }
     }
 
-    // Axiom: from the origin, heading up, to the last instance's frame.
+    fn placed(&self, s: Sym) -> Vec<Module> {
+        placed(self.names, self.g, s, self.child_count(s))
+    }
+
+    fn recurse(&self) -> Module {
+        Module::new(ModName::Name(self.name.clone()), Some(vec![m_minus_1()]))
+    }
+
+    fn add(&mut self, cond: Option<Expr>, succ: Vec<Module>, note: Option<String>) {
+        let mut n = node(Stmt::Rule(Rule {
+            label: None,
+            interpret: false,
+            left: None,
+            pred: self.pred.clone(),
+            right: None,
+            cond,
+            weight: None,
+            succ,
+        }));
+        if let Some(note) = note {
+            n.trivia.leading.push(comment(note));
+            n.trivia.blank_before = true;
+        }
+        self.out.push(n);
+    }
+
+    /// The turn, step, scale and twist of `t` as values or named constants
+    /// (`{name}_TURN{suffix}`, …), rounded for a structure repeated `n` times.
+    fn parts(&self, consts: &mut Consts, t: &Tr, suffix: &str, n: f64) -> (Part, Part, Part, Part) {
+        let units = t.d.max(1e-9);
+        let round = if self.symmetrize {
+            Round {
+                angle: 1.5,
+                d: 0.02 * units,
+                s: 0.01,
+            }
+        } else {
+            Round::new(n, units)
+        };
+        let (a, d, sc, b) = round.values(t);
+        let jitter = self.jitter;
+        let name = &self.name;
+        let mut part = |v: f64, trivial: f64, what: &str, note: &str| {
+            // A scale of 1 stays 1: random scales would compound.
+            let j = jitter
+                .filter(|_| !(what == "SCALE" && v == 1.0))
+                .map(|j| match what {
+                    "TURN" | "TWIST" => Jitter::Turn(nice(30.0 * j, 1e-6)),
+                    _ => Jitter::Factor(j),
+                });
+            if v == trivial && j.is_none() {
+                Part::Value(v)
+            } else {
+                Part::Expr(consts.add_jittered(&format!("{name}_{what}{suffix}"), v, j, note))
+            }
+        };
+        (
+            part(a, 0.0, "TURN", "degrees, left positive, before the step"),
+            part(d, 0.0, "STEP", "distance, in the current scale"),
+            part(sc, 1.0, "SCALE", "scale factor per step"),
+            part(b, 0.0, "TWIST", "degrees, left positive, after the step"),
+        )
+    }
+
+    /// `P(m) : m > 0 -> [a] T P(m - 1); P(m) : m == 0 -> [a]`, the turns
+    /// changing with m for a linear sequence (`delta`).
+    fn sequence(&mut self, consts: &mut Consts, n: f64, a: Sym, t: &Tr, delta: Option<&Tr>) {
+        let name = self.name.clone();
+        let (pa, pd, ps, pb) = self.parts(consts, t, "", n);
+        let (pa, pb) = match delta {
+            Some(dl) => {
+                let tol = 0.002 / (n * n);
+                let linear = |consts: &mut Consts, base: Part, step: f64, what: &str| {
+                    let step = nice(step.to_degrees(), tol);
+                    let base = match base {
+                        Part::Value(v) => Expr::num(v),
+                        Part::Expr(e) => e,
+                    };
+                    if step == 0.0 {
+                        return Part::Expr(base);
+                    }
+                    let c = consts.add(
+                        &format!("{name}_D{what}"),
+                        step,
+                        "change of the turn per step of m",
+                    );
+                    Part::Expr(bin(BinOp::Add, base, bin(BinOp::Mul, c, var("m"))))
+                };
+                (
+                    linear(consts, pa, dl.alpha, "TURN"),
+                    linear(consts, pb, dl.beta, "TWIST"),
+                )
+            }
+            None => (pa, pb),
+        };
+        let mut succ = self.placed(a);
+        succ.extend(transform(pa, pd, ps, pb));
+        succ.push(self.recurse());
+        let note = format!(
+            "{name}(m): a sequence of m + 1 {}{}",
+            describe(self.names, a),
+            if delta.is_some() {
+                ", turning by a changing angle"
+            } else {
+                ""
+            }
+        );
+        self.add(m_is(BinOp::Gt), succ, Some(note));
+        let last = self.placed(a);
+        self.add(m_is(BinOp::Eq), last, None);
+    }
+
+    /// `R(m) : m > 0 -> [a] [T R(m - 1)] [U R(m - 1)]; R(m) : m == 0 -> [a]`.
+    fn branching(&mut self, consts: &mut Consts, n: f64, a: Sym, t: &Tr, u: &Tr) {
+        let (ta, td, ts, tb) = self.parts(consts, t, "1", n);
+        let (ua, ud, us, ub) = self.parts(consts, u, "2", n);
+        let mut succ = self.placed(a);
+        for (pa, pd, ps, pb) in [(ta, td, ts, tb), (ua, ud, us, ub)] {
+            succ.push(sym('[', None));
+            succ.extend(transform(pa, pd, ps, pb));
+            succ.push(self.recurse());
+            succ.push(sym(']', None));
+        }
+        let note = format!(
+            "{}(m): {} branching in two, m levels deep",
+            self.name,
+            describe(self.names, a)
+        );
+        self.add(m_is(BinOp::Gt), succ, Some(note));
+        let last = self.placed(a);
+        self.add(m_is(BinOp::Eq), last, None);
+    }
+
+    /// `Q -> [a] T [b]`, the transform inlined.
+    fn pair(&mut self, a: Sym, t: &Tr, b: Sym) {
+        let (va, vd, vs, vb) = Round::new(1.0, t.d.max(1e-9)).values(t);
+        let mut succ = self.placed(a);
+        succ.extend(transform(
+            Part::Value(va),
+            Part::Value(vd),
+            Part::Value(vs),
+            Part::Value(vb),
+        ));
+        succ.push(module_of(self.names, self.g, b, self.child_count(b)));
+        let what = if b == a {
+            format!("two {}", describe(self.names, a))
+        } else {
+            format!(
+                "{} and {}",
+                describe(self.names, a),
+                describe(self.names, b)
+            )
+        };
+        let note = format!("{}: {what} (a pair)", self.name);
+        self.add(None, succ, Some(note));
+    }
+}
+
+/// The axiom (from the origin, heading up, to the last instance's frame)
+/// and the `derive` count that expands it completely.
+fn axiom(
+    elements: &[Element],
+    g: &Grammar,
+    names: &Names,
+    count_of: &[Option<Expr>],
+) -> (Vec<Module>, Expr) {
     let mut axiom = Vec::new();
     let mut derive = Expr::num(1.0);
     if let Some((frame, s)) = g.axiom {
@@ -663,7 +735,7 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
             Part::Value(sc),
             Part::Value(b),
         ));
-        axiom.push(module_of(&names, g, s, {
+        axiom.push(module_of(names, g, s, {
             match s {
                 Sym::Rule(c, _) => count_of[c].clone(),
                 Sym::Element(_) => None,
@@ -679,14 +751,18 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
         let (names, n) = steps(g, s, &named);
         derive = steps_expr(names, n);
     }
+    (axiom, derive)
+}
 
-    let mut stmts: Vec<Node<Stmt>> = Vec::new();
-    stmts.push(node(Stmt::Derive(derive)));
-    stmts.push(node(Stmt::Axiom(axiom)));
-    stmts.extend(rules);
-
-    // Header on the first item.
-    let header = [
+/// The comment header: where the program came from and how to edit it.
+fn header(
+    elements: &[Element],
+    inst: &Instancing,
+    g: &Grammar,
+    s: &Settings,
+    count_of: &[Option<Expr>],
+) -> [String; 4] {
+    [
         format!("Inferred by `lsyc infer` from {}.", s.source),
         format!(
             "{} elements of {} kind{}; {} rule{} found in {} round{}.",
@@ -707,7 +783,20 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
             }
         },
         "transforms; replace an element's path to draw something else in its place.".into(),
-    ];
+    ]
+}
+
+/// The file: elements, constants, module declarations (at the top, so that
+/// a derived string reads back as an axiom) and the lsystem, the header on
+/// the first item.
+fn assemble(
+    header: &[String],
+    element_items: Vec<Node<Item>>,
+    consts: Consts,
+    decls: Vec<Node<Item>>,
+    sys: Node<Item>,
+) -> File {
+    let mut items: Vec<Node<Item>> = Vec::new();
     let mut first = true;
     let mut push_item = |mut item: Node<Item>, items: &mut Vec<Node<Item>>| {
         if first {
@@ -727,20 +816,10 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
         c.trivia.blank_before = k == 0;
         push_item(c, &mut items);
     }
-    // Rule modules at the top, so that a derived string reads back as an axiom.
     for (k, mut d) in decls.into_iter().enumerate() {
         d.trivia.blank_before = k == 0;
         push_item(d, &mut items);
     }
-    let mut sys = node(Item::Lsystem(Lsystem {
-        name: Ident::new(s.name.clone()),
-        params: Vec::new(),
-        body: Block {
-            stmts,
-            end_comments: Vec::new(),
-        },
-    }));
-    sys.trivia.blank_before = true;
     push_item(sys, &mut items);
     File {
         items: Block {

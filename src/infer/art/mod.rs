@@ -22,6 +22,44 @@ use std::time::Instant;
 /// The most elements a drawing may have.
 pub const MAX_ELEMENTS: usize = 200_000;
 
+/// A phase would do more work than its limit: `what` it counts, and the limit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TooMuchWork {
+    pub what: &'static str,
+    pub limit: u64,
+}
+
+/// The work a phase has left before its limit, counted in `what`.
+pub(crate) struct Budget {
+    what: &'static str,
+    limit: u64,
+    left: u64,
+}
+
+impl Budget {
+    pub(crate) fn new(what: &'static str, limit: u64) -> Budget {
+        Budget {
+            what,
+            limit,
+            left: limit,
+        }
+    }
+
+    /// Spends `n`, or says the limit is reached.
+    pub(crate) fn spend(&mut self, n: usize) -> Result<(), TooMuchWork> {
+        match self.left.checked_sub(n as u64) {
+            Some(left) => {
+                self.left = left;
+                Ok(())
+            }
+            None => Err(TooMuchWork {
+                what: self.what,
+                limit: self.limit,
+            }),
+        }
+    }
+}
+
 /// Options of `lsyc infer ART.svg`.
 #[derive(Clone, Debug)]
 pub struct Options {
@@ -89,10 +127,7 @@ pub fn from_svg(
         return Err(InferError::TooLarge { file: name.into() });
     }
     let t = Instant::now();
-    let drawing = read::read(data).map_err(|why| InferError::NotSvg {
-        file: name.into(),
-        why,
-    })?;
+    let drawing = read::read(data).map_err(|why| InferError::refused(name, why))?;
     if drawing.largest > read::MAX_COORDINATE || !drawing.largest.is_finite() {
         return Err(InferError::Huge {
             file: name.into(),
@@ -128,7 +163,14 @@ pub fn from_svg(
     } else {
         opts.similarity
     };
-    let mut inst = shape::instancing(&drawing.elements, similarity, opts.reflect);
+    let too_much = |w: TooMuchWork| InferError::TooMuchWork {
+        file: name.into(),
+        elements: drawing.elements.len(),
+        what: w.what,
+        limit: w.limit,
+    };
+    let mut inst =
+        shape::instancing(&drawing.elements, similarity, opts.reflect).map_err(too_much)?;
     origin::find(&mut inst, tol);
     stats.kinds = inst.kinds.len();
     stats.instancing_ms = ms(t);
@@ -139,7 +181,7 @@ pub fn from_svg(
         .zip(&inst.of)
         .map(|(e, (k, f))| Inst::new(Sym::Element(*k), *f, e.min, e.max))
         .collect();
-    let grammar = rules::infer(insts, opts.weights, tol, progress);
+    let grammar = rules::infer(insts, opts.weights, tol, progress).map_err(too_much)?;
     stats.rules = grammar.rules.len();
     stats.rounds = grammar.rounds;
     stats.clusters = grammar.clusters;
@@ -201,7 +243,7 @@ pub fn replace_element(file: &mut File, name: &str, svg: &[u8]) -> Result<(), St
         .ok()
         .and_then(|d| size(&d))
         .map_or(1.0, |(_, r)| r);
-    let new = read::read(svg)?;
+    let new = read::read(svg).map_err(|why| why.to_string())?;
     let (centre, radius) = size(&new)
         .ok_or_else(|| "the drawing has no paths or shapes with an extent".to_string())?;
     let k = old_size / radius;

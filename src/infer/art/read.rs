@@ -10,8 +10,9 @@
 //! polygons into paths. Must not decide which elements are alike.
 
 use crate::infer::strokes::{self, Seg};
+use crate::infer::svg::{self, Refusal};
 use glam::DVec2;
-use usvg::tiny_skia_path::Transform;
+use usvg::tiny_skia_path::{PathVerb, Transform};
 
 /// Coordinates beyond this (in user units) are refused: usvg works in 32-bit
 /// floats, which cannot place such points precisely.
@@ -62,14 +63,71 @@ pub struct Drawing {
     pub largest: f64,
 }
 
-/// Reads the elements of an SVG document. The error is usvg's reason.
-pub fn read(data: &[u8]) -> Result<Drawing, String> {
-    let tree = usvg::Tree::from_data(data, &usvg::Options::default()).map_err(|e| e.to_string())?;
+/// The most subpaths a drawing may have (each path's subpaths are grouped
+/// into elements by their boxes).
+pub const MAX_SUBPATHS: usize = 2 * super::MAX_ELEMENTS;
+/// The most points (curves flattened) all elements may have together.
+pub const MAX_POINTS: usize = 4_000_000;
+/// The most pairs of subpath boxes compared while grouping subpaths (a sweep
+/// compares only boxes that meet along one axis, so a drawing needs this
+/// many only if its subpaths overlap each other in crowds).
+pub const MAX_BOX_TESTS: u64 = 100_000_000;
+
+/// Reads the elements of an SVG document. The error says why the document
+/// is not read, for a message.
+pub fn read(data: &[u8]) -> Result<Drawing, Refusal> {
+    let tree = svg::parse(data)?;
     let mut d = Drawing::default();
+    let mut work = Work::default();
     let user = strokes::user_space(data, &tree);
-    walk(tree.root(), user, &mut d);
+    // Groups depth first, in document order, with an explicit stack.
+    let mut stack = vec![tree.root().children().iter()];
+    while let Some(top) = stack.last_mut() {
+        let Some(node) = top.next() else {
+            stack.pop();
+            continue;
+        };
+        match node {
+            usvg::Node::Group(g) => stack.push(g.children().iter()),
+            usvg::Node::Path(p) => path_elements(p, user, &mut d, &mut work)?,
+            // Reported from the document (see `skipped_in_xml`).
+            usvg::Node::Image(_) | usvg::Node::Text(_) => {}
+        }
+    }
     d.skipped.extend(skipped_in_xml(data));
     Ok(d)
+}
+
+/// What reading has cost so far, against the limits.
+#[derive(Default)]
+struct Work {
+    subpaths: usize,
+    points: usize,
+    box_tests: u64,
+}
+
+impl Work {
+    fn subpaths(&mut self, n: usize) -> Result<(), Refusal> {
+        self.subpaths = self.subpaths.saturating_add(n);
+        if self.subpaths > MAX_SUBPATHS {
+            return Err(Refusal::TooMany {
+                what: "subpaths",
+                limit: MAX_SUBPATHS,
+            });
+        }
+        Ok(())
+    }
+
+    fn points(&mut self, n: usize) -> Result<(), Refusal> {
+        self.points = self.points.saturating_add(n);
+        if self.points > MAX_POINTS {
+            return Err(Refusal::TooMany {
+                what: "points (curves flattened)",
+                limit: MAX_POINTS,
+            });
+        }
+        Ok(())
+    }
 }
 
 /// Text, images and shapes with no size, found in the document itself (usvg
@@ -89,14 +147,25 @@ fn skipped_in_xml(data: &[u8]) -> Vec<String> {
                 .unwrap_or(f64::NAN)
         })
     };
+    // Whether each node is inside a definition (document order visits a
+    // parent before its children).
+    let slots = doc
+        .descendants()
+        .map(|n| n.id().get_usize() + 1)
+        .max()
+        .unwrap_or(0);
+    let mut hidden = vec![false; slots];
     let mut out = Vec::new();
     for n in doc.descendants().filter(|n| n.is_element()) {
-        if n.ancestors().any(|a| {
-            matches!(
-                a.tag_name().name(),
-                "defs" | "symbol" | "clipPath" | "mask" | "pattern" | "marker"
-            )
-        }) {
+        let inside = n.parent_element().is_some_and(|p| {
+            hidden[p.id().get_usize()]
+                || matches!(
+                    p.tag_name().name(),
+                    "defs" | "symbol" | "clipPath" | "mask" | "pattern" | "marker"
+                )
+        });
+        hidden[n.id().get_usize()] = inside;
+        if inside {
             continue;
         }
         let id = id_note(n.attribute("id").unwrap_or(""));
@@ -118,17 +187,6 @@ fn skipped_in_xml(data: &[u8]) -> Vec<String> {
         }
     }
     out
-}
-
-fn walk(group: &usvg::Group, user: Transform, d: &mut Drawing) {
-    for node in group.children() {
-        match node {
-            usvg::Node::Group(g) => walk(g, user, d),
-            usvg::Node::Path(p) => path_elements(p, user, d),
-            // Reported from the document (see `skipped_in_xml`).
-            usvg::Node::Image(_) | usvg::Node::Text(_) => {}
-        }
-    }
 }
 
 fn id_note(id: &str) -> String {
@@ -158,9 +216,26 @@ fn overlaps(a: &(DVec2, DVec2), b: &(DVec2, DVec2)) -> bool {
     a.0.x <= b.1.x && b.0.x <= a.1.x && a.0.y <= b.1.y && b.0.y <= a.1.y
 }
 
-fn path_elements(path: &usvg::Path, user: Transform, d: &mut Drawing) {
+fn path_elements(
+    path: &usvg::Path,
+    user: Transform,
+    d: &mut Drawing,
+    work: &mut Work,
+) -> Result<(), Refusal> {
     if !path.is_visible() {
-        return;
+        return Ok(());
+    }
+    // The path's own points are fewer than its flattened ones, and its
+    // moves count its subpaths: too many is refused before they are built.
+    let data = path.data();
+    work.points(data.points().len())?;
+    let moves = data
+        .verbs()
+        .iter()
+        .filter(|v| **v == PathVerb::Move)
+        .count();
+    if work.subpaths.saturating_add(moves) > MAX_SUBPATHS {
+        return work.subpaths(moves);
     }
     let t = user.pre_concat(path.abs_transform());
     let scale = f64::from((t.sx * t.sy - t.kx * t.ky).abs()).sqrt();
@@ -173,11 +248,13 @@ fn path_elements(path: &usvg::Path, user: Transform, d: &mut Drawing) {
             .filter(|w| w.is_finite() && *w > 0.0),
     };
     let subs = strokes::subpaths(path, user);
+    work.subpaths(subs.len())?;
     // Each subpath with its polyline and box.
     type Part = (Vec<Seg>, Vec<DVec2>, (DVec2, DVec2));
     let mut parts: Vec<Part> = Vec::new();
     for sub in subs {
         let flat = strokes::flatten(&sub);
+        work.points(flat.len())?;
         for p in &flat {
             d.largest = d.largest.max(p.x.abs()).max(p.y.abs());
         }
@@ -188,41 +265,13 @@ fn path_elements(path: &usvg::Path, user: Transform, d: &mut Drawing) {
         parts.push((sub, flat, b));
     }
     if parts.is_empty() {
-        return;
+        return Ok(());
     }
-    // Union subpaths whose boxes overlap (a hole with its ring).
-    let n = parts.len();
-    let mut group: Vec<usize> = (0..n).collect();
-    fn find(g: &mut [usize], mut i: usize) -> usize {
-        while g[i] != i {
-            g[i] = g[g[i]];
-            i = g[i];
-        }
-        i
-    }
-    for i in 0..n {
-        for j in i + 1..n {
-            if overlaps(&parts[i].2, &parts[j].2) {
-                let (a, b) = (find(&mut group, i), find(&mut group, j));
-                if a != b {
-                    group[a.max(b)] = a.min(b);
-                }
-            }
-        }
-    }
-    let mut order: Vec<usize> = Vec::new();
-    let mut members: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for i in 0..n {
-        let r = find(&mut group, i);
-        if members[r].is_empty() {
-            order.push(r);
-        }
-        members[r].push(i);
-    }
-    for r in order {
+    let boxes: Vec<(DVec2, DVec2)> = parts.iter().map(|p| p.2).collect();
+    for members in overlapping(&boxes, &mut work.box_tests)? {
         let mut subpaths = Vec::new();
         let mut outline = Vec::new();
-        for &i in &members[r] {
+        for &i in &members {
             subpaths.push(parts[i].0.clone());
             outline.push(parts[i].1.clone());
         }
@@ -237,6 +286,73 @@ fn path_elements(path: &usvg::Path, user: Transform, d: &mut Drawing) {
             max,
         });
     }
+    Ok(())
+}
+
+/// The groups of `boxes` that overlap, directly or through others (a hole
+/// with its ring): each group's members in order, the groups in the order of
+/// their first members. A sweep along the axis on which the boxes are
+/// shorter compares only boxes that meet on it, and drops a box from the
+/// sweep once a later one covers it across the sweep (any box that meets the
+/// dropped one meets the later one too, which is in the same group);
+/// `tests` counts the comparisons against `MAX_BOX_TESTS`.
+fn overlapping(boxes: &[(DVec2, DVec2)], tests: &mut u64) -> Result<Vec<Vec<usize>>, Refusal> {
+    let n = boxes.len();
+    // Sweep along x unless the boxes are longer in x than in y, in total.
+    let (wide, tall) = boxes.iter().fold((0.0, 0.0), |(w, t), b| {
+        (w + (b.1.x - b.0.x), t + (b.1.y - b.0.y))
+    });
+    let (along, across) = if wide <= tall { (0, 1) } else { (1, 0) };
+    let lo = |i: usize, axis: usize| boxes[i].0[axis];
+    let hi = |i: usize, axis: usize| boxes[i].1[axis];
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| lo(a, along).total_cmp(&lo(b, along)).then(a.cmp(&b)));
+    let mut group: Vec<usize> = (0..n).collect();
+    fn find(g: &mut [usize], mut i: usize) -> usize {
+        while g[i] != i {
+            g[i] = g[g[i]];
+            i = g[i];
+        }
+        i
+    }
+    let mut active: Vec<usize> = Vec::new();
+    for &i in &order {
+        active.retain(|&j| hi(j, along) >= lo(i, along));
+        *tests += active.len() as u64;
+        if *tests > MAX_BOX_TESTS {
+            return Err(Refusal::Crowded {
+                limit: MAX_BOX_TESTS,
+            });
+        }
+        for &j in &active {
+            if overlaps(&boxes[i], &boxes[j]) {
+                let (a, b) = (find(&mut group, i), find(&mut group, j));
+                if a != b {
+                    group[a.max(b)] = a.min(b);
+                }
+            }
+        }
+        // Covered across the sweep and ending no later: `i` stands for it.
+        active.retain(|&j| {
+            !(lo(i, across) <= lo(j, across)
+                && hi(j, across) <= hi(i, across)
+                && hi(j, along) <= hi(i, along))
+        });
+        active.push(i);
+    }
+    let mut order: Vec<usize> = Vec::new();
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for i in 0..n {
+        let r = find(&mut group, i);
+        if members[r].is_empty() {
+            order.push(r);
+        }
+        members[r].push(i);
+    }
+    Ok(order
+        .into_iter()
+        .map(|r| std::mem::take(&mut members[r]))
+        .collect())
 }
 
 #[cfg(test)]

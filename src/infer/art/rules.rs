@@ -16,6 +16,7 @@
 
 use super::shape::{Frame, wrap};
 use super::space::{Grid, Point, Tr, cluster};
+use super::{Budget, TooMuchWork};
 use glam::DVec2;
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 
@@ -179,13 +180,23 @@ const LINEAR_STEP_MAX: f64 = 30.0 * std::f64::consts::PI / 180.0;
 /// Neighbours compared per instance.
 const NEIGHBOURS: usize = 8;
 
-/// Runs the loop over `insts`; `progress` is told how many are left.
+/// The work limit of the loop, in transform-space points clustered over all
+/// rounds (each round clusters about 16 points per live instance, and linear
+/// sequences up to 16 times more for the steps between them), plus one per
+/// live instance and round. A drawing of a thousand elements needs well
+/// under a million; a chain of 30,000 strokes about four million (some
+/// five seconds).
+pub const MAX_WORK: u64 = 4_000_000;
+
+/// Runs the loop over `insts`; `progress` is told how many are left. Stops
+/// with `TooMuchWork` rather than run for minutes.
 pub fn infer(
     mut insts: Vec<Inst>,
     weights: Weights,
     tol: Tolerance,
     progress: &mut dyn FnMut(usize),
-) -> Grammar {
+) -> Result<Grammar, TooMuchWork> {
+    let mut budget = Budget::new("transform-space points clustered", MAX_WORK);
     let (lo, hi) = insts.iter().fold(
         (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
         |(lo, hi), i| (lo.min(i.min), hi.max(i.max)),
@@ -208,11 +219,12 @@ pub fn infer(
                 elements,
                 "every element is drawn exactly once"
             );
-            return g;
+            return Ok(g);
         }
         g.rounds += 1;
+        budget.spend(live.len())?;
         let edges = edges(&insts, &live, diagonal);
-        let (mut candidates, clusters) = candidates(&insts, &edges, tol);
+        let (mut candidates, clusters) = candidates(&insts, &edges, tol, &mut budget)?;
         g.clusters += clusters;
         let best = choose(&mut candidates, weights);
         match best {
@@ -298,7 +310,12 @@ fn close(f: &Frame, want: &Frame, step: f64, size: f64, tol: Tolerance) -> bool 
 }
 
 /// All candidates of a round, and the number of clusters.
-fn candidates(insts: &[Inst], edges: &[Edge], tol: Tolerance) -> (Vec<Candidate>, usize) {
+fn candidates(
+    insts: &[Inst],
+    edges: &[Edge],
+    tol: Tolerance,
+    budget: &mut Budget,
+) -> Result<(Vec<Candidate>, usize), TooMuchWork> {
     let mut spaces: BTreeMap<(Sym, Sym), Vec<usize>> = BTreeMap::new();
     for (k, e) in edges.iter().enumerate() {
         spaces
@@ -316,6 +333,7 @@ fn candidates(insts: &[Inst], edges: &[Edge], tol: Tolerance) -> (Vec<Candidate>
     let mut count = 0;
     for ((a, b), ks) in &spaces {
         let points: Vec<Point> = ks.iter().map(|&k| point(&edges[k].t, tol)).collect();
+        budget.spend(points.len())?;
         let (label, centres) = cluster(&points, turn);
         count += centres.len();
         let mut groups: Vec<Vec<usize>> = vec![Vec::new(); centres.len()];
@@ -340,10 +358,10 @@ fn candidates(insts: &[Inst], edges: &[Edge], tol: Tolerance) -> (Vec<Candidate>
                     }
                 }
             }
-            out.extend(linear(insts, edges, &index, ks, tol));
+            out.extend(linear(insts, edges, &index, ks, tol, budget)?);
         }
     }
-    (out, count)
+    Ok((out, count))
 }
 
 /// Chains (or pairs, across kinds) of one cluster.
@@ -510,6 +528,88 @@ fn seq_candidate(
     })
 }
 
+/// The steps between consecutive edges of `group` (an edge into an
+/// instance and an edge out of it, not straight back): the links, and the
+/// change of turn and twist along each, in tolerance units.
+fn step_links(
+    edges: &[Edge],
+    group: &[usize],
+    tol: Tolerance,
+) -> (Vec<(usize, usize)>, Vec<Point>) {
+    let mut out_of: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for &k in group {
+        out_of.entry(edges[k].from).or_default().push(k);
+    }
+    // Steps between consecutive edges.
+    let mut links: Vec<(usize, usize)> = Vec::new();
+    let mut deltas: Vec<Point> = Vec::new();
+    for &k in group {
+        for &f in out_of.get(&edges[k].to).into_iter().flatten() {
+            if edges[f].to == edges[k].from {
+                continue;
+            }
+            let (a, b) = (&edges[k].t, &edges[f].t);
+            let da = wrap(b.alpha - a.alpha) / tol.angle;
+            let db = wrap(b.beta - a.beta) / tol.angle;
+            links.push((k, f));
+            deltas.push([da, 0.0, 0.0, db]);
+        }
+    }
+    (links, deltas)
+}
+
+/// The chains of instances linked by edges whose steps are in cluster `top`
+/// of `dl` (one label per link), node-disjoint, with their transforms.
+fn linear_chains(
+    edges: &[Edge],
+    links: &[(usize, usize)],
+    dl: &[usize],
+    top: usize,
+) -> Vec<(Vec<usize>, Vec<Tr>)> {
+    let mut next: BTreeMap<usize, usize> = BTreeMap::new();
+    let mut has_prev: HashSet<usize> = HashSet::new();
+    let mut used_nodes: HashSet<usize> = HashSet::new();
+    for (i, &(k, f)) in links.iter().enumerate() {
+        if dl[i] != top || next.contains_key(&k) || has_prev.contains(&f) {
+            continue;
+        }
+        next.insert(k, f);
+        has_prev.insert(f);
+    }
+    // Edge chains to instance chains, node-disjoint.
+    let mut chains: Vec<(Vec<usize>, Vec<Tr>)> = Vec::new();
+    let starts: Vec<usize> = next
+        .keys()
+        .copied()
+        .filter(|k| !has_prev.contains(k))
+        .collect();
+    for s in starts {
+        let mut nodes = vec![edges[s].from];
+        let mut in_chain: HashSet<usize> = HashSet::from([edges[s].from]);
+        let mut ts = Vec::new();
+        let mut k = s;
+        let mut seen = HashSet::new();
+        loop {
+            let e = &edges[k];
+            if used_nodes.contains(&e.to) || !seen.insert(k) || in_chain.contains(&e.to) {
+                break;
+            }
+            nodes.push(e.to);
+            in_chain.insert(e.to);
+            ts.push(e.t);
+            match next.get(&k) {
+                Some(&f) => k = f,
+                None => break,
+            }
+        }
+        if ts.len() >= 2 && !used_nodes.contains(&nodes[0]) {
+            used_nodes.extend(nodes.iter().copied());
+            chains.push((nodes, ts));
+        }
+    }
+    chains
+}
+
 /// Chains whose turns change by a constant step: the (d, s) subspace.
 fn linear(
     insts: &[Inst],
@@ -517,7 +617,8 @@ fn linear(
     index: &Index,
     ks: &[usize],
     tol: Tolerance,
-) -> Option<Candidate> {
+    budget: &mut Budget,
+) -> Result<Option<Candidate>, TooMuchWork> {
     let points: Vec<Point> = ks
         .iter()
         .map(|&k| {
@@ -525,9 +626,11 @@ fn linear(
             [0.0, p[1], p[2], 0.0]
         })
         .collect();
+    budget.spend(points.len())?;
     let (label, centres) = cluster(&points, 0.0);
     let mut best: Option<Candidate> = None;
     for c in 0..centres.len() {
+        budget.spend(ks.len())?;
         let group: Vec<usize> = ks
             .iter()
             .zip(&label)
@@ -537,28 +640,11 @@ fn linear(
         if group.len() < 3 {
             continue;
         }
-        let mut out_of: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
-        for &k in &group {
-            out_of.entry(edges[k].from).or_default().push(k);
-        }
-        // Steps between consecutive edges.
-        let mut links: Vec<(usize, usize)> = Vec::new();
-        let mut deltas: Vec<Point> = Vec::new();
-        for &k in &group {
-            for &f in out_of.get(&edges[k].to).into_iter().flatten() {
-                if edges[f].to == edges[k].from {
-                    continue;
-                }
-                let (a, b) = (&edges[k].t, &edges[f].t);
-                let da = wrap(b.alpha - a.alpha) / tol.angle;
-                let db = wrap(b.beta - a.beta) / tol.angle;
-                links.push((k, f));
-                deltas.push([da, 0.0, 0.0, db]);
-            }
-        }
+        let (links, deltas) = step_links(edges, &group, tol);
         if links.len() < 2 {
             continue;
         }
+        budget.spend(deltas.len())?;
         let (dl, dc) = cluster(&deltas, 0.0);
         let mut sizes = vec![0usize; dc.len()];
         for l in &dl {
@@ -578,45 +664,7 @@ fn linear(
         if sizes[top] < 2 {
             continue;
         }
-        let mut next: BTreeMap<usize, usize> = BTreeMap::new();
-        let mut has_prev: HashSet<usize> = HashSet::new();
-        let mut used_nodes: HashSet<usize> = HashSet::new();
-        for (i, &(k, f)) in links.iter().enumerate() {
-            if dl[i] != top || next.contains_key(&k) || has_prev.contains(&f) {
-                continue;
-            }
-            next.insert(k, f);
-            has_prev.insert(f);
-        }
-        // Edge chains to instance chains, node-disjoint.
-        let mut chains: Vec<(Vec<usize>, Vec<Tr>)> = Vec::new();
-        let starts: Vec<usize> = next
-            .keys()
-            .copied()
-            .filter(|k| !has_prev.contains(k))
-            .collect();
-        for s in starts {
-            let mut nodes = vec![edges[s].from];
-            let mut ts = Vec::new();
-            let mut k = s;
-            let mut seen = HashSet::new();
-            loop {
-                let e = &edges[k];
-                if used_nodes.contains(&e.to) || !seen.insert(k) || nodes.contains(&e.to) {
-                    break;
-                }
-                nodes.push(e.to);
-                ts.push(e.t);
-                match next.get(&k) {
-                    Some(&f) => k = f,
-                    None => break,
-                }
-            }
-            if ts.len() >= 2 && !used_nodes.contains(&nodes[0]) {
-                used_nodes.extend(nodes.iter().copied());
-                chains.push((nodes, ts));
-            }
-        }
+        let mut chains = linear_chains(edges, &links, &dl, top);
         if chains.is_empty() {
             continue;
         }
@@ -681,7 +729,63 @@ fn linear(
             best = Some(cand);
         }
     }
-    best
+    Ok(best)
+}
+
+/// The depth of the complete binary tree below `v` whose children are
+/// `cx[v]` and `cy[v]` (0 for a leaf), memoised in `memo`. A node met again
+/// while its own depth is being found (`open`: a cycle) counts as a leaf.
+/// Iterative, so that a long chain cannot overflow the stack: each frame is
+/// one step of the recursive definition
+/// `depth(v) = 1 + min(depth(cx[v]), depth(cy[v]))`.
+fn depth_of(
+    v: usize,
+    cx: &HashMap<usize, usize>,
+    cy: &HashMap<usize, usize>,
+    memo: &mut HashMap<usize, u32>,
+    open: &mut HashSet<usize>,
+) -> u32 {
+    enum Step {
+        /// Find the depth of this node.
+        Enter(usize),
+        /// The first child's depth is found; find the second's (node, second child).
+        Second(usize, usize),
+        /// Both are found (node, first child's depth).
+        Done(usize, u32),
+    }
+    let mut calls = vec![Step::Enter(v)];
+    let mut found = 0;
+    while let Some(step) = calls.pop() {
+        match step {
+            Step::Enter(v) => {
+                if let Some(&d) = memo.get(&v) {
+                    found = d;
+                    continue;
+                }
+                match (cx.get(&v), cy.get(&v)) {
+                    (Some(&a), Some(&b)) if a != b && open.insert(v) => {
+                        calls.push(Step::Second(v, b));
+                        calls.push(Step::Enter(a));
+                    }
+                    _ => {
+                        memo.insert(v, 0);
+                        found = 0;
+                    }
+                }
+            }
+            Step::Second(v, b) => {
+                calls.push(Step::Done(v, found));
+                calls.push(Step::Enter(b));
+            }
+            Step::Done(v, first) => {
+                let d = first.min(found).saturating_add(1);
+                open.remove(&v);
+                memo.insert(v, d);
+                found = d;
+            }
+        }
+    }
+    found
 }
 
 /// Complete binary trees whose children come from clusters `x` and `y`.
@@ -713,30 +817,9 @@ fn branching(
     }
     // Depth of the complete tree below each node.
     let mut depth: HashMap<usize, u32> = HashMap::new();
-    fn depth_of(
-        v: usize,
-        cx: &HashMap<usize, usize>,
-        cy: &HashMap<usize, usize>,
-        memo: &mut HashMap<usize, u32>,
-        stack: &mut HashSet<usize>,
-    ) -> u32 {
-        if let Some(&d) = memo.get(&v) {
-            return d;
-        }
-        let d = match (cx.get(&v), cy.get(&v)) {
-            (Some(&a), Some(&b)) if a != b && stack.insert(v) => {
-                let d = 1 + depth_of(a, cx, cy, memo, stack).min(depth_of(b, cx, cy, memo, stack));
-                stack.remove(&v);
-                d
-            }
-            _ => 0,
-        };
-        memo.insert(v, d);
-        d
-    }
-    let mut stack = HashSet::new();
+    let mut open = HashSet::new();
     for &v in &both {
-        depth_of(v, &cx, &cy, &mut depth, &mut stack);
+        depth_of(v, &cx, &cy, &mut depth, &mut open);
     }
     let mut roots: Vec<(usize, u32)> = both
         .iter()

@@ -15,11 +15,16 @@
 //! keeps its guarantee. Must not know about rules.
 
 use super::read::Element;
+use super::{Budget, TooMuchWork};
 use glam::DVec2;
 use std::f64::consts::{PI, TAU};
 
 /// Samples per outline for the alignment check.
 const SAMPLES: usize = 48;
+/// The most element-to-kind comparisons of instancing (each element is
+/// compared with the kinds found before it until one fits, so a drawing of n
+/// elements all unlike each other needs n²/2): the work limit of instancing.
+pub const MAX_COMPARISONS: u64 = 15_000_000;
 /// Harmonics in the description.
 const HARMONICS: usize = 12;
 /// A harmonic at least this strong fixes the rotation.
@@ -335,7 +340,12 @@ fn mirrored(sh: &Shape) -> Option<Shape> {
     Shape::of(&lines)
 }
 
-pub fn instancing(elements: &[Element], tolerance: f64, reflect: bool) -> Instancing {
+pub fn instancing(
+    elements: &[Element],
+    tolerance: f64,
+    reflect: bool,
+) -> Result<Instancing, TooMuchWork> {
+    let mut budget = Budget::new("comparisons of element outlines", MAX_COMPARISONS);
     let shapes: Vec<Shape> = elements
         .iter()
         .map(|e| {
@@ -359,6 +369,8 @@ pub fn instancing(elements: &[Element], tolerance: f64, reflect: bool) -> Instan
     let mut of: Vec<(usize, Frame)> = Vec::with_capacity(elements.len());
     // Choices of rotation for instances of symmetric kinds.
     let mut choices: Vec<Vec<f64>> = Vec::with_capacity(elements.len());
+    // Whether each kind has a mirror kind.
+    let mut mirrored_by: Vec<bool> = Vec::new();
     for (i, e) in elements.iter().enumerate() {
         let sh = &shapes[i];
         let mut found = None;
@@ -367,6 +379,7 @@ pub fn instancing(elements: &[Element], tolerance: f64, reflect: bool) -> Instan
             if r.style.key() != e.style.key() || r.subpaths.len() != e.subpaths.len() {
                 continue;
             }
+            budget.spend(1)?;
             let fits = kind_shapes[k].align(sh, tolerance);
             if !fits.is_empty() {
                 found = Some((k, fits));
@@ -378,7 +391,7 @@ pub fn instancing(elements: &[Element], tolerance: f64, reflect: bool) -> Instan
             for k in 0..kinds.len() {
                 let r = &elements[kinds[k].representative];
                 if kinds[k].mirror_of.is_some()
-                    || kinds.iter().any(|m| m.mirror_of == Some(k))
+                    || mirrored_by[k]
                     || r.style.key() != e.style.key()
                     || r.subpaths.len() != e.subpaths.len()
                 {
@@ -387,12 +400,15 @@ pub fn instancing(elements: &[Element], tolerance: f64, reflect: bool) -> Instan
                 let Some(m) = mirrored(&kind_shapes[k]) else {
                     continue;
                 };
+                budget.spend(1)?;
                 let fits = m.align(sh, tolerance);
                 if !fits.is_empty() {
                     kinds.push(Kind {
                         mirror_of: Some(k),
                         ..kinds[k].clone()
                     });
+                    mirrored_by[k] = true;
+                    mirrored_by.push(false);
                     kind_shapes.push(m);
                     found = Some((kinds.len() - 1, fits));
                     break;
@@ -423,6 +439,7 @@ pub fn instancing(elements: &[Element], tolerance: f64, reflect: bool) -> Instan
                     None => 0,
                     Some(_) => sh.align(sh, tolerance).len().max(1),
                 };
+                mirrored_by.push(false);
                 kinds.push(Kind {
                     representative: i,
                     symmetry,
@@ -443,7 +460,7 @@ pub fn instancing(elements: &[Element], tolerance: f64, reflect: bool) -> Instan
         }
     }
     orient_symmetric(&kinds, &mut of, &choices);
-    Instancing { kinds, shapes, of }
+    Ok(Instancing { kinds, shapes, of })
 }
 
 /// Chooses, for instances of symmetric kinds, the variant of rotation closest

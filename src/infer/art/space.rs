@@ -14,6 +14,41 @@
 use super::shape::{Frame, rotate, wrap};
 use glam::DVec2;
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// A fast hasher for grid cells (small integer keys that lsyc computes, so no
+/// defence against chosen keys is needed beyond the mixing): the Fx hash
+/// of rustc. Iteration order of the maps is never used.
+#[derive(Clone, Copy, Default)]
+struct CellHasher(u64);
+
+impl Hasher for CellHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut word = [0u8; 8];
+            word[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(word));
+        }
+    }
+
+    fn write_u64(&mut self, n: u64) {
+        self.0 = (self.0.rotate_left(5) ^ n).wrapping_mul(0xf135_7aea_2e62_a9c5);
+    }
+
+    fn write_i64(&mut self, n: i64) {
+        self.write_u64(n as u64);
+    }
+
+    fn write_usize(&mut self, n: usize) {
+        self.write_u64(n as u64);
+    }
+
+    fn finish(&self) -> u64 {
+        self.0.rotate_left(26)
+    }
+}
+
+type CellMap<K, V> = HashMap<K, V, BuildHasherDefault<CellHasher>>;
 
 /// A transform from one frame to another, as turtle commands
 /// `+(alpha) f(d) *(s) +(beta)` (angles in radians).
@@ -80,7 +115,7 @@ pub struct Grid {
     cell: f64,
     cols: i64,
     rows: i64,
-    cells: HashMap<(i64, i64), Vec<usize>>,
+    cells: CellMap<(i64, i64), Vec<usize>>,
 }
 
 impl Grid {
@@ -108,7 +143,7 @@ impl Grid {
             cell,
             cols,
             rows,
-            cells: HashMap::new(),
+            cells: CellMap::default(),
         };
         for (i, p) in points.iter().enumerate() {
             let k = g.key(*p);
@@ -202,22 +237,24 @@ pub fn cluster(points: &[Point], turn: f64) -> (Vec<usize>, Vec<Point>) {
     };
     let close =
         |a: &Point, b: &Point| (0..4).all(|k| diff(a[k], b[k], k == 0 || k == 3).abs() <= 1.0);
+    // The 3⁴ cells around a cell; with fewer than three cells per turn some
+    // wrap onto each other and are counted once.
+    let offsets: Vec<[i64; 4]> = (0..81)
+        .map(|i: i64| [i / 27 % 3 - 1, i / 9 % 3 - 1, i / 3 % 3 - 1, i % 3 - 1])
+        .collect();
+    let distinct = cells_per_turn == 0 || cells_per_turn >= 3;
     let neighbours = |k: [i64; 4]| {
-        let mut out = Vec::with_capacity(81);
-        for a in -1..=1 {
-            for b in -1..=1 {
-                for c in -1..=1 {
-                    for d in -1..=1 {
-                        out.push(wrap_key([k[0] + a, k[1] + b, k[2] + c, k[3] + d]));
-                    }
-                }
-            }
+        let mut out: Vec<[i64; 4]> = offsets
+            .iter()
+            .map(|o| wrap_key([0, 1, 2, 3].map(|i| k[i].saturating_add(o[i]))))
+            .collect();
+        if !distinct {
+            out.sort_unstable();
+            out.dedup();
         }
-        out.sort_unstable();
-        out.dedup();
         out
     };
-    let mut grid: HashMap<[i64; 4], Vec<usize>> = HashMap::new();
+    let mut grid: CellMap<[i64; 4], Vec<usize>> = CellMap::default();
     for (i, p) in points.iter().enumerate() {
         grid.entry(wrap_key(key(p))).or_default().push(i);
     }
@@ -235,7 +272,7 @@ pub fn cluster(points: &[Point], turn: f64) -> (Vec<usize>, Vec<Point>) {
         .collect();
     let mut order: Vec<usize> = (0..points.len()).collect();
     order.sort_by(|&a, &b| density[b].cmp(&density[a]).then(a.cmp(&b)));
-    let mut leaders: HashMap<[i64; 4], Vec<usize>> = HashMap::new();
+    let mut leaders: CellMap<[i64; 4], Vec<usize>> = CellMap::default();
     let mut centres: Vec<Point> = Vec::new();
     let mut label = vec![0; points.len()];
     for i in order {

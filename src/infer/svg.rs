@@ -1,0 +1,256 @@
+//! Reading an SVG document safely: the checks a drawing passes before usvg
+//! sees it, and the usvg options both readers (`strokes`, `art::read`) use.
+//!
+//! Owns: refusing what would make usvg (or lsyc after it) run out of memory,
+//! stack or time on a hostile file: compressed data (usvg inflates it without
+//! a bound), too many XML nodes, elements nested too deep, `<use>` elements
+//! that draw themselves or expand to too many elements (a "billion laughs"
+//! of `<use>`s), and images (never loaded: an `href` may name any file, even
+//! a device). The checks are one pass over the XML, iterative and linear in
+//! its size. Must not decide what an element means.
+
+use std::collections::HashMap;
+use thiserror::Error;
+use usvg::roxmltree;
+
+/// The most XML nodes (elements, text, comments) a document may have.
+pub const MAX_XML_NODES: u32 = 2_000_000;
+/// The deepest nesting of elements, a `<use>` counting as the parent of
+/// what it draws (usvg refuses 1,024 levels with a less helpful message).
+pub const MAX_NESTING: usize = 1_000;
+/// The most elements a document may draw once every `<use>` is expanded
+/// (usvg's own bound).
+pub const MAX_EXPANDED: u64 = 1_000_000;
+
+/// Why a document is not read. The messages say what to change; the file
+/// name is added by whoever reports it.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum Refusal {
+    /// usvg's (or the XML parser's) reason.
+    #[error("{0}")]
+    NotSvg(String),
+    #[error("it is compressed (SVGZ); lsyc reads plain SVG text: decompress it first (gunzip)")]
+    Compressed,
+    #[error(
+        "it has more than {MAX_XML_NODES} XML nodes; lsyc reads drawings of up to {MAX_XML_NODES}"
+    )]
+    TooManyNodes,
+    #[error(
+        "its elements are nested more than {MAX_NESTING} levels deep (groups, and `<use>` with what it draws); lsyc reads drawings nested up to {MAX_NESTING} levels"
+    )]
+    TooDeep,
+    #[error(
+        "it draws more than {MAX_EXPANDED} elements once its `<use>` elements are expanded; lsyc reads drawings of up to {MAX_EXPANDED}"
+    )]
+    TooBig,
+    #[error(
+        "{what} draws{} which contains it (directly or through other `<use>` elements), so it would draw itself without end",
+        target_note(id)
+    )]
+    UseCycle { what: String, id: String },
+    /// Grouping the subpaths of paths into elements compared too many boxes.
+    #[error(
+        "its paths have subpaths that overlap in crowds: grouping them into elements would compare more than {limit} pairs of boxes (split or simplify those paths)"
+    )]
+    Crowded { limit: u64 },
+    /// A limit of the reader: `what` is counted while reading.
+    #[error("it has more than {limit} {what}; lsyc infers from drawings of up to {limit} {what}")]
+    TooMany { what: &'static str, limit: usize },
+}
+
+fn target_note(id: &str) -> String {
+    if id.is_empty() {
+        " an element".to_string()
+    } else {
+        format!(" the element with id `{id}`,")
+    }
+}
+
+/// The usvg options of both readers: no fonts, and images never loaded (a
+/// drawing's images are skipped anyway, and an `href` may name any file).
+pub fn options() -> usvg::Options<'static> {
+    usvg::Options {
+        image_href_resolver: usvg::ImageHrefResolver {
+            resolve_data: Box::new(|_, _, _| None),
+            resolve_string: Box::new(|_, _| None),
+        },
+        ..usvg::Options::default()
+    }
+}
+
+/// Checks `data` and parses it with usvg.
+pub fn parse(data: &[u8]) -> Result<usvg::Tree, Refusal> {
+    check(data)?;
+    usvg::Tree::from_data(data, &options()).map_err(|e| Refusal::NotSvg(e.to_string()))
+}
+
+/// The checks before usvg. A document that is not XML passes: usvg then
+/// says why it cannot read it, in its own words.
+pub fn check(data: &[u8]) -> Result<(), Refusal> {
+    if data.starts_with(&[0x1f, 0x8b]) {
+        return Err(Refusal::Compressed);
+    }
+    let Ok(text) = std::str::from_utf8(data) else {
+        return Ok(());
+    };
+    let opts = roxmltree::ParsingOptions {
+        allow_dtd: true,
+        nodes_limit: MAX_XML_NODES,
+        ..roxmltree::ParsingOptions::default()
+    };
+    let doc = match roxmltree::Document::parse_with_options(text, opts) {
+        Ok(doc) => doc,
+        Err(roxmltree::Error::NodesLimitReached) => return Err(Refusal::TooManyNodes),
+        Err(_) => return Ok(()),
+    };
+    expansion(&doc)
+}
+
+/// The element a `<use>` draws (its `href`, or else its `xlink:href`, `#id`).
+fn use_target<'a, 'input>(
+    node: roxmltree::Node<'a, 'input>,
+    ids: &HashMap<&'a str, roxmltree::Node<'a, 'input>>,
+) -> Option<roxmltree::Node<'a, 'input>> {
+    let href = node
+        .attributes()
+        .find(|a| a.name() == "href" && a.namespace().is_none())
+        .or_else(|| node.attributes().find(|a| a.name() == "href"))?;
+    let id = href.value().trim().strip_prefix('#')?;
+    ids.get(id.trim()).copied()
+}
+
+/// Walks the document as usvg will expand it (a `<use>`'s target is one
+/// more child of the `<use>`), depth first with an explicit stack, and
+/// finds the deepest nesting, the number of elements drawn and any cycle.
+/// Each element is visited once: sizes and depths of shared targets are
+/// remembered, so a `<use>` bomb costs no more than its text.
+fn expansion(doc: &roxmltree::Document) -> Result<(), Refusal> {
+    let mut ids: HashMap<&str, roxmltree::Node> = HashMap::new();
+    let mut slots = 0;
+    for n in doc.descendants() {
+        slots = slots.max(n.id().get_usize() + 1);
+        if n.is_element()
+            && let Some(id) = n.attribute("id")
+        {
+            ids.entry(id).or_insert(n);
+        }
+    }
+    #[derive(Clone, Copy, PartialEq)]
+    enum State {
+        New,
+        Open,
+        Done { size: u64, depth: usize },
+    }
+    let mut state = vec![State::New; slots];
+    fn successors<'a, 'input>(
+        n: roxmltree::Node<'a, 'input>,
+        ids: &HashMap<&'a str, roxmltree::Node<'a, 'input>>,
+    ) -> Vec<roxmltree::Node<'a, 'input>> {
+        let mut out: Vec<roxmltree::Node> = n.children().filter(|c| c.is_element()).collect();
+        if n.tag_name().name() == "use"
+            && let Some(t) = use_target(n, ids)
+        {
+            out.push(t);
+        }
+        out
+    }
+    for root in doc.descendants().filter(|n| n.is_element()) {
+        if state[root.id().get_usize()] != State::New {
+            continue;
+        }
+        // (node, its successors, how many of them are done)
+        let mut stack = vec![(root, successors(root, &ids), 0usize)];
+        state[root.id().get_usize()] = State::Open;
+        while let Some((node, next, k)) = stack.last_mut() {
+            if let Some(&child) = next.get(*k) {
+                *k += 1;
+                match state[child.id().get_usize()] {
+                    State::New => {
+                        state[child.id().get_usize()] = State::Open;
+                        let s = successors(child, &ids);
+                        stack.push((child, s, 0));
+                    }
+                    State::Open => {
+                        let what = match node.attribute("id") {
+                            Some(id) => {
+                                format!("the `<{}>` with id `{id}`", node.tag_name().name())
+                            }
+                            None => format!("a `<{}>`", node.tag_name().name()),
+                        };
+                        return Err(Refusal::UseCycle {
+                            what,
+                            id: child.attribute("id").unwrap_or("").to_string(),
+                        });
+                    }
+                    State::Done { .. } => {}
+                }
+                continue;
+            }
+            let mut size = 1u64;
+            let mut depth = 0usize;
+            for c in next.iter() {
+                if let State::Done { size: s, depth: d } = state[c.id().get_usize()] {
+                    size = size.saturating_add(s);
+                    depth = depth.max(d);
+                }
+            }
+            let depth = depth + 1;
+            if depth > MAX_NESTING {
+                return Err(Refusal::TooDeep);
+            }
+            if size > MAX_EXPANDED {
+                return Err(Refusal::TooBig);
+            }
+            state[node.id().get_usize()] = State::Done { size, depth };
+            stack.pop();
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEAD: &str =
+        r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink">"#;
+
+    #[test]
+    fn plain_drawings_pass() {
+        let svg = format!(
+            r##"{HEAD}<defs><path id="p" d="M0 0L1 1"/></defs><use href="#p"/><use xlink:href="#p"/><g><use href="#p"/></g></svg>"##
+        );
+        assert_eq!(check(svg.as_bytes()), Ok(()));
+        assert_eq!(check(b"not xml"), Ok(()));
+        assert_eq!(check(&[0xff, 0xfe]), Ok(()));
+    }
+
+    #[test]
+    fn cycles_depth_and_bombs_are_refused() {
+        let cycle = format!(
+            r##"{HEAD}<g id="a"><use href="#b"/></g><g id="b"><use xlink:href="#a"/></g></svg>"##
+        );
+        assert!(matches!(
+            check(cycle.as_bytes()),
+            Err(Refusal::UseCycle { .. })
+        ));
+        let own = format!(r##"{HEAD}<g id="a"><use href="#a"/></g></svg>"##);
+        assert!(matches!(
+            check(own.as_bytes()),
+            Err(Refusal::UseCycle { .. })
+        ));
+        let deep = format!("{HEAD}{}{}</svg>", "<g>".repeat(5000), "</g>".repeat(5000));
+        assert_eq!(check(deep.as_bytes()), Err(Refusal::TooDeep));
+        let mut bomb = format!(r#"{HEAD}<defs><path id="l0" d="M0 0L1 1"/>"#);
+        for k in 1..10 {
+            bomb.push_str(&format!(r#"<g id="l{k}">"#));
+            for _ in 0..10 {
+                bomb.push_str(&format!(r##"<use href="#l{}"/>"##, k - 1));
+            }
+            bomb.push_str("</g>");
+        }
+        bomb.push_str(r##"</defs><use href="#l9"/></svg>"##);
+        assert_eq!(check(bomb.as_bytes()), Err(Refusal::TooBig));
+        assert_eq!(check(&[0x1f, 0x8b, 8, 0]), Err(Refusal::Compressed));
+    }
+}
