@@ -126,13 +126,20 @@ pub fn flatten_steps(path: &BezPath, steps: usize) -> Vec<Polyline> {
     let mut out: Vec<Polyline> = Vec::new();
     let mut cur = Polyline::default();
     let mut last = DVec2::ZERO;
+    let mut start = DVec2::ZERO;
+    let mut reopen = false;
     let n = steps.max(1);
     let steps = (1..=n).map(|k| k as f64 / n as f64);
     for el in path.elements() {
+        if reopen && !matches!(el, PathEl::MoveTo(_) | PathEl::ClosePath) {
+            cur.points.push(start);
+        }
+        reopen = false;
         match *el {
             PathEl::MoveTo(a) => {
                 out.push(std::mem::take(&mut cur));
                 last = v(a);
+                start = last;
                 cur.points.push(last);
             }
             PathEl::LineTo(a) => {
@@ -166,6 +173,10 @@ pub fn flatten_steps(path: &BezPath, steps: usize) -> Vec<Polyline> {
             PathEl::ClosePath => {
                 cur.closed = true;
                 out.push(std::mem::take(&mut cur));
+                // As in SVG: what follows a close without a move starts a new
+                // subpath at the closed one's start.
+                last = start;
+                reopen = true;
             }
         }
     }
@@ -233,5 +244,14 @@ mod tests {
         assert_eq!(largest_outline("M0 0 L5 x"), None);
         assert_eq!(flatten_steps(&p, 12)[0].points.len(), 13);
         assert_eq!(flatten_steps(&p, CURVE_STEPS), subs);
+    }
+
+    #[test]
+    fn a_subpath_after_a_close_starts_where_the_closed_one_started() {
+        let p = parse("M1 1 L5 1 L5 5 Z L9 1").expect("reads");
+        let subs = flatten(&p);
+        assert_eq!(subs.len(), 2);
+        assert_eq!(subs[1].points, [DVec2::new(1.0, 1.0), DVec2::new(9.0, 1.0)]);
+        assert!(!subs[1].closed);
     }
 }

@@ -237,41 +237,37 @@ pub fn seg_points(s: &Seg) -> Vec<DVec2> {
 /// A subpath as a polyline: curves flattened into `CURVE_STEPS` pieces, no two
 /// consecutive points equal; a closed subpath ends where it started.
 pub fn flatten(sub: &[Seg]) -> Vec<DVec2> {
-    let mut points = Vec::new();
-    let mut last = DVec2::ZERO;
-    let mut start = DVec2::ZERO;
+    let pt = |p: DVec2| kurbo::Point::new(p.x, p.y);
+    let mut bez = kurbo::BezPath::new();
+    // A subpath that does not begin with a move starts at the origin, which is
+    // not one of its points.
+    let implicit = !matches!(sub.first(), Some(Seg::Move(_)) | None);
+    if implicit {
+        bez.move_to(pt(DVec2::ZERO));
+    }
     for s in sub {
         match *s {
-            Seg::Move(p) => {
-                push(&mut points, p);
-                last = p;
-                start = p;
-            }
-            Seg::Line(p) => {
-                push(&mut points, p);
-                last = p;
-            }
-            Seg::Quad(c, p) => {
-                for k in 1..=CURVE_STEPS {
-                    let s = k as f64 / CURVE_STEPS as f64;
-                    let u = 1.0 - s;
-                    push(&mut points, u * u * last + 2.0 * u * s * c + s * s * p);
-                }
-                last = p;
-            }
-            Seg::Cubic(c1, c2, p) => {
-                for k in 1..=CURVE_STEPS {
-                    let s = k as f64 / CURVE_STEPS as f64;
-                    let u = 1.0 - s;
-                    let (a, b, c, d) = (u * u * u, 3.0 * u * u * s, 3.0 * u * s * s, s * s * s);
-                    push(&mut points, a * last + b * c1 + c * c2 + d * p);
-                }
-                last = p;
-            }
-            Seg::Close => {
-                push(&mut points, start);
-                last = start;
-            }
+            Seg::Move(p) => bez.move_to(pt(p)),
+            Seg::Line(p) => bez.line_to(pt(p)),
+            Seg::Quad(c, p) => bez.quad_to(pt(c), pt(p)),
+            Seg::Cubic(c1, c2, p) => bez.curve_to(pt(c1), pt(c2), pt(p)),
+            Seg::Close => bez.close_path(),
+        }
+    }
+    // The one flattener, with inference's finer count; then no repeated
+    // points, and a closed subpath ends at its start.
+    let mut points = Vec::new();
+    for (i, line) in crate::path::flatten_steps(&bez, CURVE_STEPS)
+        .into_iter()
+        .enumerate()
+    {
+        let first = line.points.first().copied();
+        let skip = usize::from(i == 0 && implicit);
+        for &p in &line.points[skip..] {
+            push(&mut points, p);
+        }
+        if let (true, Some(f)) = (line.closed, first) {
+            push(&mut points, f);
         }
     }
     points

@@ -7,7 +7,8 @@
 
 use crate::support::{rel, render_plain, root};
 use glam::DVec2;
-use lsyc::infer::art::{self, Options, read, space::Grid};
+use lsyc::geometry::index::PointGrid as Grid;
+use lsyc::infer::art::{self, Options, read};
 use lsyc::{fmt, frontend};
 use std::path::Path;
 use std::process::Command;

@@ -12,7 +12,8 @@
 
 use super::rules::Tolerance;
 use super::shape::{Frame, Instancing, rotate, wrap};
-use super::space::{Grid, Point, cluster};
+use super::space::{Point, cluster};
+use crate::geometry::index::PointGrid;
 use glam::DVec2;
 
 /// A similarity x ↦ t + s·R(θ)·x.
@@ -125,7 +126,7 @@ pub fn find(inst: &mut Instancing, tol: Tolerance) {
         let radius = inst.shapes[inst.kinds[k].representative].radius;
         let frames: Vec<Frame> = members.iter().map(|&i| inst.of[i].1).collect();
         let points: Vec<DVec2> = frames.iter().map(|f| f.pos).collect();
-        let grid = Grid::new(&points);
+        let grid = PointGrid::new(&points);
         let cell = 0.02 * radius;
         let mut votes: Vec<(Point, Sim, [usize; 3])> = Vec::new();
         for j in 0..frames.len() {

@@ -15,8 +15,9 @@
 //! so what is drawn back stays on the input. Must not print or build syntax.
 
 use super::shape::{Frame, wrap};
-use super::space::{Grid, Point, Tr, cluster};
+use super::space::{Point, Tr, cluster};
 use super::{Budget, TooMuchWork};
+use crate::geometry::index::PointGrid;
 use glam::DVec2;
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 
@@ -237,7 +238,7 @@ pub fn infer(
 /// Directed edges between each live instance and its nearest neighbours.
 fn edges(insts: &[Inst], live: &[usize], diagonal: f64) -> Vec<Edge> {
     let centres: Vec<DVec2> = live.iter().map(|&i| insts[i].centre()).collect();
-    let grid = Grid::new(&centres);
+    let grid = PointGrid::new(&centres);
     let mut pairs: BTreeSet<(usize, usize)> = BTreeSet::new();
     for (a, c) in centres.iter().enumerate() {
         for b in grid.nearest(*c, NEIGHBOURS + 1) {

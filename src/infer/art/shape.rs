@@ -481,7 +481,7 @@ fn orient_symmetric(kinds: &[Kind], of: &mut [(usize, Frame)], choices: &[Vec<f6
             continue;
         }
         let points: Vec<DVec2> = members.iter().map(|&i| of[i].1.pos).collect();
-        let index = super::space::Grid::new(&points);
+        let index = crate::geometry::index::PointGrid::new(&points);
         let mut placed = vec![false; members.len()];
         let mut queue = std::collections::VecDeque::new();
         for start in 0..members.len() {

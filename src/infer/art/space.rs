@@ -108,109 +108,6 @@ impl Tr {
     }
 }
 
-/// A uniform grid over points for nearest-neighbour queries.
-pub struct Grid {
-    points: Vec<DVec2>,
-    min: DVec2,
-    cell: f64,
-    cols: i64,
-    rows: i64,
-    cells: CellMap<(i64, i64), Vec<usize>>,
-}
-
-impl Grid {
-    pub fn new(points: &[DVec2]) -> Grid {
-        let (min, max) = points.iter().fold(
-            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-        );
-        let size = if points.is_empty() {
-            DVec2::ONE
-        } else {
-            (max - min).max(DVec2::splat(1e-9))
-        };
-        // About two points per cell, also when the points lie on a line.
-        let n = points.len().max(1) as f64;
-        let cell = (2.0 * size.x * size.y / n)
-            .sqrt()
-            .max(2.0 * size.x.max(size.y) / n)
-            .max(1e-12);
-        let cols = (size.x / cell).floor() as i64 + 1;
-        let rows = (size.y / cell).floor() as i64 + 1;
-        let mut g = Grid {
-            points: points.to_vec(),
-            min: if points.is_empty() { DVec2::ZERO } else { min },
-            cell,
-            cols,
-            rows,
-            cells: CellMap::default(),
-        };
-        for (i, p) in points.iter().enumerate() {
-            let k = g.key(*p);
-            g.cells.entry(k).or_default().push(i);
-        }
-        g
-    }
-
-    fn key(&self, p: DVec2) -> (i64, i64) {
-        let q = (p - self.min) / self.cell;
-        (
-            (q.x.floor() as i64).clamp(0, self.cols - 1),
-            (q.y.floor() as i64).clamp(0, self.rows - 1),
-        )
-    }
-
-    /// The `k` points nearest to `p` (including any at `p` itself), nearest
-    /// first, ties by index.
-    pub fn nearest(&self, p: DVec2, k: usize) -> Vec<usize> {
-        let k = k.min(self.points.len());
-        if k == 0 {
-            return Vec::new();
-        }
-        let (cx, cy) = self.key(p);
-        let mut found: Vec<(f64, usize)> = Vec::new();
-        let mut ring = 0i64;
-        loop {
-            let (x0, x1) = ((cx - ring).max(0), (cx + ring).min(self.cols - 1));
-            let (y0, y1) = ((cy - ring).max(0), (cy + ring).min(self.rows - 1));
-            for x in x0..=x1 {
-                // Only the ring's border: all of a column at its two ends.
-                let border = (x - cx).abs() == ring;
-                let mut y = y0;
-                while y <= y1 {
-                    if border || (y - cy).abs() == ring {
-                        if let Some(c) = self.cells.get(&(x, y)) {
-                            for &i in c {
-                                found.push((self.points[i].distance_squared(p), i));
-                            }
-                        }
-                        y += 1;
-                    } else {
-                        // Jump to the bottom edge of the ring.
-                        y = (cy + ring).max(y + 1);
-                    }
-                }
-            }
-            // Every point within `ring` cells of p's cell has been seen; a
-            // point outside is at least `ring` cells away.
-            if found.len() >= k {
-                found.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                let reach = ring as f64 * self.cell;
-                if found[k - 1].0 <= reach * reach {
-                    break;
-                }
-            }
-            if ring > self.cols.max(self.rows) {
-                found.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                break;
-            }
-            ring += 1;
-        }
-        found.truncate(k);
-        found.into_iter().map(|(_, i)| i).collect()
-    }
-}
-
 /// A point of a transformation space in tolerance units: α/tol, ln d/tol,
 /// ln s/tol, β/tol. Angles wrap with period `turn` (2π over the angle tolerance).
 pub type Point = [f64; 4];
@@ -341,17 +238,6 @@ mod tests {
         assert!(wrap(c.rot - b.rot).abs() < 1e-12);
         assert!((c.scale - b.scale).abs() < 1e-12);
         assert!((t.s - 0.25).abs() < 1e-12);
-    }
-
-    #[test]
-    fn nearest_points_in_order() {
-        let pts: Vec<DVec2> = (0..100)
-            .map(|i| DVec2::new((i % 10) as f64, (i / 10) as f64 * 1.5))
-            .collect();
-        let g = Grid::new(&pts);
-        let n = g.nearest(DVec2::new(4.1, 3.0), 3);
-        assert_eq!(n, vec![24, 25, 23]);
-        assert_eq!(g.nearest(DVec2::new(100.0, 100.0), 1), vec![99]);
     }
 
     #[test]
