@@ -69,21 +69,9 @@ pub fn read(data: &[u8], max_strokes: usize) -> Result<Vec<Stroke>, Refusal> {
         max_strokes,
     };
     let user = user_space(data, &tree);
-    // Groups depth first, in document order, with an explicit stack.
-    let mut stack = vec![tree.root().children().iter()];
-    while let Some(top) = stack.last_mut() {
-        let Some(node) = top.next() else {
-            stack.pop();
-            continue;
-        };
-        match node {
-            usvg::Node::Group(g) => stack.push(g.children().iter()),
-            usvg::Node::Path(p) => {
-                if !r.path(p, user)? {
-                    break;
-                }
-            }
-            usvg::Node::Image(_) | usvg::Node::Text(_) => {}
+    for p in super::svg::paths(&tree) {
+        if !r.path(p, user)? {
+            break;
         }
     }
     Ok(r.out)

@@ -208,6 +208,26 @@ fn expansion(doc: &roxmltree::Document) -> Result<(), Refusal> {
     Ok(())
 }
 
+/// The paths of a parsed drawing, groups depth first in document order, with
+/// an explicit stack (the walk never recurses, however deep the groups). Both
+/// readers, elements and strokes, walk drawings through this.
+pub fn paths(tree: &usvg::Tree) -> impl Iterator<Item = &usvg::Path> + '_ {
+    let mut stack = vec![tree.root().children().iter()];
+    std::iter::from_fn(move || {
+        while let Some(top) = stack.last_mut() {
+            match top.next() {
+                None => {
+                    stack.pop();
+                }
+                Some(usvg::Node::Group(g)) => stack.push(g.children().iter()),
+                Some(usvg::Node::Path(p)) => return Some(p.as_ref()),
+                Some(usvg::Node::Image(_) | usvg::Node::Text(_)) => {}
+            }
+        }
+        None
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -80,19 +80,9 @@ pub fn read(data: &[u8]) -> Result<Drawing, Refusal> {
     let mut d = Drawing::default();
     let mut work = Work::default();
     let user = strokes::user_space(data, &tree);
-    // Groups depth first, in document order, with an explicit stack.
-    let mut stack = vec![tree.root().children().iter()];
-    while let Some(top) = stack.last_mut() {
-        let Some(node) = top.next() else {
-            stack.pop();
-            continue;
-        };
-        match node {
-            usvg::Node::Group(g) => stack.push(g.children().iter()),
-            usvg::Node::Path(p) => path_elements(p, user, &mut d, &mut work)?,
-            // Reported from the document (see `skipped_in_xml`).
-            usvg::Node::Image(_) | usvg::Node::Text(_) => {}
-        }
+    // Images and text are reported from the document (see `skipped_in_xml`).
+    for p in svg::paths(&tree) {
+        path_elements(p, user, &mut d, &mut work)?;
     }
     d.skipped.extend(skipped_in_xml(data));
     Ok(d)
