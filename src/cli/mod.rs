@@ -186,12 +186,31 @@ pub fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
+            use clap::error::ErrorKind;
+            let shown = matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion);
+            if !shown && json_requested() {
+                // A usage error honours `--error-format json` too: one object.
+                let text = e.to_string();
+                let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+                let message = lines
+                    .next()
+                    .unwrap_or("")
+                    .trim_start_matches("error: ")
+                    .to_string();
+                let rest: Vec<&str> = lines.map(str::trim).collect();
+                let v = serde_json::json!({
+                    "severity": "error",
+                    "message": message,
+                    "help": rest.join(" "),
+                });
+                eprintln!("{v}");
+                return ExitCode::from(2);
+            }
             let _ = e.print();
-            return match e.kind() {
-                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => {
-                    ExitCode::SUCCESS
-                }
-                _ => ExitCode::from(2),
+            return if shown {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(2)
             };
         }
     };
@@ -204,6 +223,16 @@ pub fn main() -> ExitCode {
         Command::Edit(args) => edit::run(args, &reporter),
     };
     ExitCode::from(status)
+}
+
+/// Whether the raw arguments ask for JSON messages (read before clap has
+/// understood them, for clap's own usage errors).
+fn json_requested() -> bool {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter().enumerate().any(|(i, a)| {
+        a == "--error-format=json"
+            || (a == "--error-format" && args.get(i + 1).is_some_and(|v| v == "json"))
+    })
 }
 
 /// Counts for a summary line: "2 errors, 1 warning".

@@ -337,6 +337,8 @@ fn json_mode_writes_only_json_lines() {
         vec!["check", &f, "--error-format", "json"],
         vec!["fmt", &f, "--check", "--error-format", "json"],
         vec!["infer", "--error-format", "json"],
+        vec!["run", &f, "--no-such-flag", "--error-format", "json"],
+        vec!["run", "--error-format=json"],
     ];
     for args in cases {
         let r = run(&args);
