@@ -33,13 +33,17 @@ pub enum ExprError {
     UnknownName { name: String, span: Span },
     #[error("unknown function `{name}`")]
     UnknownFunction { name: String, span: Span },
+    /// The parser's placeholder for an expression it could not read.
+    #[error("an expression that could not be read")]
+    Malformed { span: Span },
     #[error("{0}")]
     Vm(VmError),
 }
 
 impl ExprError {
     /// The error as a diagnostic. After a successful check only a failed
-    /// evaluation can happen; the other two are the checker's E0302 and E0303.
+    /// evaluation can happen; the others are the checker's E0302, E0303 and
+    /// the parser's E0201.
     pub fn diagnostic(&self) -> Diagnostic {
         match self {
             ExprError::UnknownName { span, .. } => {
@@ -49,6 +53,10 @@ impl ExprError {
             ExprError::UnknownFunction { span, .. } => {
                 Diagnostic::error(DiagCode::UnknownFunction, self.to_string())
                     .primary(*span, "no built-in function has this name")
+            }
+            ExprError::Malformed { span } => {
+                Diagnostic::error(DiagCode::UnexpectedToken, self.to_string())
+                    .primary(*span, "the parser could not read this")
             }
             ExprError::Vm(e) => Diagnostic::error(
                 match e.fault {
@@ -126,12 +134,7 @@ impl<'a> ExprCompiler<'a> {
             ExprKind::Bool(b) => {
                 self.chunk.push(Op::Const(f64::from(u8::from(*b))), e.span);
             }
-            ExprKind::Error => {
-                return Err(ExprError::UnknownName {
-                    name: String::new(),
-                    span: e.span,
-                });
-            }
+            ExprKind::Error => return Err(ExprError::Malformed { span: e.span }),
             ExprKind::Var(n) => {
                 if let Some(&slot) = self.env.get(n) {
                     self.chunk.push(Op::Load(slot), e.span);
@@ -153,14 +156,14 @@ impl<'a> ExprCompiler<'a> {
                 };
                 self.emit_folded(op, 1, e.span);
             }
-            ExprKind::Binary(op @ (BinOp::And | BinOp::Or), a, b) => {
-                self.logic(*op == BinOp::And, a, b, e.span)?;
-            }
-            ExprKind::Binary(op, a, b) => {
-                self.expr(a)?;
-                self.expr(b)?;
-                self.emit_folded(arithmetic(*op), 2, e.span);
-            }
+            ExprKind::Binary(op, a, b) => match arithmetic(*op) {
+                Some(code) => {
+                    self.expr(a)?;
+                    self.expr(b)?;
+                    self.emit_folded(code, 2, e.span);
+                }
+                None => self.logic(*op == BinOp::And, a, b, e.span)?,
+            },
             ExprKind::Call(f, args) => {
                 for a in args {
                     self.expr(a)?;
@@ -252,9 +255,10 @@ impl<'a> ExprCompiler<'a> {
     }
 }
 
-/// The instruction of a binary operator other than `&&` and `||`.
-fn arithmetic(op: BinOp) -> Op {
-    match op {
+/// The instruction of a binary operator; `None` for `&&` and `||`, which
+/// short-circuit (see `logic`).
+fn arithmetic(op: BinOp) -> Option<Op> {
+    Some(match op {
         BinOp::Add => Op::Add,
         BinOp::Sub => Op::Sub,
         BinOp::Mul => Op::Mul,
@@ -267,8 +271,6 @@ fn arithmetic(op: BinOp) -> Op {
         BinOp::Le => Op::Le,
         BinOp::Gt => Op::Gt,
         BinOp::Ge => Op::Ge,
-        // Compiled with jumps by `logic`; never reaches here.
-        BinOp::And => Op::Mul,
-        BinOp::Or => Op::Add,
-    }
+        BinOp::And | BinOp::Or => return None,
+    })
 }
