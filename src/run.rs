@@ -144,13 +144,14 @@ fn check_extent(b: &Bounds, prog: &Program) -> Result<(), Diagnostic> {
     if !b.any {
         return Ok(());
     }
-    let far = [b.min.x, b.min.y, b.max.x, b.max.y]
-        .into_iter()
-        .map(f64::abs)
-        .fold(
-            0.0,
-            |m: f64, v| if v.is_nan() { f64::INFINITY } else { m.max(v) },
-        );
+    check_corners([b.min.x, b.min.y, b.max.x, b.max.y], prog)
+}
+
+/// `check_extent` on a bounding box [minx, miny, maxx, maxy].
+fn check_corners(corners: [f64; 4], prog: &Program) -> Result<(), Diagnostic> {
+    let far = corners.into_iter().map(f64::abs).fold(0.0, |m: f64, v| {
+        if v.is_nan() { f64::INFINITY } else { m.max(v) }
+    });
     if far <= MAX_COORDINATE {
         return Ok(());
     }
@@ -225,10 +226,14 @@ pub fn write_output(
             Ok(drawn)
         }
         Format::Obj => {
-            measure(d, seed).map_err(OutputError::Diagnostic)?;
+            // One pass: the extent comes from what was drawn, checked before the
+            // mesh is finished (the file is written only if this succeeds).
             let options = render::obj::ObjOptions::for_program(&d.prog);
             let mut w = render::obj::ObjWriter::new(out, options);
             let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
+            if let Some(b) = drawn.bbox {
+                check_corners(b, &d.prog).map_err(OutputError::Diagnostic)?;
+            }
             w.finish()?;
             Ok(drawn)
         }

@@ -98,26 +98,21 @@ struct Work {
 
 impl Work {
     fn subpaths(&mut self, n: usize) -> Result<(), Refusal> {
-        self.subpaths = self.subpaths.saturating_add(n);
-        if self.subpaths > MAX_SUBPATHS {
-            return Err(Refusal::TooMany {
-                what: "subpaths",
-                limit: MAX_SUBPATHS,
-            });
-        }
-        Ok(())
+        count(&mut self.subpaths, n, MAX_SUBPATHS, "subpaths")
     }
 
     fn points(&mut self, n: usize) -> Result<(), Refusal> {
-        self.points = self.points.saturating_add(n);
-        if self.points > MAX_POINTS {
-            return Err(Refusal::TooMany {
-                what: "points (curves flattened)",
-                limit: MAX_POINTS,
-            });
-        }
-        Ok(())
+        count(&mut self.points, n, MAX_POINTS, "points (curves flattened)")
     }
+}
+
+/// Adds `n` to a running count; a refusal once it passes `limit`.
+fn count(total: &mut usize, n: usize, limit: usize, what: &'static str) -> Result<(), Refusal> {
+    *total = total.saturating_add(n);
+    if *total > limit {
+        return Err(Refusal::TooMany { what, limit });
+    }
+    Ok(())
 }
 
 /// Text, images and shapes with no size, found in the document itself (usvg
