@@ -69,8 +69,8 @@ pub fn read(data: &[u8], max_strokes: usize) -> Result<Vec<Stroke>, Refusal> {
         max_strokes,
     };
     let user = user_space(data, &tree);
-    for p in super::svg::paths(&tree) {
-        if !r.path(p, user)? {
+    for (p, t) in super::svg::paths(&tree) {
+        if !r.path(p, user.pre_concat(t))? {
             break;
         }
     }
@@ -93,9 +93,9 @@ struct Reader {
 }
 
 impl Reader {
-    /// Adds the strokes of `path`; `false` once there are more than enough.
-    fn path(&mut self, path: &usvg::Path, user: Transform) -> Result<bool, Refusal> {
-        let t = user.pre_concat(path.abs_transform());
+    /// Adds the strokes of `path`, whose coordinates `t` maps to the
+    /// document's user space; `false` once there are more than enough.
+    fn path(&mut self, path: &usvg::Path, t: Transform) -> Result<bool, Refusal> {
         // A width scales with the transform's mean scale factor.
         let scale = f64::from((t.sx * t.sy - t.kx * t.ky).abs()).sqrt();
         let width = path
@@ -107,7 +107,7 @@ impl Reader {
         if self.points.saturating_add(path.data().points().len()) > MAX_POINTS {
             return Err(too_many_points());
         }
-        for (k, sub) in subpaths(path, user).into_iter().enumerate() {
+        for (k, sub) in subpaths(path, t).into_iter().enumerate() {
             self.number += 1;
             let points = flatten(&sub);
             if points.len() < 2 {
@@ -134,7 +134,7 @@ impl Reader {
 
 /// The map from usvg's coordinates back to the document's user space: usvg
 /// puts the root `viewBox` (and a root `transform`) into one group around the
-/// content, which `abs_transform` includes; lsyc works in user units so that
+/// content, which the paths' transforms include; lsyc works in user units so that
 /// what it draws back lies on the input.
 pub fn user_space(data: &[u8], tree: &usvg::Tree) -> Transform {
     let root_group = || match tree.root().children() {
@@ -176,11 +176,11 @@ pub enum Seg {
     Close,
 }
 
-/// The subpaths of a path in world coordinates (its absolute transform and
-/// then `user` applied, y flipped up), exactly: curves stay curves. A subpath whose
-/// points are not all finite is dropped.
-pub fn subpaths(path: &usvg::Path, user: Transform) -> Vec<Vec<Seg>> {
-    let t = user.pre_concat(path.abs_transform());
+/// The subpaths of a path in world coordinates (`t`, the map from its own
+/// coordinates to the document's user space, applied, and y flipped up),
+/// exactly: curves stay curves. A subpath whose points are not all finite is
+/// dropped.
+pub fn subpaths(path: &usvg::Path, t: Transform) -> Vec<Vec<Seg>> {
     let map = |mut p: Point| {
         t.map_point(&mut p);
         DVec2::new(f64::from(p.x), -f64::from(p.y))

@@ -11,6 +11,7 @@
 
 use std::collections::HashMap;
 use thiserror::Error;
+use usvg::Transform;
 use usvg::roxmltree;
 
 /// The most XML nodes (elements, text, comments) a document may have.
@@ -208,19 +209,26 @@ fn expansion(doc: &roxmltree::Document) -> Result<(), Refusal> {
     Ok(())
 }
 
-/// The paths of a parsed drawing, groups depth first in document order, with
-/// an explicit stack (the walk never recurses, however deep the groups). Both
-/// readers, elements and strokes, walk drawings through this.
-pub fn paths(tree: &usvg::Tree) -> impl Iterator<Item = &usvg::Path> + '_ {
-    let mut stack = vec![tree.root().children().iter()];
+/// The paths of a parsed drawing, groups depth first in document order, each
+/// with its transform (usvg's user space to the path's own coordinates),
+/// with an explicit stack (the walk never recurses, however deep the
+/// groups). Both readers, elements and strokes, walk drawings through this.
+/// The transform composes the groups' own transforms: usvg 0.49's
+/// `abs_transform` applies a `<use>`'s transform twice when it draws a
+/// `<symbol>` (linebender/resvg#1056).
+pub fn paths(tree: &usvg::Tree) -> impl Iterator<Item = (&usvg::Path, Transform)> + '_ {
+    let mut stack = vec![(tree.root().children().iter(), Transform::identity())];
     std::iter::from_fn(move || {
-        while let Some(top) = stack.last_mut() {
+        while let Some((top, t)) = stack.last_mut() {
+            let t = *t;
             match top.next() {
                 None => {
                     stack.pop();
                 }
-                Some(usvg::Node::Group(g)) => stack.push(g.children().iter()),
-                Some(usvg::Node::Path(p)) => return Some(p.as_ref()),
+                Some(usvg::Node::Group(g)) => {
+                    stack.push((g.children().iter(), t.pre_concat(g.transform())))
+                }
+                Some(usvg::Node::Path(p)) => return Some((p.as_ref(), t)),
                 Some(usvg::Node::Image(_) | usvg::Node::Text(_)) => {}
             }
         }

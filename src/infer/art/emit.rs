@@ -12,7 +12,7 @@
 
 use super::read::Element;
 use super::rules::{Body, Grammar, Sym};
-use super::shape::{Frame, Instancing};
+use super::shape::{Frame, Instancing, map_subpaths};
 use super::space::Tr;
 use crate::ast::{
     BinOp, Block, ConstDecl, Element as ElementItem, Expr, ExprKind, File, Ident, Item, Lsystem,
@@ -308,17 +308,6 @@ fn placed(names: &Names, g: &Grammar, s: Sym, count: Option<Expr>) -> Vec<Module
     }
 }
 
-/// A segment with its points mapped by `f`.
-pub fn map_seg(s: &Seg, f: impl Fn(DVec2) -> DVec2) -> Seg {
-    match *s {
-        Seg::Move(p) => Seg::Move(f(p)),
-        Seg::Line(p) => Seg::Line(f(p)),
-        Seg::Quad(c, p) => Seg::Quad(f(c), f(p)),
-        Seg::Cubic(a, b, p) => Seg::Cubic(f(a), f(b), f(p)),
-        Seg::Close => Seg::Close,
-    }
-}
-
 /// SVG path data for subpaths, relative to `origin`, with about four
 /// significant digits for a shape of `radius`.
 pub fn path_data(subpaths: &[Vec<Seg>], origin: DVec2, radius: f64) -> String {
@@ -429,22 +418,11 @@ fn kinds(elements: &[Element], inst: &Instancing, names: &Names) -> Vec<Node<Ite
     for (k, kind) in inst.kinds.iter().enumerate() {
         let e = &elements[kind.representative];
         let sh = &inst.shapes[kind.representative];
-        // A mirror kind draws its twin's outline with x negated.
-        let subpaths: Vec<Vec<Seg>> = match kind.mirror_of {
-            Some(_) => e
-                .subpaths
-                .iter()
-                .map(|sub| {
-                    sub.iter()
-                        .map(|s| map_seg(s, |p| DVec2::new(2.0 * sh.centroid.x - p.x, p.y)))
-                        .collect()
-                })
-                .collect(),
-            None => e.subpaths.clone(),
-        };
+        // The outline in the kind's local frame.
+        let local = map_subpaths(&kind.subpaths, |p| kind.frame.local(p));
         let mut props = vec![string_prop(
             "path",
-            path_data(&subpaths, sh.centroid + kind.origin, sh.radius),
+            path_data(&local, DVec2::ZERO, sh.radius / kind.frame.scale),
         )];
         props.push(string_prop(
             "fill",

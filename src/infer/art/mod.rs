@@ -3,12 +3,14 @@
 //! Procedural Modeling by Automatic Generation of L-systems* (CGF 2010).
 //!
 //! Owns: the pipeline and its options and statistics: elements (`read`),
-//! kinds and frames (`shape`), the kinds' origins (`origin`), transformation spaces and clustering (`space`),
+//! kinds and frames (`shape`), the kinds' origins (`origin`) and local frames
+//! (`pivot`) where the drawing gives none, transformation spaces and clustering (`space`),
 //! rules level by level (`rules`) and the program (`emit`). Must not write
 //! files or print (the CLI does), and must not panic on any input.
 
 pub mod emit;
 pub mod origin;
+pub mod pivot;
 pub mod read;
 pub mod rules;
 pub mod shape;
@@ -171,7 +173,8 @@ pub fn from_svg(
     };
     let mut inst =
         shape::instancing(&drawing.elements, similarity, opts.reflect).map_err(too_much)?;
-    origin::find(&mut inst, tol);
+    let moved = origin::find(&mut inst, tol);
+    pivot::choose(&mut inst, &moved, tol);
     stats.kinds = inst.kinds.len();
     stats.instancing_ms = ms(t);
     let t = Instant::now();
@@ -252,7 +255,7 @@ pub fn replace_element(file: &mut File, name: &str, svg: &[u8]) -> Result<(), St
         for sub in &e.subpaths {
             subpaths.push(
                 sub.iter()
-                    .map(|s| emit::map_seg(s, |p| (p - centre) * k))
+                    .map(|s| shape::map_seg(s, |p| (p - centre) * k))
                     .collect::<Vec<_>>(),
             );
         }

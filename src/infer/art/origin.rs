@@ -116,9 +116,13 @@ fn refine(frames: &[Frame], runs: &[[usize; 3]], mut q: DVec2, radius: f64) -> D
 const NEIGHBOURS: usize = 2;
 
 /// Moves kinds' origins where runs of neighbours turn about one point, and
-/// the instances' frames with them.
-pub fn find(inst: &mut Instancing, tol: Tolerance) {
-    for k in 0..inst.kinds.len() {
+/// the instances' frames with them; says which kinds it moved.
+pub fn find(inst: &mut Instancing, tol: Tolerance) -> Vec<bool> {
+    let mut moved = vec![false; inst.kinds.len()];
+    for (k, moved) in moved.iter_mut().enumerate() {
+        if inst.kinds[k].given {
+            continue;
+        }
         let members: Vec<usize> = (0..inst.of.len()).filter(|&i| inst.of[i].0 == k).collect();
         if members.len() < 4 {
             continue;
@@ -201,10 +205,14 @@ pub fn find(inst: &mut Instancing, tol: Tolerance) {
             .map(|(v, _)| v.2)
             .collect();
         let q = refine(&frames, &runs, q, radius);
-        inst.kinds[k].origin = q;
-        for &i in &members {
-            let f = &mut inst.of[i].1;
-            f.pos += rotate(q, f.rot) * f.scale;
-        }
+        inst.reframe(
+            k,
+            &Frame {
+                pos: q,
+                ..Frame::IDENTITY
+            },
+        );
+        *moved = true;
     }
+    moved
 }

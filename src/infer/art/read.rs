@@ -51,6 +51,43 @@ pub struct Element {
     pub style: Style,
     pub min: DVec2,
     pub max: DVec2,
+    /// The map from the element's own path coordinates to the world, and
+    /// which definition it draws: the frame the drawing gives it.
+    pub placed: Placed,
+}
+
+/// How the drawing placed an element: the affine map from its path's own
+/// coordinates to the world (x ↦ (m0·x + m1·y + m2, m3·x + m4·y + m5)), and
+/// a key of the path data in those coordinates (with the element's place
+/// among the shapes of its path), equal for elements that draw one
+/// definition, such as the `<use>`s of one `<path>` or `<symbol>`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placed {
+    pub map: [f64; 6],
+    pub key: u64,
+}
+
+impl Placed {
+    /// The map's determinant (negative for a mirror image).
+    pub fn det(&self) -> f64 {
+        self.map[0] * self.map[4] - self.map[1] * self.map[3]
+    }
+
+    /// Whether the map is a similarity (rotation, uniform scale, perhaps a
+    /// reflection, and translation), within `tol` of its scale.
+    pub fn is_similarity(&self, tol: f64) -> bool {
+        let [a, b, _, c, d, _] = self.map;
+        let scale = self.det().abs().sqrt();
+        if !(scale.is_finite() && scale > 0.0) {
+            return false;
+        }
+        let t = tol * scale;
+        if self.det() > 0.0 {
+            (a - d).abs() <= t && (b + c).abs() <= t
+        } else {
+            (a + d).abs() <= t && (b - c).abs() <= t
+        }
+    }
 }
 
 /// The elements of a drawing and what was left out.
@@ -81,8 +118,8 @@ pub fn read(data: &[u8]) -> Result<Drawing, Refusal> {
     let mut work = Work::default();
     let user = strokes::user_space(data, &tree);
     // Images and text are reported from the document (see `skipped_in_xml`).
-    for p in svg::paths(&tree) {
-        path_elements(p, user, &mut d, &mut work)?;
+    for (p, t) in svg::paths(&tree) {
+        path_elements(p, user.pre_concat(t), &mut d, &mut work)?;
     }
     d.skipped.extend(skipped_in_xml(data));
     Ok(d)
@@ -201,9 +238,11 @@ fn overlaps(a: &(DVec2, DVec2), b: &(DVec2, DVec2)) -> bool {
     a.0.x <= b.1.x && b.0.x <= a.1.x && a.0.y <= b.1.y && b.0.y <= a.1.y
 }
 
+/// The elements of `path`, whose coordinates `t` maps to the document's
+/// user space.
 fn path_elements(
     path: &usvg::Path,
-    user: Transform,
+    t: Transform,
     d: &mut Drawing,
     work: &mut Work,
 ) -> Result<(), Refusal> {
@@ -222,8 +261,21 @@ fn path_elements(
     if work.subpaths.saturating_add(moves) > MAX_SUBPATHS {
         return work.subpaths(moves);
     }
-    let t = user.pre_concat(path.abs_transform());
     let scale = f64::from((t.sx * t.sy - t.kx * t.ky).abs()).sqrt();
+    // World coordinates flip y.
+    let map = [t.sx, t.kx, t.tx, -t.ky, -t.sy, -t.ty].map(f64::from);
+    let data_key = {
+        use std::hash::Hash;
+        let mut h = std::hash::DefaultHasher::new();
+        data.verbs().len().hash(&mut h);
+        for v in data.verbs() {
+            (*v as u8).hash(&mut h);
+        }
+        for p in data.points() {
+            (p.x.to_bits(), p.y.to_bits()).hash(&mut h);
+        }
+        h
+    };
     let style = Style {
         fill: path.fill().map(|f| color(f.paint())),
         stroke: path.stroke().map(|s| color(s.paint())),
@@ -232,7 +284,7 @@ fn path_elements(
             .map(|s| f64::from(s.width().get()) * scale)
             .filter(|w| w.is_finite() && *w > 0.0),
     };
-    let subs = strokes::subpaths(path, user);
+    let subs = strokes::subpaths(path, t);
     work.subpaths(subs.len())?;
     // Each subpath with its polyline and box.
     type Part = (Vec<Seg>, Vec<DVec2>, (DVec2, DVec2));
@@ -253,7 +305,17 @@ fn path_elements(
         return Ok(());
     }
     let boxes: Vec<(DVec2, DVec2)> = parts.iter().map(|p| p.2).collect();
-    for members in overlapping(&boxes, &mut work.box_tests)? {
+    for (part, members) in overlapping(&boxes, &mut work.box_tests)?
+        .into_iter()
+        .enumerate()
+    {
+        let key = {
+            use std::hash::{Hash, Hasher};
+            let mut h = data_key.clone();
+            part.hash(&mut h);
+            members.hash(&mut h);
+            h.finish()
+        };
         let mut subpaths = Vec::new();
         let mut outline = Vec::new();
         for &i in &members {
@@ -269,6 +331,7 @@ fn path_elements(
             style: style.clone(),
             min,
             max,
+            placed: Placed { map, key },
         });
     }
     Ok(())

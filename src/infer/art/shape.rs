@@ -16,7 +16,9 @@
 
 use super::read::Element;
 use super::{Budget, TooMuchWork};
+use crate::infer::strokes::Seg;
 use glam::DVec2;
+use std::collections::HashMap;
 use std::f64::consts::{PI, TAU};
 
 /// Samples per outline for the alignment check.
@@ -255,17 +257,25 @@ fn distance_to(p: DVec2, lines: &[Vec<DVec2>], map: impl Fn(DVec2) -> DVec2) -> 
     best.sqrt()
 }
 
-/// One kind of element: its representative and symmetry.
+/// One kind of element: its representative, symmetry and local frame.
 #[derive(Clone, Debug)]
 pub struct Kind {
     /// Index of the representative in the element list.
     pub representative: usize,
     /// Rotational symmetry order: 1 for none, k for k-fold, 0 for round.
     pub symmetry: usize,
-    /// The local frame's origin relative to the representative's centroid
-    /// (see `origin`): zero unless the drawing shows a better one.
-    pub origin: DVec2,
-    /// `Some(k)`: this kind is kind `k` mirrored (x negated in its local
+    /// The kind's local frame on its representative, in the world: the
+    /// element's path is written in this frame. The drawing's own frame when
+    /// it gives one (`given`); else at the centroid, unturned, until
+    /// `origin` and `pivot` find where a person would put it.
+    pub frame: Frame,
+    /// The drawing placed every instance of this kind through a transform
+    /// (`<use>`, a transformed group): the frames are the transforms'.
+    pub given: bool,
+    /// The representative's outline as this kind draws it, in the world
+    /// (mirrored for a mirror kind).
+    pub subpaths: Vec<Vec<Seg>>,
+    /// `Some(k)`: this kind is kind `k` mirrored (x negated in `k`'s local
     /// frame), found with `--reflect`; it shares `k`'s representative.
     pub mirror_of: Option<usize>,
 }
@@ -280,9 +290,20 @@ pub struct Frame {
 }
 
 impl Frame {
+    pub const IDENTITY: Frame = Frame {
+        pos: DVec2::ZERO,
+        rot: 0.0,
+        scale: 1.0,
+    };
+
     /// Maps a point of the representative's local frame into the world.
     pub fn apply(&self, p: DVec2) -> DVec2 {
         self.pos + rotate(p, self.rot) * self.scale
+    }
+
+    /// Maps a world point into this frame.
+    pub fn local(&self, p: DVec2) -> DVec2 {
+        rotate(p - self.pos, -self.rot) / self.scale
     }
 
     /// The frame `local` (given in this frame's coordinates) in the world.
@@ -313,6 +334,19 @@ impl Frame {
             scale: (frames.iter().map(|f| f.scale.ln()).sum::<f64>() / n).exp(),
         })
     }
+
+    /// The frame of a drawing's map `m` (a similarity) for the path read
+    /// with its x and y multiplied by `flip` (each ±1): `m` after `flip`,
+    /// which must not mirror.
+    fn of_map(m: &[f64; 6], flip: DVec2) -> Frame {
+        let [a, _, tx, c, _, ty] = *m;
+        let (a, c) = (a * flip.x, c * flip.x);
+        Frame {
+            pos: DVec2::new(tx, ty),
+            rot: c.atan2(a),
+            scale: (a * a + c * c).sqrt(),
+        }
+    }
 }
 
 /// The kinds of a drawing, and each element's kind and frame.
@@ -324,22 +358,155 @@ pub struct Instancing {
     pub of: Vec<(usize, Frame)>,
 }
 
-/// Groups elements into kinds. `tolerance` is the largest mean misfit,
-/// relative to the element's radius, of two alike elements.
-/// The shape mirrored about the vertical line through its centroid.
-fn mirrored(sh: &Shape) -> Option<Shape> {
+impl Instancing {
+    /// Moves kind `k`'s local frame by `change` (given in the old local
+    /// frame), and every instance's frame with it.
+    pub fn reframe(&mut self, k: usize, change: &Frame) {
+        self.kinds[k].frame = self.kinds[k].frame.then(change);
+        for (kk, f) in self.of.iter_mut() {
+            if *kk == k {
+                *f = f.then(change);
+            }
+        }
+    }
+}
+
+/// Subpaths with every point mapped by `f`.
+pub fn map_subpaths(subpaths: &[Vec<Seg>], f: impl Fn(DVec2) -> DVec2) -> Vec<Vec<Seg>> {
+    subpaths
+        .iter()
+        .map(|sub| sub.iter().map(|s| map_seg(s, &f)).collect())
+        .collect()
+}
+
+/// A segment with its points mapped by `f`.
+pub fn map_seg(s: &Seg, f: impl Fn(DVec2) -> DVec2) -> Seg {
+    match *s {
+        Seg::Move(p) => Seg::Move(f(p)),
+        Seg::Line(p) => Seg::Line(f(p)),
+        Seg::Quad(c, p) => Seg::Quad(f(c), f(p)),
+        Seg::Cubic(a, b, p) => Seg::Cubic(f(a), f(b), f(p)),
+        Seg::Close => Seg::Close,
+    }
+}
+
+/// The shape mirrored about the y axis of `frame`, with its outline.
+fn mirrored(sh: &Shape, subpaths: &[Vec<Seg>], frame: &Frame) -> Option<(Shape, Vec<Vec<Seg>>)> {
+    let flip = |p: DVec2| {
+        let q = frame.local(p);
+        frame.apply(DVec2::new(-q.x, q.y))
+    };
     let lines: Vec<Vec<DVec2>> = sh
         .outline
         .iter()
-        .map(|l| {
-            l.iter()
-                .map(|p| sh.centroid + DVec2::new(-p.x, p.y))
-                .collect()
-        })
+        .map(|l| l.iter().map(|p| flip(sh.centroid + *p)).collect())
         .collect();
-    Shape::of(&lines)
+    Some((Shape::of(&lines)?, map_subpaths(subpaths, flip)))
 }
 
+/// The frame of an element that is a kind's shape `rep` turned by `a` and
+/// scaled by `s`, when the kind's local frame is `frame`; `sh` is the
+/// element's shape.
+fn placed_frame(frame: &Frame, rep: &Shape, sh: &Shape, a: f64, s: f64) -> Frame {
+    Frame {
+        pos: sh.centroid + rotate(frame.pos - rep.centroid, a) * s,
+        rot: wrap(frame.rot + a),
+        scale: frame.scale * s,
+    }
+}
+
+/// How far a drawing's map may be from a similarity (relative to its
+/// scale) for its frame to be taken: lsyc writes matrices to 5 decimals.
+const SIMILARITY: f64 = 1e-3;
+
+/// A group of elements that draw one definition through similarities,
+/// mirrored alike.
+struct Given {
+    /// In document order.
+    members: Vec<usize>,
+    /// How the definition's path is read (x and y multiplied by ±1): y
+    /// flipped when the drawing mirrors it (a y-down drawing read y up).
+    flip: DVec2,
+    /// The group of the same definition drawn the other way round, read as
+    /// its mirror image (x negated), when this one came later.
+    mirror_of: Option<usize>,
+}
+
+/// The groups of elements that draw one definition through similarities:
+/// the drawing gives their frames. A group counts when its members are
+/// placed differently, or, for a single element, when its map is not the
+/// one most elements share (the document's own).
+fn given_groups(elements: &[Element]) -> Vec<Given> {
+    let mut groups: Vec<Given> = Vec::new();
+    let mut index: HashMap<(u64, bool), usize> = HashMap::new();
+    for (i, e) in elements.iter().enumerate() {
+        if !e.placed.is_similarity(SIMILARITY) {
+            continue;
+        }
+        let mirrors = e.placed.det() < 0.0;
+        let g = match index.get(&(e.placed.key, mirrors)) {
+            Some(&g) => g,
+            None => {
+                let twin = index.get(&(e.placed.key, !mirrors)).copied();
+                let y = if mirrors { -1.0 } else { 1.0 };
+                let flip = match twin {
+                    // The twin's reading, x negated.
+                    Some(t) => DVec2::new(-groups[t].flip.x, groups[t].flip.y),
+                    None => DVec2::new(1.0, y),
+                };
+                index.insert((e.placed.key, mirrors), groups.len());
+                groups.push(Given {
+                    members: Vec::new(),
+                    flip,
+                    mirror_of: twin,
+                });
+                groups.len() - 1
+            }
+        };
+        groups[g].members.push(i);
+    }
+    let bits = |m: &[f64; 6]| m.map(|v| (v as f32).to_bits());
+    let mut maps: Vec<[u32; 6]> = elements.iter().map(|e| bits(&e.placed.map)).collect();
+    maps.sort_unstable();
+    let document = maps
+        .chunk_by(|a, b| a == b)
+        .max_by_key(|c| c.len())
+        .map(|c| c[0]);
+    let counts: Vec<bool> = groups
+        .iter()
+        .map(|g| {
+            let first = bits(&elements[g.members[0]].placed.map);
+            if g.members.len() >= 2 {
+                g.members
+                    .iter()
+                    .any(|&i| bits(&elements[i].placed.map) != first)
+            } else {
+                Some(first) != document || elements.len() == 1
+            }
+        })
+        .collect();
+    // Renumber the twins of the groups kept.
+    let mut new = vec![None; groups.len()];
+    let mut kept = 0;
+    for (g, keep) in counts.iter().enumerate() {
+        if *keep {
+            new[g] = Some(kept);
+            kept += 1;
+        }
+    }
+    groups
+        .into_iter()
+        .zip(counts)
+        .filter(|(_, keep)| *keep)
+        .map(|(mut g, _)| {
+            g.mirror_of = g.mirror_of.and_then(|t| new[t]);
+            g
+        })
+        .collect()
+}
+
+/// Groups elements into kinds. `tolerance` is the largest mean misfit,
+/// relative to the element's radius, of two alike elements.
 pub fn instancing(
     elements: &[Element],
     tolerance: f64,
@@ -366,12 +533,63 @@ pub fn instancing(
     let mut kinds: Vec<Kind> = Vec::new();
     // Each kind's representative outline (mirrored for a mirror kind).
     let mut kind_shapes: Vec<Shape> = Vec::new();
-    let mut of: Vec<(usize, Frame)> = Vec::with_capacity(elements.len());
-    // Choices of rotation for instances of symmetric kinds.
-    let mut choices: Vec<Vec<f64>> = Vec::with_capacity(elements.len());
+    let mut of: Vec<Option<(usize, Frame)>> = vec![None; elements.len()];
+    // Choices of frame for instances of symmetric kinds.
+    let mut choices: Vec<Vec<Frame>> = vec![Vec::new(); elements.len()];
     // Whether each kind has a mirror kind.
     let mut mirrored_by: Vec<bool> = Vec::new();
+    let symmetry_of = |sh: &Shape| match sh.order() {
+        None => 0,
+        Some(_) => sh.align(sh, tolerance).len().max(1),
+    };
+    // Kinds whose frames the drawing gives (a group's kind is its index).
+    for g in given_groups(elements) {
+        let rep = g.members[0];
+        let sh = &shapes[rep];
+        let symmetry = symmetry_of(sh);
+        let k = kinds.len();
+        for &i in &g.members {
+            let f = Frame::of_map(&elements[i].placed.map, g.flip);
+            of[i] = Some((k, f));
+            // A symmetric element may be turned about its centroid.
+            let c = shapes[i].centroid;
+            choices[i] = (0..symmetry.max(1))
+                .map(|j| {
+                    let a = TAU * j as f64 / symmetry.max(1) as f64;
+                    Frame {
+                        pos: c + rotate(f.pos - c, a),
+                        rot: wrap(f.rot + a),
+                        scale: f.scale,
+                    }
+                })
+                .collect();
+        }
+        // The representative of a symmetric kind turned least: its
+        // neighbours follow it (`orient_symmetric`).
+        let least = choices[rep]
+            .iter()
+            .copied()
+            .min_by(|a, b| a.rot.abs().total_cmp(&b.rot.abs()))
+            .unwrap_or(Frame::IDENTITY);
+        of[rep] = Some((k, least));
+        kinds.push(Kind {
+            representative: rep,
+            symmetry,
+            frame: least,
+            given: true,
+            subpaths: elements[rep].subpaths.clone(),
+            mirror_of: g.mirror_of.filter(|_| reflect),
+        });
+        kind_shapes.push(sh.clone());
+        mirrored_by.push(false);
+        if let Some(t) = g.mirror_of.filter(|_| reflect) {
+            mirrored_by[t] = true;
+        }
+    }
     for (i, e) in elements.iter().enumerate() {
+        if of[i].is_some() {
+            continue;
+        }
         let sh = &shapes[i];
         let mut found = None;
         for (k, kind) in kinds.iter().enumerate() {
@@ -397,7 +615,9 @@ pub fn instancing(
                 {
                     continue;
                 }
-                let Some(m) = mirrored(&kind_shapes[k]) else {
+                let Some((m, subpaths)) =
+                    mirrored(&kind_shapes[k], &kinds[k].subpaths, &kinds[k].frame)
+                else {
                     continue;
                 };
                 budget.spend(1)?;
@@ -405,6 +625,8 @@ pub fn instancing(
                 if !fits.is_empty() {
                     kinds.push(Kind {
                         mirror_of: Some(k),
+                        subpaths,
+                        given: false,
                         ..kinds[k].clone()
                     });
                     mirrored_by[k] = true;
@@ -419,54 +641,52 @@ pub fn instancing(
             Some((k, fits)) => {
                 let rep = &kind_shapes[k];
                 let best = fits[0].1;
-                let variants: Vec<f64> = fits
+                let s = sh.radius / rep.radius;
+                let variants: Vec<Frame> = fits
                     .iter()
                     .filter(|f| f.1 <= best + tolerance * 0.5)
-                    .map(|f| f.0)
+                    .map(|f| placed_frame(&kinds[k].frame, rep, sh, f.0, s))
                     .collect();
-                of.push((
-                    k,
-                    Frame {
-                        pos: sh.centroid,
-                        rot: fits[0].0,
-                        scale: sh.radius / rep.radius,
-                    },
-                ));
-                choices.push(variants);
+                of[i] = Some((k, variants[0]));
+                choices[i] = variants;
             }
             None => {
-                let symmetry = match sh.order() {
-                    None => 0,
-                    Some(_) => sh.align(sh, tolerance).len().max(1),
-                };
                 mirrored_by.push(false);
+                let frame = Frame {
+                    pos: sh.centroid,
+                    rot: 0.0,
+                    scale: 1.0,
+                };
                 kinds.push(Kind {
                     representative: i,
-                    symmetry,
-                    origin: DVec2::ZERO,
+                    symmetry: symmetry_of(sh),
+                    frame,
+                    given: false,
+                    subpaths: e.subpaths.clone(),
                     mirror_of: None,
                 });
                 kind_shapes.push(sh.clone());
-                of.push((
-                    kinds.len() - 1,
-                    Frame {
-                        pos: sh.centroid,
-                        rot: 0.0,
-                        scale: 1.0,
-                    },
-                ));
-                choices.push(vec![0.0]);
+                of[i] = Some((kinds.len() - 1, frame));
+                choices[i] = vec![frame];
             }
         }
     }
-    orient_symmetric(&kinds, &mut of, &choices);
+    let mut of: Vec<(usize, Frame)> = of.into_iter().flatten().collect();
+    orient_symmetric(&kinds, &shapes, &mut of, &choices);
     Ok(Instancing { kinds, shapes, of })
 }
 
-/// Chooses, for instances of symmetric kinds, the variant of rotation closest
-/// to an already placed neighbour of the same kind (breadth first from the
-/// representative over nearest neighbours), so orientations vary smoothly.
-fn orient_symmetric(kinds: &[Kind], of: &mut [(usize, Frame)], choices: &[Vec<f64>]) {
+/// Chooses, for instances of symmetric kinds, the variant of frame whose
+/// rotation is closest to an already placed neighbour of the same kind
+/// (breadth first from the representative over nearest neighbours), so
+/// orientations vary smoothly. Round kinds the drawing does not place keep
+/// the drawing's axes.
+fn orient_symmetric(
+    kinds: &[Kind],
+    shapes: &[Shape],
+    of: &mut [(usize, Frame)],
+    choices: &[Vec<Frame>],
+) {
     const NEIGHBOURS: usize = 6;
     for (k, kind) in kinds.iter().enumerate() {
         if kind.symmetry == 1 {
@@ -474,9 +694,16 @@ fn orient_symmetric(kinds: &[Kind], of: &mut [(usize, Frame)], choices: &[Vec<f6
         }
         let members: Vec<usize> = (0..of.len()).filter(|&i| of[i].0 == k).collect();
         if kind.symmetry == 0 {
-            // Round: no orientation to choose; keep the drawing's axes.
-            for &i in &members {
-                of[i].1.rot = 0.0;
+            if !kind.given {
+                // No orientation to choose: the local frame sits where it
+                // sits on the representative, unturned.
+                let rep = &shapes[kind.representative];
+                for &i in &members {
+                    let f = &mut of[i].1;
+                    let s = f.scale / kind.frame.scale;
+                    f.pos = shapes[i].centroid + (kind.frame.pos - rep.centroid) * s;
+                    f.rot = kind.frame.rot;
+                }
             }
             continue;
         }
@@ -501,9 +728,9 @@ fn orient_symmetric(kinds: &[Kind], of: &mut [(usize, Frame)], choices: &[Vec<f6
                     if let Some(best) = choices[i]
                         .iter()
                         .copied()
-                        .min_by(|x, y| wrap(x - rot).abs().total_cmp(&wrap(y - rot).abs()))
+                        .min_by(|x, y| wrap(x.rot - rot).abs().total_cmp(&wrap(y.rot - rot).abs()))
                     {
-                        of[i].1.rot = best;
+                        of[i].1 = best;
                     }
                     queue.push_back(b);
                 }
