@@ -12,6 +12,7 @@ mod hostile;
 mod hostile_svg;
 mod infer;
 mod layers;
+mod roundtrip;
 mod run;
 mod scene;
 mod sketch;
