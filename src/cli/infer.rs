@@ -64,7 +64,7 @@ pub struct Args {
     #[arg(long, conflicts_with = "skeleton")]
     pub reflect: bool,
 
-    /// Art: print what was found (elements, kinds, clusters, rules, time per phase) as JSON on stderr.
+    /// Art: print what was found (elements, kinds, clusters, rules, time per phase, program size over SVG size) as JSON on stderr.
     #[arg(long)]
     pub stats: bool,
 }

@@ -1,5 +1,6 @@
 //! All integration tests, in one binary so that `cargo test` links once.
 
+mod art_table;
 mod bridge;
 mod cli;
 mod corpus;

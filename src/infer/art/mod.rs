@@ -102,6 +102,12 @@ pub struct Stats {
     pub instancing_ms: f64,
     pub rules_ms: f64,
     pub emit_ms: f64,
+    /// Bytes of the drawing read.
+    pub svg_bytes: usize,
+    /// Bytes of the emitted program (its canonical text).
+    pub program_bytes: usize,
+    /// `program_bytes / svg_bytes`: below 1 the program is the smaller description.
+    pub size_ratio: f64,
 }
 
 /// A drawing and the program inferred from it.
@@ -200,6 +206,9 @@ pub fn from_svg(
     let file = emit::program(&drawing.elements, &inst, &grammar, &settings);
     let text = crate::fmt::format_file(&file);
     stats.emit_ms = ms(t);
+    stats.svg_bytes = data.len();
+    stats.program_bytes = text.len();
+    stats.size_ratio = text.len() as f64 / data.len().max(1) as f64;
     Ok(Inferred {
         file,
         text,
