@@ -43,32 +43,42 @@ pub fn choose(inst: &mut Instancing, fixed: &[bool], tol: Tolerance) {
             .iter()
             .map(|p| frame.local(sh.centroid + *p))
             .collect();
+        let lines: Vec<Vec<DVec2>> = sh
+            .outline
+            .iter()
+            .map(|l| l.iter().map(|p| frame.local(sh.centroid + *p)).collect())
+            .collect();
         let centroid = frame.local(sh.centroid);
         let origins = if kind.symmetry != 1 {
             vec![DVec2::ZERO]
         } else if fixed.get(k).copied().unwrap_or(false) {
             // The pivot found, or a candidate within the noise of it.
             let near = sh.radius / frame.scale * 0.02;
-            let mut near: Vec<DVec2> = origins(&kind.subpaths, &frame, &outline, centroid)
+            let mut near: Vec<DVec2> = origins(&kind.subpaths, &frame, &lines, &outline, centroid)
                 .into_iter()
                 .filter(|o| o.length() <= near)
                 .collect();
             near.push(DVec2::ZERO);
             near
         } else {
-            origins(&kind.subpaths, &frame, &outline, centroid)
+            origins(&kind.subpaths, &frame, &lines, &outline, centroid)
         };
-        // Neighbours by centroid, which no choice of frame moves.
+        // Neighbours by centroid, which no choice of frame moves, each pair
+        // in the drawing's order (a grammar draws a parent before its
+        // children and a sequence from its start).
         let centres: Vec<DVec2> = members.iter().map(|&i| inst.shapes[i].centroid).collect();
         let grid = PointGrid::new(&centres);
         let mut pairs: Vec<(usize, usize)> = Vec::new();
         for (a, c) in centres.iter().enumerate() {
             for b in grid.nearest(*c, NEIGHBOURS + 1) {
-                if a != b {
+                if a < b {
                     pairs.push((members[a], members[b]));
+                } else if b < a && !grid.nearest(centres[b], NEIGHBOURS + 1).contains(&a) {
+                    pairs.push((members[b], members[a]));
                 }
             }
         }
+        let changing = fixed.get(k).copied().unwrap_or(false);
         let mut best: Option<(Score, Frame)> = None;
         for (n, &o) in origins.iter().enumerate() {
             let change = Frame {
@@ -82,48 +92,39 @@ pub fn choose(inst: &mut Instancing, fixed: &[bool], tol: Tolerance) {
                 0.0
             };
             let mut headings = vec![up];
-            let repeated = if fixed.get(k).copied().unwrap_or(false) {
+            let repeated = if changing {
                 // A changing turn: the transforms agree but for the turn
                 // that changes; the heading takes the other one to zero.
-                let before = dominant(inst, &pairs, &change, sh.radius, tol, Some(0));
-                let after = dominant(inst, &pairs, &change, sh.radius, tol, Some(3));
-                match (before, after) {
-                    (Some((t, n)), Some((_, m))) if n >= m => {
-                        headings.push(-t.beta);
-                        Some(t)
-                    }
-                    (_, Some((t, _))) => {
-                        headings.push(t.alpha);
-                        Some(t)
-                    }
-                    (Some((t, _)), None) => {
-                        headings.push(-t.beta);
-                        Some(t)
-                    }
-                    (None, None) => None,
+                let before = repeated(inst, &pairs, &change, sh.radius, tol, Some(0));
+                let after = repeated(inst, &pairs, &change, sh.radius, tol, Some(3));
+                let size = |r: &[(Tr, usize)]| r.first().map_or(0, |c| c.1);
+                if size(&before) >= size(&after) {
+                    headings.extend(before.iter().map(|(t, _)| -t.beta));
+                    before
+                } else {
+                    headings.extend(after.iter().map(|(t, _)| t.alpha));
+                    after
                 }
             } else {
-                let t = dominant(inst, &pairs, &change, sh.radius, tol, None).map(|(t, _)| t);
-                if let Some(t) = t {
+                let r = repeated(inst, &pairs, &change, sh.radius, tol, None);
+                for (t, _) in &r {
                     headings.push(t.alpha);
                     headings.push(-t.beta);
                 }
-                t
+                r
             };
             for (h, &phi) in headings.iter().enumerate() {
-                let score = match repeated {
-                    Some(t) => {
-                        let (a, b) = (wrap(t.alpha - phi), wrap(t.beta + phi));
-                        let turns =
-                            usize::from(a.abs() > tol.angle) + usize::from(b.abs() > tol.angle);
-                        let digits = angle_digits(a)
-                            + angle_digits(b)
-                            + digits(t.d, t.d.abs() * 5e-4)
-                            + digits(t.s, 5e-4);
-                        (turns, digits, n, h)
-                    }
-                    None => (0, 0, n, h),
-                };
+                let (mut turns, mut digits_) = (0, 0);
+                for (t, _) in &repeated {
+                    let (a, b) = (wrap(t.alpha - phi), wrap(t.beta + phi));
+                    // The turn that changes counts as one, whatever its start.
+                    turns += usize::from(a.abs() > tol.angle) + usize::from(b.abs() > tol.angle);
+                    digits_ += angle_digits(a)
+                        + angle_digits(b)
+                        + digits(t.d, t.d.abs() * 5e-4)
+                        + digits(t.s, 5e-4);
+                }
+                let score = (turns, digits_, n, h);
                 let candidate = Frame {
                     pos: o,
                     rot: phi,
@@ -145,8 +146,15 @@ pub fn choose(inst: &mut Instancing, fixed: &[bool], tol: Tolerance) {
 type Score = (usize, usize, usize, usize);
 
 /// The origins to try, in the kind's current local frame: the path's start,
-/// an open stroke's end, the principal axis's ends, the centroid.
-fn origins(subpaths: &[Vec<Seg>], frame: &Frame, outline: &[DVec2], centroid: DVec2) -> Vec<DVec2> {
+/// an open stroke's end, where the principal axis crosses the outline
+/// (`lines`), the outline's extremes along it, the centroid.
+fn origins(
+    subpaths: &[Vec<Seg>],
+    frame: &Frame,
+    lines: &[Vec<DVec2>],
+    outline: &[DVec2],
+    centroid: DVec2,
+) -> Vec<DVec2> {
     let mut out = Vec::new();
     let first = subpaths.first().and_then(|s| s.first());
     if let Some(Seg::Move(p)) = first {
@@ -159,6 +167,26 @@ fn origins(subpaths: &[Vec<Seg>], frame: &Frame, outline: &[DVec2], centroid: DV
         out.push(frame.local(p));
     }
     let axis = principal_axis(outline, centroid);
+    // Where the axis through the centroid leaves the outline: the base and
+    // the tip of a leaf.
+    let normal = axis.perp();
+    let mut crossings: Vec<f64> = Vec::new();
+    for line in lines {
+        for w in line.windows(2) {
+            let (a, b) = ((w[0] - centroid).dot(normal), (w[1] - centroid).dot(normal));
+            if (a <= 0.0) != (b <= 0.0) {
+                let p = w[0].lerp(w[1], a / (a - b));
+                crossings.push((p - centroid).dot(axis));
+            }
+        }
+    }
+    let lo = crossings.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = crossings.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    for t in [lo, hi] {
+        if t.is_finite() {
+            out.push(centroid + axis * t);
+        }
+    }
     let along = |p: &DVec2| (*p - centroid).dot(axis);
     if let (Some(lo), Some(hi)) = (
         outline.iter().min_by(|a, b| along(a).total_cmp(&along(b))),
@@ -217,18 +245,20 @@ fn heading_of(v: DVec2) -> f64 {
     (-v.x).atan2(v.y)
 }
 
-/// The transform that repeats most between neighbouring instances when
-/// each frame moves by `change`: the mean of the largest cluster of their
-/// transforms, if it has at least two, and its size. `ignore`: the
-/// coordinate (0 the turn before the step, 3 the one after) that may change.
-fn dominant(
+/// The transforms that repeat between neighbouring instances when each
+/// frame moves by `change`: the means of the largest cluster of their
+/// transforms and of the next when it is at least half as large (a
+/// branching's second child), each with its size, if the largest has at
+/// least two. `ignore`: the coordinate (0 the turn before the step, 3 the
+/// one after) that may change along a sequence.
+fn repeated(
     inst: &Instancing,
     pairs: &[(usize, usize)],
     change: &Frame,
     radius: f64,
     tol: Tolerance,
     ignore: Option<usize>,
-) -> Option<(Tr, usize)> {
+) -> Vec<(Tr, usize)> {
     let trs: Vec<Tr> = pairs
         .iter()
         .map(|&(i, j)| {
@@ -256,28 +286,39 @@ fn dominant(
     for l in &label {
         count[*l] += 1;
     }
-    let top = (0..centres.len()).max_by(|&a, &b| count[a].cmp(&count[b]).then(b.cmp(&a)))?;
+    let mut order: Vec<usize> = (0..centres.len()).collect();
+    order.sort_by(|&a, &b| count[b].cmp(&count[a]).then(a.cmp(&b)));
+    let Some(&top) = order.first() else {
+        return Vec::new();
+    };
     if count[top] < 2 {
-        return None;
+        return Vec::new();
     }
-    let members: Vec<&Tr> = trs
+    order
         .iter()
-        .zip(&label)
-        .filter(|(_, l)| **l == top)
-        .map(|(t, _)| t)
-        .collect();
-    let n = members.len() as f64;
-    let first = members[0];
-    let mean_angle = |f: fn(&Tr) -> f64| {
-        wrap(f(first) + members.iter().map(|t| wrap(f(t) - f(first))).sum::<f64>() / n)
-    };
-    let t = Tr {
-        alpha: mean_angle(|t| t.alpha),
-        d: members.iter().map(|t| t.d).sum::<f64>() / n,
-        s: members.iter().map(|t| t.s).sum::<f64>() / n,
-        beta: mean_angle(|t| t.beta),
-    };
-    Some((t, members.len()))
+        .take(2)
+        .filter(|&&c| count[c] * 2 >= count[top])
+        .map(|&c| {
+            let members: Vec<&Tr> = trs
+                .iter()
+                .zip(&label)
+                .filter(|(_, l)| **l == c)
+                .map(|(t, _)| t)
+                .collect();
+            let n = members.len() as f64;
+            let first = members[0];
+            let mean_angle = |f: fn(&Tr) -> f64| {
+                wrap(f(first) + members.iter().map(|t| wrap(f(t) - f(first))).sum::<f64>() / n)
+            };
+            let t = Tr {
+                alpha: mean_angle(|t| t.alpha),
+                d: members.iter().map(|t| t.d).sum::<f64>() / n,
+                s: members.iter().map(|t| t.s).sum::<f64>() / n,
+                beta: mean_angle(|t| t.beta),
+            };
+            (t, members.len())
+        })
+        .collect()
 }
 
 /// Decimals an angle (radians) needs in degrees, to a hundredth of a degree.
