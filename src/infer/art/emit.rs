@@ -453,12 +453,12 @@ fn kinds(elements: &[Element], inst: &Instancing, names: &Names) -> Vec<Node<Ite
         let drawn = match kind.mirror_of {
             Some(twin) => format!("{} mirrored", names.elements[twin]),
             None => format!(
-                "drawn as element {}{} of the drawing, centred",
+                "drawn as element {} of the drawing, {}",
                 e.number,
-                if e.id.is_empty() {
-                    String::new()
+                if kind.given {
+                    "in the frame the drawing gives it"
                 } else {
-                    format!(" (id `{}`)", e.id)
+                    "in the frame that keeps the rules simplest"
                 }
             ),
         };
