@@ -66,21 +66,12 @@ fn round_trip(name: &str, opts: &Options) -> (String, f64) {
     )
 }
 
-fn round_trip_file(path: &Path, name: &str, opts: &Options) -> (String, f64) {
-    let path = path.to_path_buf();
-    let inferred = infer(&path, opts);
-    let text = inferred.text;
-    let fe = frontend::run(&text, Vec::new(), &[]);
-    assert!(
-        fe.diagnostics.is_empty(),
-        "{name}: {}\n{text}",
-        render_plain(&fe.diagnostics, name, &text)
-    );
-    assert_eq!(fmt::format_file(&fe.file), text, "{name}: not canonical");
+/// Runs a program with the `lsyc` binary and returns the SVG it draws.
+fn draw(text: &str, name: &str) -> Vec<u8> {
     let dir = tempfile::tempdir().expect("tempdir");
     let prog = dir.path().join(format!("{name}.lsy"));
     let back = dir.path().join(format!("{name}.svg"));
-    std::fs::write(&prog, &text).expect("write");
+    std::fs::write(&prog, text).expect("write");
     let out = Command::new(env!("CARGO_BIN_EXE_lsyc"))
         .arg("run")
         .arg(&prog)
@@ -93,19 +84,37 @@ fn round_trip_file(path: &Path, name: &str, opts: &Options) -> (String, f64) {
         "{name}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
+    std::fs::read(&back).expect("output")
+}
+
+/// The Chamfer distance between two drawings, relative to the first's diagonal.
+fn distance(a: &[u8], b: &[u8]) -> f64 {
+    let diag = diagonal(&samples(a, 1.0));
+    let step = diag / 1500.0;
+    chamfer(&samples(a, step), &samples(b, step)) / diag
+}
+
+fn round_trip_file(path: &Path, name: &str, opts: &Options) -> (String, f64) {
+    let path = path.to_path_buf();
+    let inferred = infer(&path, opts);
+    let text = inferred.text;
+    let fe = frontend::run(&text, Vec::new(), &[]);
+    assert!(
+        fe.diagnostics.is_empty(),
+        "{name}: {}\n{text}",
+        render_plain(&fe.diagnostics, name, &text)
+    );
+    assert_eq!(fmt::format_file(&fe.file), text, "{name}: not canonical");
+    let output = draw(&text, name);
     let input = std::fs::read(&path).expect("input");
-    let output = std::fs::read(&back).expect("output");
     let count = |svg: &[u8]| read::read(svg).expect("reads").elements.len();
     assert_eq!(
         count(&output),
         count(&input),
         "{name}: every element drawn once"
     );
-    let a0 = samples(&input, 1.0);
-    let diag = diagonal(&a0);
-    let step = diag / 1500.0;
-    let (a, b) = (samples(&input, step), samples(&output, step));
-    (text, chamfer(&a, &b) / diag)
+    let d = distance(&input, &output);
+    (text, d)
 }
 
 const EXACT: &[&str] = &[
@@ -234,6 +243,37 @@ fn symmetrize_makes_a_noisy_grid_regular() {
     assert_eq!(constant(t, "P1_TURN"), -90.0);
     assert_eq!(constant(t, "P1_TWIST"), 90.0);
     assert_eq!(constant(t, "P2_N"), 2.0);
+}
+
+/// `--symmetrize` on jittered grids and rings (three seeds each): the redraw is
+/// at least twice as close to the clean drawing as the jittered input is.
+#[test]
+fn symmetrize_halves_the_distance_to_the_clean_drawing() {
+    let opts = Options {
+        symmetrize: true,
+        ..Options::default()
+    };
+    let mut report = Vec::new();
+    let mut failures = Vec::new();
+    for base in ["noisy-grid", "noisy-ring"] {
+        let clean = std::fs::read(case(&format!("{base}-clean"))).expect("clean");
+        for name in [base.to_string(), format!("{base}-1"), format!("{base}-2")] {
+            let input = std::fs::read(case(&name)).expect("input");
+            let text = infer(&case(&name), &opts).text;
+            let output = draw(&text, &name);
+            let (before, after) = (distance(&clean, &input), distance(&clean, &output));
+            let line = format!(
+                "{name}: input {before:.2e}, symmetrized {after:.2e}, ratio {:.2}",
+                after / before
+            );
+            if after > before / 2.0 {
+                failures.push(format!("{line}\n{text}"));
+            }
+            report.push(line);
+        }
+    }
+    eprintln!("{}", report.join("\n"));
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 #[test]
@@ -404,4 +444,27 @@ fn reflect_makes_mirror_images_one_outline() {
         "{text}"
     );
     assert!(d <= 1e-3, "Chamfer {d:.2e} of the diagonal");
+}
+
+/// `--symmetrize` on drawings that are regular already draws them back
+/// (it refits and rounds, it does not move what the drawing pins down).
+#[test]
+fn symmetrize_keeps_regular_drawings() {
+    let opts = Options {
+        symmetrize: true,
+        ..Options::default()
+    };
+    let mut failures = Vec::new();
+    for name in EXACT
+        .iter()
+        .filter(|n| !["noisy-grid", "linear-angle"].contains(n))
+    {
+        let text = infer(&case(name), &opts).text;
+        let input = std::fs::read(case(name)).expect("input");
+        let d = distance(&input, &draw(&text, name));
+        if d > 1e-3 {
+            failures.push(format!("{name}: Chamfer {d:.2e} of the diagonal\n{text}"));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

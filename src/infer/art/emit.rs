@@ -12,7 +12,7 @@
 
 use super::read::Element;
 use super::rules::{Body, Grammar, Sym};
-use super::shape::{Frame, Instancing, map_subpaths};
+use super::shape::{Frame, Instancing, map_subpaths, rotate};
 use super::space::Tr;
 use crate::ast::{
     BinOp, Block, ConstDecl, Element as ElementItem, Expr, ExprKind, File, Ident, Item, Lsystem,
@@ -30,8 +30,8 @@ pub struct Settings<'a> {
     pub source: &'a str,
     /// The lsystem's name.
     pub name: String,
-    /// `--symmetrize`: transforms of repeated structures round to whole
-    /// degrees and plain steps (within 1.5°, 2 % and 1 %).
+    /// `--symmetrize`: the grammar's transforms are already regular (see
+    /// `rules::regular`); the header says so.
     pub symmetrize: bool,
     /// `--jitter J`: the transforms of repeated structures vary at random
     /// (turns by ±30·J degrees, steps and scales by ±J of their value), drawn
@@ -355,7 +355,10 @@ fn describe(names: &Names, s: Sym) -> String {
 pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Settings) -> File {
     let names = Names::new(inst.kinds.len(), g);
     let mut consts = Consts { items: Vec::new() };
-    let element_items = kinds(elements, inst, &names);
+    let element_items = match turned(inst, &g.tilt) {
+        Some(inst) => kinds(elements, &inst, &names),
+        None => kinds(elements, inst, &names),
+    };
     let count_of = count_constants(g, &names, &mut consts);
     let mut decls: Vec<Node<Item>> = Vec::new();
     let mut rules: Vec<Node<Stmt>> = Vec::new();
@@ -373,7 +376,6 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
         let mut w = RuleWriter {
             g,
             names: &names,
-            symmetrize: s.symmetrize,
             jitter: s.jitter,
             count_of: &count_of,
             pred: Module::new(
@@ -409,6 +411,29 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
     sys.trivia.blank_before = true;
     let header = header(elements, inst, g, s, &count_of);
     assemble(&header, element_items, consts, decls, sys)
+}
+
+/// The kinds with each outline turned by its kind's tilt about the kind's
+/// origin (see `Grammar::tilt`), or `None` when no kind turns. A kind drawn
+/// as another one mirrored shares its outline, so neither turns.
+fn turned(inst: &Instancing, tilt: &[(usize, f64)]) -> Option<Instancing> {
+    let mirrored = |k: usize| {
+        inst.kinds[k].mirror_of.is_some() || inst.kinds.iter().any(|o| o.mirror_of == Some(k))
+    };
+    let turn = |k: usize| tilt.iter().find(|t| t.0 == k).map_or(0.0, |t| t.1);
+    let any = (0..inst.kinds.len()).any(|k| turn(k) != 0.0 && !mirrored(k));
+    if !any {
+        return None;
+    }
+    let mut out = inst.clone();
+    for (k, kind) in out.kinds.iter_mut().enumerate() {
+        let a = turn(k);
+        if a != 0.0 && !mirrored(k) {
+            let o = kind.frame.pos;
+            kind.subpaths = map_subpaths(&kind.subpaths, |p| o + rotate(p - o, a));
+        }
+    }
+    Some(out)
 }
 
 /// The element kinds as `element` items, each with a comment saying how
@@ -504,7 +529,6 @@ fn m_is(op: BinOp) -> Option<Expr> {
 struct RuleWriter<'a> {
     g: &'a Grammar,
     names: &'a Names,
-    symmetrize: bool,
     jitter: Option<f64>,
     count_of: &'a [Option<Expr>],
     name: String,
@@ -550,17 +574,7 @@ impl RuleWriter<'_> {
     /// The turn, step, scale and twist of `t` as values or named constants
     /// (`{name}_TURN{suffix}`, …), rounded for a structure repeated `n` times.
     fn parts(&self, consts: &mut Consts, t: &Tr, suffix: &str, n: f64) -> (Part, Part, Part, Part) {
-        let units = t.d.max(1e-9);
-        let round = if self.symmetrize {
-            Round {
-                angle: 1.5,
-                d: 0.02 * units,
-                s: 0.01,
-            }
-        } else {
-            Round::new(n, units)
-        };
-        let (a, d, sc, b) = round.values(t);
+        let (a, d, sc, b) = Round::new(n, t.d.max(1e-9)).values(t);
         let jitter = self.jitter;
         let name = &self.name;
         let mut part = |v: f64, trivial: f64, what: &str, note: &str| {
@@ -741,7 +755,11 @@ fn header(
     count_of: &[Option<Expr>],
 ) -> [String; 4] {
     [
-        format!("Inferred by `lsyc infer` from {}.", s.source),
+        format!(
+            "Inferred by `lsyc infer{}` from {}.",
+            if s.symmetrize { " --symmetrize" } else { "" },
+            s.source
+        ),
         format!(
             "{} elements of {} kind{}; {} rule{} found in {} round{}.",
             elements.len(),

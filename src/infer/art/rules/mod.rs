@@ -14,6 +14,9 @@
 //! redrawing it with the rule's averaged transform would leave the tolerance,
 //! so what is drawn back stays on the input. Must not print or build syntax.
 
+mod fit;
+mod regular;
+
 use super::shape::{Frame, wrap};
 use super::space::{Point, Tr, cluster};
 use super::{Budget, TooMuchWork};
@@ -76,6 +79,9 @@ pub struct Tolerance {
     pub distance: f64,
     /// Scales, relative.
     pub scale: f64,
+    /// Whether a chosen rule is made regular (`--symmetrize`): refitted to
+    /// all its instances and its numbers snapped to round values (`regular`).
+    pub regular: bool,
 }
 
 impl Tolerance {
@@ -83,11 +89,13 @@ impl Tolerance {
         angle: 0.5 * std::f64::consts::PI / 180.0,
         distance: 0.005,
         scale: 0.005,
+        regular: false,
     };
     pub const RELAXED: Tolerance = Tolerance {
         angle: 10.0 * std::f64::consts::PI / 180.0,
         distance: 0.15,
         scale: 0.1,
+        regular: true,
     };
 }
 
@@ -99,6 +107,20 @@ pub struct Inst {
     pub min: DVec2,
     pub max: DVec2,
     alive: bool,
+    /// Standard error of the frame's rotation where a fit placed it
+    /// (radians; 0 for an element of the drawing), and of a coordinate of
+    /// its position.
+    rot_se: f64,
+    pos_se: f64,
+    /// The mean position of the elements it draws, and their number.
+    mass: DVec2,
+    count: f64,
+    /// The variance of its elements' positions about the fits that placed
+    /// them (per coordinate; 0 for an element of the drawing).
+    noise: f64,
+    /// Per element kind it draws: the sum of its elements' rotations less
+    /// those they are drawn with, and their number.
+    tilt: Vec<(usize, f64, f64)>,
 }
 
 impl Inst {
@@ -109,6 +131,15 @@ impl Inst {
             min,
             max,
             alive: true,
+            rot_se: 0.0,
+            pos_se: 0.0,
+            mass: frame.pos,
+            count: 1.0,
+            noise: 0.0,
+            tilt: match sym {
+                Sym::Element(k) => vec![(k, 0.0, 1.0)],
+                Sym::Rule(..) => Vec::new(),
+            },
         }
     }
 
@@ -131,6 +162,11 @@ pub struct Grammar {
     pub rounds: usize,
     /// Clusters met, over all rounds.
     pub clusters: usize,
+    /// With `--symmetrize`, per element kind: the mean rotation of its
+    /// elements relative to how the grammar draws them (radians), so that
+    /// the kind's outline is drawn turned by it: the representative is one
+    /// noisy sample, the mean of all is not.
+    pub tilt: Vec<(usize, f64)>,
 }
 
 struct Edge {
@@ -209,12 +245,40 @@ pub fn infer(
         axiom: None,
         rounds: 0,
         clusters: 0,
+        tilt: Vec::new(),
     };
     loop {
         let live: Vec<usize> = (0..insts.len()).filter(|&i| insts[i].alive).collect();
         progress(live.len());
         if live.len() <= 1 {
-            g.axiom = live.first().map(|&i| (insts[i].frame, insts[i].sym));
+            g.axiom = live.first().map(|&i| {
+                let inst = &insts[i];
+                if !tol.regular {
+                    return (inst.frame, inst.sym);
+                }
+                let pos_se = (inst.noise / inst.count).sqrt();
+                let straight = match (inst.sym, &g.rules) {
+                    (Sym::Rule(r, _), rules) => match rules[r].body {
+                        Body::Seq { t, delta: None, .. }
+                            if t.d > 0.0 && t.alpha + t.beta == 0.0 =>
+                        {
+                            Some(t.alpha)
+                        }
+                        _ => None,
+                    },
+                    _ => None,
+                };
+                let frame =
+                    regular::axiom(inst.frame, straight, inst.rot_se, inst.mass, pos_se, tol);
+                let turn = wrap(frame.rot - inst.frame.rot);
+                g.tilt = inst
+                    .tilt
+                    .iter()
+                    .map(|&(k, sum, n)| (k, wrap(sum / n.max(1.0) - turn)))
+                    .filter(|t| t.1 != 0.0)
+                    .collect();
+                (frame, inst.sym)
+            });
             debug_assert_eq!(
                 g.axiom.map_or(0, |(_, s)| g.covered(s)),
                 elements,
@@ -229,8 +293,8 @@ pub fn infer(
         g.clusters += clusters;
         let best = choose(&mut candidates, weights);
         match best {
-            Some(c) if c.pairs >= 2 => apply(&mut g, &mut insts, c.plan),
-            _ => pair_up(&mut g, &mut insts, &edges),
+            Some(c) if c.pairs >= 2 => apply(&mut g, &mut insts, c.plan, tol),
+            _ => pair_up(&mut g, &mut insts, &edges, tol),
         }
     }
 }
@@ -342,8 +406,10 @@ fn candidates(
             groups[label[i]].push(k);
         }
         let phi = if a == b { 1.0 } else { 0.5 };
+        let near = (tol.regular && a == b).then(|| Near::new(insts, *a));
         for group in &groups {
-            if let Some(c) = sequence(insts, edges, &index, group, a == b, tol, phi) {
+            if let Some(c) = sequence(insts, edges, &index, group, a == b, tol, phi, near.as_ref())
+            {
                 out.push(c);
             }
         }
@@ -366,6 +432,7 @@ fn candidates(
 }
 
 /// Chains (or pairs, across kinds) of one cluster.
+#[allow(clippy::too_many_arguments)]
 fn sequence(
     insts: &[Inst],
     edges: &[Edge],
@@ -374,6 +441,7 @@ fn sequence(
     same: bool,
     tol: Tolerance,
     phi: f64,
+    near: Option<&Near>,
 ) -> Option<Candidate> {
     let ts: Vec<Tr> = group.iter().map(|&k| edges[k].t).collect();
     let centre = mean(&ts);
@@ -454,7 +522,10 @@ fn sequence(
         .filter_map(|w| index.get(&(w[0], w[1])).map(|&k| edges[k].t))
         .collect();
     let t = mean(&used);
-    let chains = cut_drift(insts, chains, |_, _| t, tol);
+    let mut chains = cut_drift(insts, chains, |_, _| t, tol);
+    if let Some(near) = near {
+        chains = extend(insts, chains, &t, near, tol);
+    }
     let mut cand = seq_candidate(edges, index, chains, t, None, phi)?;
     if !same {
         // Across two kinds the chains are pairs: A T B.
@@ -501,6 +572,115 @@ fn cut_drift(
         }
     }
     out
+}
+
+/// The live instances of one symbol, for finding one near a point.
+struct Near {
+    ids: Vec<usize>,
+    grid: PointGrid,
+}
+
+impl Near {
+    fn new(insts: &[Inst], sym: Sym) -> Near {
+        let ids: Vec<usize> = (0..insts.len())
+            .filter(|&i| insts[i].alive && insts[i].sym == sym)
+            .collect();
+        let points: Vec<DVec2> = ids.iter().map(|&i| insts[i].frame.pos).collect();
+        Near {
+            grid: PointGrid::new(&points),
+            ids,
+        }
+    }
+
+    /// The instance nearest to where `want` is, if it is there within the tolerance.
+    fn at(&self, insts: &[Inst], want: &Frame, step: f64, tol: Tolerance) -> Option<usize> {
+        let j = *self.ids.get(*self.grid.nearest(want.pos, 1).first()?)?;
+        close(&insts[j].frame, want, step, insts[j].size(), tol).then_some(j)
+    }
+}
+
+/// Chains grown at both ends while the next instance `t` leads to (or the
+/// one it comes from) is where it should be, joining chains that meet: a
+/// noisy row or ring whose transforms fell into two clusters comes out whole
+/// (`--symmetrize`).
+fn extend(
+    insts: &[Inst],
+    mut chains: Vec<Vec<usize>>,
+    t: &Tr,
+    near: &Near,
+    tol: Tolerance,
+) -> Vec<Vec<usize>> {
+    let origin = Frame {
+        pos: DVec2::ZERO,
+        rot: 0.0,
+        scale: 1.0,
+    };
+    let back = t.apply(&origin).inverse();
+    // Which chain each instance is in, and whether it starts or ends it.
+    let mut owner: HashMap<usize, usize> = HashMap::new();
+    for (c, chain) in chains.iter().enumerate() {
+        for &i in chain {
+            owner.insert(i, c);
+        }
+    }
+    let mut gone = vec![false; chains.len()];
+    for c in 0..chains.len() {
+        if gone[c] {
+            continue;
+        }
+        // Forward: append free instances, or a chain that starts there.
+        while let Some(&last) = chains[c].last() {
+            let f = insts[last].frame;
+            let want = t.apply(&f);
+            let Some(j) = near.at(insts, &want, t.d * f.scale, tol) else {
+                break;
+            };
+            match owner.get(&j).copied() {
+                None => {
+                    chains[c].push(j);
+                    owner.insert(j, c);
+                }
+                Some(o) if o != c && !gone[o] && chains[o].first() == Some(&j) => {
+                    let tail = std::mem::take(&mut chains[o]);
+                    for &i in &tail {
+                        owner.insert(i, c);
+                    }
+                    chains[c].extend(tail);
+                    gone[o] = true;
+                }
+                _ => break,
+            }
+        }
+        // Backward: prepend free instances, or a chain that ends there.
+        while let Some(&first) = chains[c].first() {
+            let want = insts[first].frame.then(&back);
+            let Some(j) = near.at(insts, &want, t.d * want.scale, tol) else {
+                break;
+            };
+            match owner.get(&j).copied() {
+                None => {
+                    chains[c].insert(0, j);
+                    owner.insert(j, c);
+                }
+                Some(o) if o != c && !gone[o] && chains[o].last() == Some(&j) => {
+                    let mut head = std::mem::take(&mut chains[o]);
+                    for &i in &head {
+                        owner.insert(i, c);
+                    }
+                    head.append(&mut chains[c]);
+                    chains[c] = head;
+                    gone[o] = true;
+                }
+                _ => break,
+            }
+        }
+    }
+    chains
+        .into_iter()
+        .zip(gone)
+        .filter(|(c, gone)| !gone && c.len() >= 2)
+        .map(|(c, _)| c)
+        .collect()
 }
 
 fn seq_candidate(
@@ -915,15 +1095,70 @@ fn union_box(insts: &[Inst], ids: impl IntoIterator<Item = usize>) -> (DVec2, DV
 
 fn replace(insts: &mut Vec<Inst>, first: usize, members: &[usize], sym: Sym) {
     let frame = insts[first].frame;
-    replace_at(insts, frame, members, sym);
+    replace_at(insts, frame, members, sym, None);
 }
 
-fn replace_at(insts: &mut Vec<Inst>, frame: Frame, members: &[usize], sym: Sym) {
+/// How a regular fit placed a new instance: the standard error of its
+/// rotation, where each member is drawn, and the variance about the fit.
+struct Placed<'a> {
+    rot_se: f64,
+    pos_se: f64,
+    drawn: &'a [Frame],
+    sigma2: f64,
+}
+
+fn replace_at(
+    insts: &mut Vec<Inst>,
+    frame: Frame,
+    members: &[usize],
+    sym: Sym,
+    placed: Option<Placed>,
+) {
     let (min, max) = union_box(insts, members.iter().copied());
+    let mut mass = DVec2::ZERO;
+    let mut count = 0.0;
+    let mut noise = 0.0;
+    let mut tilt: Vec<(usize, f64, f64)> = Vec::new();
+    for (k, &i) in members.iter().enumerate() {
+        let m = &insts[i];
+        // A member drawn elsewhere than it is carries its elements along.
+        let (at, turn) = match placed.as_ref().and_then(|p| p.drawn.get(k)) {
+            Some(d) => (
+                d.apply(m.frame.inverse().apply(m.mass)),
+                wrap(d.rot - m.frame.rot),
+            ),
+            None => (m.mass, 0.0),
+        };
+        mass += at * m.count;
+        count += m.count;
+        noise += m.noise * m.count;
+        for &(kind, sum, n) in &m.tilt {
+            match tilt.iter_mut().find(|t| t.0 == kind) {
+                Some(t) => {
+                    t.1 += sum - turn * n;
+                    t.2 += n;
+                }
+                None => tilt.push((kind, sum - turn * n, n)),
+            }
+        }
+    }
+    let mut inst = Inst::new(sym, frame, min, max);
+    inst.count = count.max(1.0);
+    inst.mass = mass / inst.count;
+    inst.noise = noise / inst.count;
+    inst.tilt = tilt;
+    if let Some(p) = placed {
+        inst.rot_se = p.rot_se;
+        inst.pos_se = p.pos_se;
+        // Elements placed directly: the fit says how far they are off.
+        if inst.noise == 0.0 && p.sigma2.is_finite() {
+            inst.noise = p.sigma2;
+        }
+    }
     for &i in members {
         insts[i].alive = false;
     }
-    insts.push(Inst::new(sym, frame, min, max));
+    insts.push(inst);
 }
 
 /// Where a chain drawn with `t` from one start frame fits its elements best:
@@ -944,21 +1179,49 @@ fn fitted_start(insts: &[Inst], chain: &[usize], t: &Tr) -> Frame {
     Frame::mean(&implied).unwrap_or(insts[chain[0]].frame)
 }
 
-fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan) {
+/// The members of a complete binary tree, level by level.
+fn tree_members(child: &[HashMap<usize, usize>; 2], root: usize, depth: u32) -> Vec<usize> {
+    let mut members = vec![root];
+    let mut level = vec![root];
+    for _ in 0..depth {
+        level = level
+            .iter()
+            .flat_map(|v| [child[0].get(v), child[1].get(v)])
+            .flatten()
+            .copied()
+            .collect();
+        members.extend(level.iter().copied());
+    }
+    members
+}
+
+fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
     let r = g.rules.len();
     match plan {
         Plan::Seq { chains, t, delta } => {
             let a = insts[chains[0][0]].sym;
+            let reg = (tol.regular && delta.is_none())
+                .then(|| regular::sequence(insts, &chains, &t, tol));
             let mut counts = BTreeSet::new();
-            for c in &chains {
+            let mut offset = 0;
+            for (k, c) in chains.iter().enumerate() {
                 let m = (c.len() - 1) as u32;
                 counts.insert(m);
-                let start = match delta {
-                    None => fitted_start(insts, c, &t),
-                    Some(_) => insts[c[0]].frame,
+                let start = match (&reg, delta) {
+                    (Some(reg), _) => reg.starts[k],
+                    (None, None) => fitted_start(insts, c, &t),
+                    (None, Some(_)) => insts[c[0]].frame,
                 };
-                replace_at(insts, start, c, Sym::Rule(r, m));
+                let placed = reg.as_ref().map(|reg| Placed {
+                    rot_se: reg.rot_se[k],
+                    pos_se: reg.pos_se[k],
+                    drawn: &reg.drawn[offset..offset + c.len()],
+                    sigma2: reg.sigma2,
+                });
+                replace_at(insts, start, c, Sym::Rule(r, m), placed);
+                offset += c.len();
             }
+            let t = reg.map_or(t, |reg| reg.t[0]);
             g.rules.push(Rule {
                 body: Body::Seq { a, t, delta },
                 counts,
@@ -966,20 +1229,35 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan) {
         }
         Plan::Branch { trees, child, t, u } => {
             let a = insts[trees[0].0].sym;
+            let reg = tol
+                .regular
+                .then(|| regular::branching(insts, &trees, &child, &t, &u, tol));
             let mut counts = BTreeSet::new();
-            for (root, d) in trees {
-                let mut members = vec![root];
-                let mut level = vec![root];
-                for _ in 0..d {
-                    level = level
-                        .iter()
-                        .flat_map(|v| [child[0][v], child[1][v]])
-                        .collect();
-                    members.extend(level.iter().copied());
-                }
+            let mut offset = 0;
+            for (k, &(root, d)) in trees.iter().enumerate() {
+                let members = tree_members(&child, root, d);
                 counts.insert(d);
-                replace(insts, root, &members, Sym::Rule(r, d));
+                match &reg {
+                    Some(reg) => {
+                        let placed = Placed {
+                            rot_se: reg.rot_se[k],
+                            pos_se: reg.pos_se[k],
+                            drawn: &reg.drawn[offset..offset + members.len()],
+                            sigma2: reg.sigma2,
+                        };
+                        replace_at(
+                            insts,
+                            reg.starts[k],
+                            &members,
+                            Sym::Rule(r, d),
+                            Some(placed),
+                        )
+                    }
+                    None => replace(insts, root, &members, Sym::Rule(r, d)),
+                }
+                offset += members.len();
             }
+            let (t, u) = reg.map_or((t, u), |reg| (reg.t[0], reg.t[1]));
             g.rules.push(Rule {
                 body: Body::Branch { a, t, u },
                 counts,
@@ -987,9 +1265,26 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan) {
         }
         Plan::Pair { pairs, t } => {
             let (a, b) = (insts[pairs[0].0].sym, insts[pairs[0].1].sym);
-            for &(x, y) in &pairs {
-                replace(insts, x, &[x, y], Sym::Rule(r, 0));
+            // Pairs of one cluster are a repeated structure; a lone pair is not.
+            let reg = (tol.regular && pairs.len() >= 2).then(|| {
+                let chains: Vec<Vec<usize>> = pairs.iter().map(|&(x, y)| vec![x, y]).collect();
+                regular::sequence(insts, &chains, &t, tol)
+            });
+            for (k, &(x, y)) in pairs.iter().enumerate() {
+                match &reg {
+                    Some(reg) => {
+                        let placed = Placed {
+                            rot_se: reg.rot_se[k],
+                            pos_se: reg.pos_se[k],
+                            drawn: &reg.drawn[2 * k..2 * k + 2],
+                            sigma2: reg.sigma2,
+                        };
+                        replace_at(insts, reg.starts[k], &[x, y], Sym::Rule(r, 0), Some(placed))
+                    }
+                    None => replace(insts, x, &[x, y], Sym::Rule(r, 0)),
+                }
             }
+            let t = reg.map_or(t, |reg| reg.t[0]);
             g.rules.push(Rule {
                 body: Body::Pair { a, t, b },
                 counts: BTreeSet::from([0]),
@@ -1000,7 +1295,7 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan) {
 
 /// Nothing repeats: the closest pairs become pair rules, as many at once as
 /// do not share an instance.
-fn pair_up(g: &mut Grammar, insts: &mut Vec<Inst>, edges: &[Edge]) {
+fn pair_up(g: &mut Grammar, insts: &mut Vec<Inst>, edges: &[Edge], tol: Tolerance) {
     let mut order: Vec<&Edge> = edges.iter().collect();
     order.sort_by(|a, b| {
         a.gap
@@ -1028,6 +1323,7 @@ fn pair_up(g: &mut Grammar, insts: &mut Vec<Inst>, edges: &[Edge]) {
                 pairs: vec![(e.from, e.to)],
                 t: e.t,
             },
+            tol,
         );
         any = true;
     }
@@ -1039,6 +1335,7 @@ fn pair_up(g: &mut Grammar, insts: &mut Vec<Inst>, edges: &[Edge]) {
                 pairs: vec![(e.from, e.to)],
                 t: e.t,
             },
+            tol,
         );
     }
 }
