@@ -55,10 +55,6 @@ const NOT_YET: &[(&str, &str)] = &[
         "a step that grows by a constant is not a linear sequence: every leaf is a pair (14 rules)",
     ),
     (
-        "ring",
-        "one sequence, read backwards: +(150) f(40) +(180) instead of f(40) +(30) (the reverse direction wins a tie between the two clusters)",
-    ),
-    (
         "ternary-branching",
         "a branching in three is not a rule kind: a binary branching, sequences and pairs (11 rules)",
     ),
@@ -94,10 +90,6 @@ const NOT_YET_PLAIN: &[(&str, &str)] = &[
     (
         "linear-step",
         "a step that grows by a constant is not a linear sequence: every leaf is a pair (14 rules)",
-    ),
-    (
-        "ring",
-        "one sequence with the writer's turn, but read backwards (see NOT_YET) and the pen's start is the leaf's base only up to the drawing's rounding",
     ),
     (
         "spiral",

@@ -121,6 +121,9 @@ pub struct Inst {
     /// Per element kind it draws: the sum of its elements' rotations less
     /// those they are drawn with, and their number.
     tilt: Vec<(usize, f64, f64)>,
+    /// The place in the drawing of the first element it draws: structures
+    /// read in the drawing's order where the geometry leaves a choice.
+    order: usize,
 }
 
 impl Inst {
@@ -140,6 +143,7 @@ impl Inst {
                 Sym::Element(k) => vec![(k, 0.0, 1.0)],
                 Sym::Rule(..) => Vec::new(),
             },
+            order: usize::MAX,
         }
     }
 
@@ -240,6 +244,9 @@ pub fn infer(
     );
     let diagonal = (hi - lo).length().max(1e-12);
     let elements = insts.len() as u64;
+    for (i, inst) in insts.iter_mut().enumerate() {
+        inst.order = inst.order.min(i);
+    }
     let mut g = Grammar {
         rules: Vec::new(),
         axiom: None,
@@ -291,7 +298,7 @@ pub fn infer(
         let edges = edges(&insts, &live, diagonal);
         let (mut candidates, clusters) = candidates(&insts, &edges, tol, &mut budget)?;
         g.clusters += clusters;
-        let best = choose(&mut candidates, weights);
+        let best = choose(&insts, &mut candidates, weights);
         match best {
             Some(c) if c.pairs >= 2 => apply(&mut g, &mut insts, c.plan, tol),
             _ => pair_up(&mut g, &mut insts, &edges, tol),
@@ -1070,16 +1077,37 @@ fn branching(
     })
 }
 
-/// The most important candidate.
-fn choose(cands: &mut Vec<Candidate>, w: Weights) -> Option<Candidate> {
+/// Importances closer than this are equal (the two directions of one chain
+/// differ in proximity by the one link each leaves out).
+const TIE: f64 = 0.005;
+
+/// The most important candidate; between equals, the one whose links run
+/// most in the drawing's order (a ring read as it was drawn, not backwards).
+fn choose(insts: &[Inst], cands: &mut Vec<Candidate>, w: Weights) -> Option<Candidate> {
     let max_n = cands.iter().map(|c| c.pairs).max()? as f64;
     let max_l = cands.iter().map(|c| c.length).fold(0.0, f64::max);
     let score = |c: &Candidate| {
         w.n * c.pairs as f64 / max_n + w.h * c.h + w.phi * c.phi + w.l * c.length / max_l
     };
+    let forward = |c: &Candidate| {
+        let ahead = |a: usize, b: usize| usize::from(insts[a].order < insts[b].order);
+        let (k, n) = match &c.plan {
+            Plan::Seq { chains, .. } => chains
+                .iter()
+                .flat_map(|ch| ch.windows(2))
+                .fold((0, 0), |(k, n), w| (k + ahead(w[0], w[1]), n + 1)),
+            Plan::Pair { pairs, .. } => pairs
+                .iter()
+                .fold((0, 0), |(k, n), &(a, b)| (k + ahead(a, b), n + 1)),
+            Plan::Branch { .. } => (1, 1),
+        };
+        k as f64 / n.max(1) as f64
+    };
     let mut best = 0;
     for i in 1..cands.len() {
-        if score(&cands[i]) > score(&cands[best]) + 1e-12 {
+        let (a, b) = (score(&cands[i]), score(&cands[best]));
+        let (fa, fb) = (forward(&cands[i]), forward(&cands[best]));
+        if (a > b + 1e-12 && !(a < b + TIE && fb > fa)) || (a > b - TIE && fa > fb) {
             best = i;
         }
     }
@@ -1143,6 +1171,11 @@ fn replace_at(
         }
     }
     let mut inst = Inst::new(sym, frame, min, max);
+    inst.order = members
+        .iter()
+        .map(|&i| insts[i].order)
+        .min()
+        .unwrap_or(usize::MAX);
     inst.count = count.max(1.0);
     inst.mass = mass / inst.count;
     inst.noise = noise / inst.count;
