@@ -39,10 +39,6 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// numbers yet, with the reason.
 const NOT_YET: &[(&str, &str)] = &[
     (
-        "fern",
-        "mirrored leaflets become two sequences joined by pairs (6 rules); the leaflets' turn is lost",
-    ),
-    (
         "fig5-sequence",
         "the linear sequence (t0 = (60, 30, 1, -50), tΔ = (10, 0, 0, 10)) is cut after 3 elements, the rest are pairs",
     ),
@@ -59,26 +55,14 @@ const NOT_YET: &[(&str, &str)] = &[
         "a branching in three is not a rule kind: a binary branching, sequences and pairs (11 rules)",
     ),
     (
-        "three-kinds",
-        "a period of three kinds becomes three sequences joined by pairs (8 rules)",
-    ),
-    (
         "tip-buds",
         "the buds at the tips become pairs, not the m == 0 case of the branching (7 rules)",
-    ),
-    (
-        "two-kinds",
-        "a period of two kinds is coded as pairs (13 rules)",
     ),
 ];
 
 /// Cases whose plain drawing does not give back the program's rules and
 /// numbers yet, with the reason.
 const NOT_YET_PLAIN: &[(&str, &str)] = &[
-    (
-        "fern",
-        "mirrored leaflets become two sequences joined by pairs (6 rules); the leaflets' turn is lost",
-    ),
     (
         "fig1-branching",
         "one branching rule, but the leaf's pen starts at (-3, 0), not at the writer's origin (0, 0) between the base's corners, and the fewest-turns heading is not the writer's: steps 65 and 179.9, turns -20, 24, 6",
@@ -98,10 +82,6 @@ const NOT_YET_PLAIN: &[(&str, &str)] = &[
     (
         "ternary-branching",
         "a branching in three is not a rule kind: a binary branching, sequences and pairs (11 rules)",
-    ),
-    (
-        "three-kinds",
-        "a period of three kinds becomes three sequences joined by pairs (8 rules)",
     ),
     (
         "tip-buds",

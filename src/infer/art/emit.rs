@@ -70,12 +70,14 @@ struct Names {
 }
 
 impl Names {
-    fn new(kinds: usize, g: &Grammar) -> Names {
+    fn new(kinds: usize, g: &Grammar, inline: &[bool]) -> Names {
         let (mut p, mut r, mut q) = (0, 0, 0);
         let rules = g
             .rules
             .iter()
-            .map(|rule| match rule.body {
+            .zip(inline)
+            .map(|(rule, &inlined)| match rule.body {
+                _ if inlined => String::new(),
                 Body::Seq { .. } if rule.counts.iter().all(|&m| m == 1) => {
                     q += 1;
                     format!("Q{q}")
@@ -101,6 +103,58 @@ impl Names {
     }
 }
 
+/// The pair rules used exactly once, not by the axiom: each is written
+/// where it is used, so that a period reads as one rule (`P(m) -> A f(18)
+/// +(12) B f(18) +(12) P(m - 1)`, not a pair rule and a sequence of pairs).
+fn inlined(g: &Grammar) -> Vec<bool> {
+    let mut uses = vec![0usize; g.rules.len()];
+    let mut count = |s: &Sym| {
+        if let Sym::Rule(r, _) = s {
+            uses[*r] += 1;
+        }
+    };
+    for rule in &g.rules {
+        match &rule.body {
+            Body::Seq { a, .. } | Body::Branch { a, .. } => count(a),
+            Body::Pair { a, b, .. } => {
+                count(a);
+                count(b);
+            }
+        }
+    }
+    let axiom = match g.axiom {
+        Some((_, Sym::Rule(r, _))) => Some(r),
+        _ => None,
+    };
+    g.rules
+        .iter()
+        .zip(uses)
+        .enumerate()
+        .map(|(r, (rule, n))| n == 1 && axiom != Some(r) && matches!(rule.body, Body::Pair { .. }))
+        .collect()
+}
+
+/// What `s` draws when its inlined pairs are written out: each symbol with
+/// its frame relative to where `s` starts.
+fn unit(g: &Grammar, inline: &[bool], s: Sym) -> Vec<(Sym, Frame)> {
+    match s {
+        Sym::Rule(r, _) if inline[r] => match &g.rules[r].body {
+            Body::Pair { a, t, b } => {
+                let mut out = unit(g, inline, *a);
+                let at = t.apply(&Frame::IDENTITY);
+                out.extend(
+                    unit(g, inline, *b)
+                        .into_iter()
+                        .map(|(x, f)| (x, at.then(&f))),
+                );
+                out
+            }
+            _ => vec![(s, Frame::IDENTITY)],
+        },
+        _ => vec![(s, Frame::IDENTITY)],
+    }
+}
+
 /// Whether a rule takes the count `m` (sequences longer than a pair, branchings).
 fn counted(g: &Grammar, r: usize) -> bool {
     match g.rules[r].body {
@@ -113,12 +167,17 @@ fn counted(g: &Grammar, r: usize) -> bool {
 /// Derivation steps to expand `s` completely, as named counts (with their
 /// multiplicities) plus a number, so that `derive` follows `-D` edits of the
 /// counts. `named[r]` is rule `r`'s count constant, if it has one.
-fn steps(g: &Grammar, s: Sym, named: &[Option<String>]) -> (BTreeMap<String, u64>, u64) {
+fn steps(
+    g: &Grammar,
+    s: Sym,
+    named: &[Option<String>],
+    inline: &[bool],
+) -> (BTreeMap<String, u64>, u64) {
     match s {
         Sym::Element(_) => (BTreeMap::new(), 0),
         Sym::Rule(r, m) => match &g.rules[r].body {
             Body::Seq { a, .. } | Body::Branch { a, .. } => {
-                let (mut names, n) = steps(g, *a, named);
+                let (mut names, n) = steps(g, *a, named, inline);
                 if !counted(g, r) {
                     return (names, n + 1);
                 }
@@ -132,13 +191,14 @@ fn steps(g: &Grammar, s: Sym, named: &[Option<String>]) -> (BTreeMap<String, u64
             }
             Body::Pair { a, b, .. } => {
                 // max(x + y, z + w) ≤ max(x, z) + max(y, w) for counts ≥ 0.
-                let (mut x, n) = steps(g, *a, named);
-                let (y, k) = steps(g, *b, named);
+                let (mut x, n) = steps(g, *a, named, inline);
+                let (y, k) = steps(g, *b, named, inline);
                 for (name, c) in y {
                     let e = x.entry(name).or_default();
                     *e = (*e).max(c);
                 }
-                (x, 1 + n.max(k))
+                // An inlined pair is rewritten with the rule that uses it.
+                (x, u64::from(!inline[r]) + n.max(k))
             }
         },
     }
@@ -226,7 +286,10 @@ fn transform(alpha: Part, d: Part, s: Part, beta: Part) -> Vec<Module> {
     // Without a step, the two turns are one.
     let (alpha, beta) = match (alpha, &d, beta) {
         (Part::Value(a), Part::Value(0.0), Part::Value(b)) => {
-            (Part::Value(nice(a + b, 1e-9)), Part::Value(0.0))
+            // Within (−180, 180]: a left turn of 270° is a right turn of 90°.
+            let turn = (a + b).rem_euclid(360.0);
+            let turn = if turn > 180.0 { turn - 360.0 } else { turn };
+            (Part::Value(nice(turn, 1e-9)), Part::Value(0.0))
         }
         (a, _, b) => (a, b),
     };
@@ -353,7 +416,8 @@ fn describe(names: &Names, s: Sym) -> String {
 
 /// The program for a grammar.
 pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Settings) -> File {
-    let names = Names::new(inst.kinds.len(), g);
+    let inline = inlined(g);
+    let names = Names::new(inst.kinds.len(), g, &inline);
     let mut consts = Consts { items: Vec::new() };
     let element_items = match turned(inst, &g.tilt) {
         Some(inst) => kinds(elements, &inst, &names),
@@ -363,6 +427,9 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
     let mut decls: Vec<Node<Item>> = Vec::new();
     let mut rules: Vec<Node<Stmt>> = Vec::new();
     for (r, rule) in g.rules.iter().enumerate() {
+        if inline[r] {
+            continue;
+        }
         let counted_r = counted(g, r);
         let name = names.rules[r].clone();
         decls.push(node(Item::Module(ModuleDecl {
@@ -375,6 +442,7 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
         })));
         let mut w = RuleWriter {
             g,
+            inline: &inline,
             names: &names,
             jitter: s.jitter,
             count_of: &count_of,
@@ -395,7 +463,7 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
             Body::Pair { a, t, b } => w.pair(*a, t, *b),
         }
     }
-    let (axiom, derive) = axiom(elements, g, &names, &count_of);
+    let (axiom, derive) = axiom(elements, g, &names, &count_of, &inline);
     let mut stmts: Vec<Node<Stmt>> = Vec::new();
     stmts.push(node(Stmt::Derive(derive)));
     stmts.push(node(Stmt::Axiom(axiom)));
@@ -528,6 +596,8 @@ fn m_is(op: BinOp) -> Option<Expr> {
 /// Writes the rules of one rule of the grammar, named `name`, into `out`.
 struct RuleWriter<'a> {
     g: &'a Grammar,
+    /// Pair rules written where they are used (see `inlined`).
+    inline: &'a [bool],
     names: &'a Names,
     jitter: Option<f64>,
     count_of: &'a [Option<Expr>],
@@ -547,6 +617,79 @@ impl RuleWriter<'_> {
 
     fn placed(&self, s: Sym) -> Vec<Module> {
         placed(self.names, self.g, s, self.child_count(s))
+    }
+
+    /// `s` with its inlined pairs written out, each move rounded for a
+    /// structure repeated `n` times, and where the turtle ends (relative to
+    /// where `s` starts). `last_open`: the last symbol is not bracketed (it
+    /// ends the successor).
+    fn unit(&self, s: Sym, n: f64, last_open: bool) -> (Vec<Module>, Frame) {
+        self.write(&unit(self.g, self.inline, s), n, last_open)
+    }
+
+    /// Symbols at frames (relative to where the turtle starts), each move
+    /// rounded for a structure repeated `n` times, and where the turtle ends.
+    fn write(&self, items: &[(Sym, Frame)], n: f64, last_open: bool) -> (Vec<Module>, Frame) {
+        let mut out = Vec::new();
+        let mut at = Frame::IDENTITY;
+        for (k, (x, f)) in items.iter().enumerate() {
+            if k > 0 || *f != Frame::IDENTITY {
+                let t = Tr::between(&at, f, 1.0);
+                let (va, vd, vs, vb) = Round::new(n, t.d.max(1e-9)).values(&t);
+                out.extend(transform(
+                    Part::Value(va),
+                    Part::Value(vd),
+                    Part::Value(vs),
+                    Part::Value(vb),
+                ));
+                at = *f;
+            }
+            if last_open && k + 1 == items.len() {
+                out.push(module_of(self.names, self.g, *x, self.child_count(*x)));
+            } else {
+                out.extend(self.placed(*x));
+            }
+        }
+        (out, at)
+    }
+
+    /// What `s` draws, for a comment: its name, or its inlined pairs' parts.
+    fn describe(&self, s: Sym) -> String {
+        self.summary(&unit(self.g, self.inline, s))
+    }
+
+    /// The symbols of a unit, counted in the order they first appear:
+    /// `A and B`, `3 A and 2 B`.
+    fn summary(&self, items: &[(Sym, Frame)]) -> String {
+        let mut counts: Vec<(Sym, usize)> = Vec::new();
+        for (x, _) in items {
+            match counts.iter_mut().find(|c| c.0 == *x) {
+                Some(c) => c.1 += 1,
+                None => counts.push((*x, 1)),
+            }
+        }
+        let parts: Vec<String> = counts
+            .iter()
+            .map(|&(x, n)| match n {
+                1 => describe(self.names, x),
+                n => format!("{n} {}", describe(self.names, x)),
+            })
+            .collect();
+        match parts.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+            _ => parts.concat(),
+        }
+    }
+
+    /// `s` written out, from and back to where it starts: bracketed when
+    /// it moves the turtle.
+    fn unit_in_place(&self, s: Sym, n: f64) -> Vec<Module> {
+        let (mut out, at) = self.unit(s, n, false);
+        if at != Frame::IDENTITY {
+            out.insert(0, sym('[', None));
+            out.push(sym(']', None));
+        }
+        out
     }
 
     fn recurse(&self) -> Module {
@@ -603,7 +746,19 @@ impl RuleWriter<'_> {
     /// changing with m for a linear sequence (`delta`).
     fn sequence(&mut self, consts: &mut Consts, n: f64, a: Sym, t: &Tr, delta: Option<&Tr>) {
         let name = self.name.clone();
-        let (pa, pd, ps, pb) = self.parts(consts, t, "", n);
+        // A period written out ends where its last part is: the step goes
+        // on from there (`A f(18) +(12) B f(18) +(12)`), unless it changes
+        // with m (then the period is bracketed).
+        let (mut succ, at) = self.unit(a, n, false);
+        let step = if at == Frame::IDENTITY {
+            *t
+        } else if delta.is_some() {
+            succ = self.unit_in_place(a, n);
+            *t
+        } else {
+            Tr::between(&at, &t.apply(&Frame::IDENTITY), 1.0)
+        };
+        let (pa, pd, ps, pb) = self.parts(consts, &step, "", n);
         let (pa, pb) = match delta {
             Some(dl) => {
                 let tol = 0.002 / (n * n);
@@ -630,12 +785,11 @@ impl RuleWriter<'_> {
             }
             None => (pa, pb),
         };
-        let mut succ = self.placed(a);
         succ.extend(transform(pa, pd, ps, pb));
         succ.push(self.recurse());
         let note = format!(
             "{name}(m): a sequence of m + 1 {}{}",
-            describe(self.names, a),
+            self.describe(a),
             if delta.is_some() {
                 ", turning by a changing angle"
             } else {
@@ -643,7 +797,7 @@ impl RuleWriter<'_> {
             }
         );
         self.add(m_is(BinOp::Gt), succ, Some(note));
-        let last = self.placed(a);
+        let (last, _) = self.unit(a, n, false);
         self.add(m_is(BinOp::Eq), last, None);
     }
 
@@ -651,7 +805,7 @@ impl RuleWriter<'_> {
     fn branching(&mut self, consts: &mut Consts, n: f64, a: Sym, t: &Tr, u: &Tr) {
         let (ta, td, ts, tb) = self.parts(consts, t, "1", n);
         let (ua, ud, us, ub) = self.parts(consts, u, "2", n);
-        let mut succ = self.placed(a);
+        let mut succ = self.unit_in_place(a, n);
         for (pa, pd, ps, pb) in [(ta, td, ts, tb), (ua, ud, us, ub)] {
             succ.push(sym('[', None));
             succ.extend(transform(pa, pd, ps, pb));
@@ -661,34 +815,32 @@ impl RuleWriter<'_> {
         let note = format!(
             "{}(m): {} branching in two, m levels deep",
             self.name,
-            describe(self.names, a)
+            self.describe(a)
         );
         self.add(m_is(BinOp::Gt), succ, Some(note));
-        let last = self.placed(a);
+        let (last, _) = self.unit(a, n, false);
         self.add(m_is(BinOp::Eq), last, None);
     }
 
     /// `Q -> [a] T [b]`, the transform inlined.
     fn pair(&mut self, a: Sym, t: &Tr, b: Sym) {
-        let (va, vd, vs, vb) = Round::new(1.0, t.d.max(1e-9)).values(t);
-        let mut succ = self.placed(a);
-        succ.extend(transform(
-            Part::Value(va),
-            Part::Value(vd),
-            Part::Value(vs),
-            Part::Value(vb),
-        ));
-        succ.push(module_of(self.names, self.g, b, self.child_count(b)));
-        let what = if b == a {
-            format!("two {}", describe(self.names, a))
-        } else {
-            format!(
-                "{} and {}",
-                describe(self.names, a),
-                describe(self.names, b)
-            )
+        let mut items = unit(self.g, self.inline, a);
+        let at = t.apply(&Frame::IDENTITY);
+        items.extend(
+            unit(self.g, self.inline, b)
+                .into_iter()
+                .map(|(x, f)| (x, at.then(&f))),
+        );
+        let (succ, _) = self.write(&items, 1.0, true);
+        let note = match items.len() {
+            2 if a == b => format!("{}: two {} (a pair)", self.name, self.describe(a)),
+            2 => format!("{}: {} (a pair)", self.name, self.summary(&items)),
+            _ => format!(
+                "{}: {}, each placed from the one before",
+                self.name,
+                self.summary(&items)
+            ),
         };
-        let note = format!("{}: {what} (a pair)", self.name);
         self.add(None, succ, Some(note));
     }
 }
@@ -700,6 +852,7 @@ fn axiom(
     g: &Grammar,
     names: &Names,
     count_of: &[Option<Expr>],
+    inline: &[bool],
 ) -> (Vec<Module>, Expr) {
     let mut axiom = Vec::new();
     let mut derive = Expr::num(1.0);
@@ -740,7 +893,7 @@ fn axiom(
                 _ => None,
             })
             .collect();
-        let (names, n) = steps(g, s, &named);
+        let (names, n) = steps(g, s, &named, inline);
         derive = steps_expr(names, n);
     }
     (axiom, derive)

@@ -22,6 +22,7 @@ use super::space::{Point, Tr, cluster};
 use super::{Budget, TooMuchWork};
 use crate::geometry::index::PointGrid;
 use glam::DVec2;
+use std::cmp::Ordering;
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 
 /// A symbol of the inferred grammar: an element kind, or a rule with its count.
@@ -1109,6 +1110,39 @@ fn choose(insts: &[Inst], cands: &mut Vec<Candidate>, w: Weights) -> Option<Cand
         let (fa, fb) = (forward(&cands[i]), forward(&cands[best]));
         if (a > b + 1e-12 && !(a < b + TIE && fb > fa)) || (a > b - TIE && fa > fb) {
             best = i;
+        }
+    }
+    // A sequence whose members pair up regularly with another kind's (A B
+    // A B …, a leaflet on each side) is a period: the pairs first, then the
+    // sequence of pairs, one rule over the period.
+    if let Plan::Seq { chains, .. } = &cands[best].plan {
+        let members: HashSet<usize> = chains.iter().flatten().copied().collect();
+        let covers = |c: &Candidate| match &c.plan {
+            Plan::Pair { pairs, .. } if pairs.len() >= 2 => {
+                let k = pairs
+                    .iter()
+                    .filter(|(a, b)| members.contains(a) || members.contains(b))
+                    .count();
+                pairs.len() * 5 >= members.len() * 4 && k * 5 >= members.len() * 4
+            }
+            _ => false,
+        };
+        if let Some(p) = (0..cands.len())
+            .filter(|&i| covers(&cands[i]))
+            .max_by(|&x, &y| {
+                let (a, b) = (score(&cands[x]), score(&cands[y]));
+                let tie = (a - b).abs() <= TIE;
+                (if tie {
+                    Ordering::Equal
+                } else {
+                    a.total_cmp(&b)
+                })
+                .then(forward(&cands[x]).total_cmp(&forward(&cands[y])))
+                .then(a.total_cmp(&b))
+                .then(y.cmp(&x))
+            })
+        {
+            best = p;
         }
     }
     Some(cands.swap_remove(best))
