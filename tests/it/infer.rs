@@ -135,6 +135,8 @@ const EXACT: &[&str] = &[
     "mixed-skip",
     "noisy-grid",
     "mirrored",
+    "fig5",
+    "linear-step",
 ];
 
 #[test]
@@ -222,6 +224,44 @@ fn recovered_counts_and_transforms_are_the_generators() {
     // Separate squares in one path are separate elements; a ring with its hole is one.
     let sub = infer(&case("subpaths"), &o).stats;
     assert_eq!((sub.elements, sub.kinds), (6, 2));
+}
+
+/// Linear sequences (the paper's §5.3, Fig. 5) are one rule each, with the
+/// counter in its expressions: t(m) = t0 + tΔ·m.
+#[test]
+fn linear_sequences_are_one_rule() {
+    let near = |text: &str, name: &str, want: f64| {
+        let v = constant(text, name);
+        assert!(
+            (v - want).abs() <= 0.005 * want.abs().max(1.0),
+            "{name} = {v}, want {want}\n{text}"
+        );
+    };
+    // Fig. 5: t0 = (60°, 20, 1, −50°), tΔ = (10°, 0, 0, 10°), P(8).
+    let fig5 = infer(&case("fig5"), &Options::default());
+    let t = &fig5.text;
+    assert_eq!(fig5.stats.rules, 1, "{t}");
+    assert_eq!(constant(t, "P1_N"), 8.0);
+    for (name, want) in [
+        ("P1_TURN", 60.0),
+        ("P1_STEP", 20.0),
+        ("P1_TWIST", -50.0),
+        ("P1_DTURN", 10.0),
+        ("P1_DTWIST", 10.0),
+    ] {
+        near(t, name, want);
+    }
+    assert!(!t.contains("P1_SCALE") && !t.contains("P1_DSTEP"), "{t}");
+    // A step that grows by 2 per leaf: f(D0 + DD * m), D0 = 32, DD = −2, P(10).
+    let step = infer(&case("linear-step"), &Options::default());
+    let t = &step.text;
+    assert_eq!(step.stats.rules, 1, "{t}");
+    assert_eq!(constant(t, "P1_N"), 10.0);
+    near(t, "P1_STEP", 32.0);
+    near(t, "P1_DSTEP", -2.0);
+    near(t, "P1_TURN", -90.0);
+    near(t, "P1_TWIST", 90.0);
+    assert!(!t.contains("P1_DTURN"), "{t}");
 }
 
 #[test]

@@ -454,8 +454,17 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
             out: &mut rules,
         };
         match &rule.body {
-            Body::Seq { a, t, delta } if counted_r => {
-                w.sequence(&mut consts, run(g, r), *a, t, delta.as_ref());
+            Body::Seq {
+                a, t, delta, place, ..
+            } if counted_r => {
+                w.sequence(
+                    &mut consts,
+                    run(g, r),
+                    *a,
+                    t,
+                    delta.as_ref(),
+                    place.as_ref(),
+                );
             }
             Body::Branch { a, t, u } => w.branching(&mut consts, run(g, r), *a, t, u),
             // A sequence used only with m = 1 is the pair P -> A T A.
@@ -742,14 +751,45 @@ impl RuleWriter<'_> {
         )
     }
 
-    /// `P(m) : m > 0 -> [a] T P(m - 1); P(m) : m == 0 -> [a]`, the turns
-    /// changing with m for a linear sequence (`delta`).
-    fn sequence(&mut self, consts: &mut Consts, n: f64, a: Sym, t: &Tr, delta: Option<&Tr>) {
+    /// `a` drawn from the turtle moved by `place` (`[+(φ) f(r) -(φ) a]`), or
+    /// placed as usual.
+    fn placed_at(&self, a: Sym, place: Option<&Tr>) -> Vec<Module> {
+        let Some(pl) = place else {
+            return self.placed(a);
+        };
+        let (va, vd, vs, vb) = Round::new(1.0, pl.d.max(1e-9)).values(pl);
+        let mut out = vec![sym('[', None)];
+        out.extend(transform(
+            Part::Value(va),
+            Part::Value(vd),
+            Part::Value(vs),
+            Part::Value(vb),
+        ));
+        out.push(module_of(self.names, self.g, a, self.child_count(a)));
+        out.push(sym(']', None));
+        out
+    }
+
+    /// `P(m) : m > 0 -> [a] T P(m - 1); P(m) : m == 0 -> [a]`; for a linear
+    /// sequence (`delta`) each number of T that changes is `X + DX * m`, the
+    /// paper's t(m) = t0 + tΔ·m, with named constants for t0 and tΔ.
+    fn sequence(
+        &mut self,
+        consts: &mut Consts,
+        n: f64,
+        a: Sym,
+        t: &Tr,
+        delta: Option<&Tr>,
+        place: Option<&Tr>,
+    ) {
         let name = self.name.clone();
         // A period written out ends where its last part is: the step goes
         // on from there (`A f(18) +(12) B f(18) +(12)`), unless it changes
         // with m (then the period is bracketed).
-        let (mut succ, at) = self.unit(a, n, false);
+        let (mut succ, at) = match place {
+            Some(_) => (self.placed_at(a, place), Frame::IDENTITY),
+            None => self.unit(a, n, false),
+        };
         let step = if at == Frame::IDENTITY {
             *t
         } else if delta.is_some() {
@@ -759,45 +799,85 @@ impl RuleWriter<'_> {
             Tr::between(&at, &t.apply(&Frame::IDENTITY), 1.0)
         };
         let (pa, pd, ps, pb) = self.parts(consts, &step, "", n);
-        let (pa, pb) = match delta {
+        let mut changing: Vec<&'static str> = Vec::new();
+        let (pa, pd, ps, pb) = match delta {
             Some(dl) => {
-                let tol = 0.002 / (n * n);
-                let linear = |consts: &mut Consts, base: Part, step: f64, what: &str| {
-                    let step = nice(step.to_degrees(), tol);
-                    let base = match base {
-                        Part::Value(v) => Expr::num(v),
-                        Part::Expr(e) => e,
+                // A change per step is applied up to n times to a value
+                // applied up to n times.
+                let nn = n * n;
+                let units = t.d.abs().max(dl.d.abs() * n).max(1e-9);
+                let mut linear =
+                    |base: Part, step: f64, tol: f64, what: &str, how: &'static str| {
+                        let step = nice(step, tol);
+                        let base = match base {
+                            Part::Value(v) => Expr::num(v),
+                            Part::Expr(e) => e,
+                        };
+                        if step == 0.0 {
+                            return match base.kind {
+                                ExprKind::Num(v) => Part::Value(v),
+                                _ => Part::Expr(base),
+                            };
+                        }
+                        changing.push(how);
+                        let note = match what {
+                            "STEP" => "change of the step per step of m",
+                            "SCALE" => "change of the scale factor per step of m",
+                            _ => "change of the turn per step of m",
+                        };
+                        let c = consts.add(&format!("{name}_D{what}"), step, note);
+                        Part::Expr(bin(BinOp::Add, base, bin(BinOp::Mul, c, var("m"))))
                     };
-                    if step == 0.0 {
-                        return Part::Expr(base);
-                    }
-                    let c = consts.add(
-                        &format!("{name}_D{what}"),
-                        step,
-                        "change of the turn per step of m",
-                    );
-                    Part::Expr(bin(BinOp::Add, base, bin(BinOp::Mul, c, var("m"))))
-                };
+                let turn = 0.002 / nn;
                 (
-                    linear(consts, pa, dl.alpha, "TURN"),
-                    linear(consts, pb, dl.beta, "TWIST"),
+                    linear(
+                        pa,
+                        dl.alpha.to_degrees(),
+                        turn,
+                        "TURN",
+                        "turning by a changing angle",
+                    ),
+                    linear(
+                        pd,
+                        dl.d,
+                        units * 2e-5 / nn,
+                        "STEP",
+                        "stepping a changing distance",
+                    ),
+                    linear(ps, dl.s, 2e-5 / nn, "SCALE", "scaling by a changing factor"),
+                    linear(
+                        pb,
+                        dl.beta.to_degrees(),
+                        turn,
+                        "TWIST",
+                        "turning by a changing angle",
+                    ),
                 )
             }
-            None => (pa, pb),
+            None => (pa, pd, ps, pb),
         };
         succ.extend(transform(pa, pd, ps, pb));
         succ.push(self.recurse());
+        let mut hows: Vec<&str> = Vec::new();
+        for how in changing {
+            if !hows.contains(&how) {
+                hows.push(how);
+            }
+        }
         let note = format!(
             "{name}(m): a sequence of m + 1 {}{}",
             self.describe(a),
-            if delta.is_some() {
-                ", turning by a changing angle"
+            if hows.is_empty() {
+                String::new()
             } else {
-                ""
+                format!(", {}", hows.join(" and "))
             }
         );
         self.add(m_is(BinOp::Gt), succ, Some(note));
-        let (last, _) = self.unit(a, n, false);
+        let last = match place {
+            Some(_) => self.placed_at(a, place),
+            None => self.unit(a, n, false).0,
+        };
         self.add(m_is(BinOp::Eq), last, None);
     }
 

@@ -491,7 +491,7 @@ impl<'a> Fit<'a> {
 
 /// Solves `a x = b` (Gaussian elimination with partial pivoting); `None`
 /// when `a` is singular.
-fn solve_linear(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
+pub(super) fn solve_linear(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
     let n = b.len();
     let scale = a
         .iter()

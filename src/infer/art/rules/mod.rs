@@ -15,6 +15,7 @@
 //! so what is drawn back stays on the input. Must not print or build syntax.
 
 mod fit;
+mod linear;
 mod regular;
 
 use super::shape::{Frame, wrap};
@@ -36,8 +37,15 @@ pub enum Sym {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Body {
     /// `P(m) : m > 0 -> [a] T(t(m)) P(m - 1); P(m) : m == 0 -> [a]` with
-    /// t(m) = t + delta·m (delta only for linear sequences).
-    Seq { a: Sym, t: Tr, delta: Option<Tr> },
+    /// t(m) = t + delta·m (delta only for linear sequences); `a` is drawn
+    /// from the turtle moved by `place` (when its frame's origin is not where
+    /// the turtle turns).
+    Seq {
+        a: Sym,
+        t: Tr,
+        delta: Option<Tr>,
+        place: Option<Tr>,
+    },
     /// `R(m) : m > 0 -> [a] [T R(m - 1)] [U R(m - 1)]; R(m) : m == 0 -> [a]`.
     Branch { a: Sym, t: Tr, u: Tr },
     /// `Q -> [a] T [b]`.
@@ -188,6 +196,9 @@ enum Plan {
         chains: Vec<Vec<usize>>,
         t: Tr,
         delta: Option<Tr>,
+        place: Option<Tr>,
+        /// Where a fit placed the chains, when one did.
+        fitted: Option<regular::Regular>,
     },
     Branch {
         trees: Vec<(usize, u32)>,
@@ -433,7 +444,7 @@ fn candidates(
                     }
                 }
             }
-            out.extend(linear(insts, edges, &index, ks, tol, budget)?);
+            out.extend(linear::linear(insts, edges, &index, ks, tol, budget)?);
         }
     }
     Ok((out, count))
@@ -713,212 +724,14 @@ fn seq_candidate(
         h: 1.0 - gap_sum / pairs as f64,
         phi,
         pairs,
-        plan: Plan::Seq { chains, t, delta },
+        plan: Plan::Seq {
+            chains,
+            t,
+            delta,
+            place: None,
+            fitted: None,
+        },
     })
-}
-
-/// The steps between consecutive edges of `group` (an edge into an
-/// instance and an edge out of it, not straight back): the links, and the
-/// change of turn and twist along each, in tolerance units.
-fn step_links(
-    edges: &[Edge],
-    group: &[usize],
-    tol: Tolerance,
-) -> (Vec<(usize, usize)>, Vec<Point>) {
-    let mut out_of: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
-    for &k in group {
-        out_of.entry(edges[k].from).or_default().push(k);
-    }
-    // Steps between consecutive edges.
-    let mut links: Vec<(usize, usize)> = Vec::new();
-    let mut deltas: Vec<Point> = Vec::new();
-    for &k in group {
-        for &f in out_of.get(&edges[k].to).into_iter().flatten() {
-            if edges[f].to == edges[k].from {
-                continue;
-            }
-            let (a, b) = (&edges[k].t, &edges[f].t);
-            let da = wrap(b.alpha - a.alpha) / tol.angle;
-            let db = wrap(b.beta - a.beta) / tol.angle;
-            links.push((k, f));
-            deltas.push([da, 0.0, 0.0, db]);
-        }
-    }
-    (links, deltas)
-}
-
-/// The chains of instances linked by edges whose steps are in cluster `top`
-/// of `dl` (one label per link), node-disjoint, with their transforms.
-fn linear_chains(
-    edges: &[Edge],
-    links: &[(usize, usize)],
-    dl: &[usize],
-    top: usize,
-) -> Vec<(Vec<usize>, Vec<Tr>)> {
-    let mut next: BTreeMap<usize, usize> = BTreeMap::new();
-    let mut has_prev: HashSet<usize> = HashSet::new();
-    let mut used_nodes: HashSet<usize> = HashSet::new();
-    for (i, &(k, f)) in links.iter().enumerate() {
-        if dl[i] != top || next.contains_key(&k) || has_prev.contains(&f) {
-            continue;
-        }
-        next.insert(k, f);
-        has_prev.insert(f);
-    }
-    // Edge chains to instance chains, node-disjoint.
-    let mut chains: Vec<(Vec<usize>, Vec<Tr>)> = Vec::new();
-    let starts: Vec<usize> = next
-        .keys()
-        .copied()
-        .filter(|k| !has_prev.contains(k))
-        .collect();
-    for s in starts {
-        let mut nodes = vec![edges[s].from];
-        let mut in_chain: HashSet<usize> = HashSet::from([edges[s].from]);
-        let mut ts = Vec::new();
-        let mut k = s;
-        let mut seen = HashSet::new();
-        loop {
-            let e = &edges[k];
-            if used_nodes.contains(&e.to) || !seen.insert(k) || in_chain.contains(&e.to) {
-                break;
-            }
-            nodes.push(e.to);
-            in_chain.insert(e.to);
-            ts.push(e.t);
-            match next.get(&k) {
-                Some(&f) => k = f,
-                None => break,
-            }
-        }
-        if ts.len() >= 2 && !used_nodes.contains(&nodes[0]) {
-            used_nodes.extend(nodes.iter().copied());
-            chains.push((nodes, ts));
-        }
-    }
-    chains
-}
-
-/// Chains whose turns change by a constant step: the (d, s) subspace.
-fn linear(
-    insts: &[Inst],
-    edges: &[Edge],
-    index: &Index,
-    ks: &[usize],
-    tol: Tolerance,
-    budget: &mut Budget,
-) -> Result<Option<Candidate>, TooMuchWork> {
-    let points: Vec<Point> = ks
-        .iter()
-        .map(|&k| {
-            let p = point(&edges[k].t, tol);
-            [0.0, p[1], p[2], 0.0]
-        })
-        .collect();
-    budget.spend(points.len())?;
-    let (label, centres) = cluster(&points, 0.0);
-    let mut best: Option<Candidate> = None;
-    for c in 0..centres.len() {
-        budget.spend(ks.len())?;
-        let group: Vec<usize> = ks
-            .iter()
-            .zip(&label)
-            .filter(|(_, l)| **l == c)
-            .map(|(k, _)| *k)
-            .collect();
-        if group.len() < 3 {
-            continue;
-        }
-        let (links, deltas) = step_links(edges, &group, tol);
-        if links.len() < 2 {
-            continue;
-        }
-        budget.spend(deltas.len())?;
-        let (dl, dc) = cluster(&deltas, 0.0);
-        let mut sizes = vec![0usize; dc.len()];
-        for l in &dl {
-            sizes[*l] += 1;
-        }
-        // The most common step that actually turns.
-        // A step that turns, by less than LINEAR_STEP_MAX (larger changes
-        // are not a gradual curve but different structures).
-        let max = LINEAR_STEP_MAX / tol.angle;
-        let Some(top) = (0..dc.len())
-            .filter(|&i| dc[i][0].abs() > 1.5 || dc[i][3].abs() > 1.5)
-            .filter(|&i| dc[i][0].abs() <= max && dc[i][3].abs() <= max)
-            .max_by(|&x, &y| sizes[x].cmp(&sizes[y]).then(y.cmp(&x)))
-        else {
-            continue;
-        };
-        if sizes[top] < 2 {
-            continue;
-        }
-        let mut chains = linear_chains(edges, &links, &dl, top);
-        if chains.is_empty() {
-            continue;
-        }
-        // One rule for chains that share t0: the longest one's.
-        chains.sort_by_key(|c| std::cmp::Reverse(c.0.len()));
-        let step = |ts: &[Tr]| {
-            let n = (ts.len() - 1) as f64;
-            Tr {
-                alpha: wrap(ts.last().map_or(0.0, |t| t.alpha) - ts[0].alpha) / n,
-                d: 0.0,
-                s: 0.0,
-                beta: wrap(ts.last().map_or(0.0, |t| t.beta) - ts[0].beta) / n,
-            }
-        };
-        let d0 = step(&chains[0].1);
-        // t(m) = t0 + tΔ·m with m counting down: tΔ = −step, t0 = first − tΔ·M.
-        let t0_of = |ts: &[Tr]| {
-            let m = ts.len() as f64;
-            let avg = mean(ts);
-            Tr {
-                alpha: wrap(ts[0].alpha + d0.alpha * m),
-                d: avg.d,
-                s: avg.s,
-                beta: wrap(ts[0].beta + d0.beta * m),
-            }
-        };
-        let t0 = t0_of(&chains[0].1);
-        let delta = Tr {
-            alpha: -d0.alpha,
-            d: 0.0,
-            s: 0.0,
-            beta: -d0.beta,
-        };
-        let at = |m: usize| Tr {
-            alpha: wrap(t0.alpha + delta.alpha * m as f64),
-            d: t0.d,
-            s: t0.s,
-            beta: wrap(t0.beta + delta.beta * m as f64),
-        };
-        let keep: Vec<Vec<usize>> = chains
-            .into_iter()
-            .filter(|(_, ts)| {
-                let t = t0_of(ts);
-                wrap(t.alpha - t0.alpha).abs() <= tol.angle * 2.0
-                    && wrap(t.beta - t0.beta).abs() <= tol.angle * 2.0
-            })
-            .map(|(n, _)| n)
-            .collect();
-        // Redraw check: the q-th step of a chain of n uses m = n - 1 - q.
-        let mut cut = Vec::new();
-        for chain in keep {
-            let n = chain.len();
-            let pieces = cut_drift(insts, vec![chain], |q, _| at(n - 1 - q), tol);
-            // Only whole chains keep the count right for t(m).
-            if pieces.len() == 1 && pieces[0].len() == n {
-                cut.extend(pieces);
-            }
-        }
-        if let Some(cand) = seq_candidate(edges, index, cut, t0, Some(delta), 1.0)
-            && best.as_ref().is_none_or(|b| cand.pairs > b.pairs)
-        {
-            best = Some(cand);
-        }
-    }
-    Ok(best)
 }
 
 /// The depth of the complete binary tree below `v` whose children are
@@ -1265,10 +1078,17 @@ fn tree_members(child: &[HashMap<usize, usize>; 2], root: usize, depth: u32) -> 
 fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
     let r = g.rules.len();
     match plan {
-        Plan::Seq { chains, t, delta } => {
+        Plan::Seq {
+            chains,
+            t,
+            delta,
+            place,
+            fitted,
+        } => {
             let a = insts[chains[0][0]].sym;
-            let reg = (tol.regular && delta.is_none())
-                .then(|| regular::sequence(insts, &chains, &t, tol));
+            let reg = fitted.or_else(|| {
+                (tol.regular && delta.is_none()).then(|| regular::sequence(insts, &chains, &t, tol))
+            });
             let mut counts = BTreeSet::new();
             let mut offset = 0;
             for (k, c) in chains.iter().enumerate() {
@@ -1290,7 +1110,7 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
             }
             let t = reg.map_or(t, |reg| reg.t[0]);
             g.rules.push(Rule {
-                body: Body::Seq { a, t, delta },
+                body: Body::Seq { a, t, delta, place },
                 counts,
             });
         }

@@ -48,6 +48,7 @@ fn identity() -> Frame {
 /// A regular structure: its transforms, each copy's start frame with the
 /// standard error of its rotation, where each member is drawn (in the order
 /// of the members), and the variance of a position about the fit.
+#[derive(Debug)]
 pub(super) struct Regular {
     pub t: Vec<Tr>,
     pub starts: Vec<Frame>,
