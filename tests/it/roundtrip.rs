@@ -43,14 +43,6 @@ const NOT_YET: &[(&str, &str)] = &[
         "the linear sequence (t0 = (60, 30, 1, -50), tΔ = (10, 0, 0, 10)) is cut after 3 elements, the rest are pairs",
     ),
     (
-        "linear-angle",
-        "one linear rule with the writer's t0 and tΔ, but printed with the drawing's noise (a twist of 6.0086, not 6): numbers are not yet printed to the precision the drawing supports",
-    ),
-    (
-        "linear-step",
-        "a step that grows by a constant is not a linear sequence: every leaf is a pair (14 rules)",
-    ),
-    (
         "ternary-branching",
         "a branching in three is not a rule kind: a binary branching, sequences and pairs (11 rules)",
     ),
