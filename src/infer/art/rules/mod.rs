@@ -1020,7 +1020,9 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
         } => {
             let a = insts[chains[0][0]].sym;
             let reg = fitted.or_else(|| {
-                (tol.regular && delta.is_none()).then(|| regular::sequence(insts, &chains, &t, tol))
+                (tol.regular && delta.is_none())
+                    .then(|| regular::sequence(insts, &chains, &t, tol))
+                    .flatten()
             });
             let mut counts = BTreeSet::new();
             let mut offset = 0;
@@ -1051,7 +1053,8 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
             let a = insts[trees[0].0].sym;
             let reg = tol
                 .regular
-                .then(|| regular::branching(insts, &trees, &child, &t, &u, tol));
+                .then(|| regular::branching(insts, &trees, &child, &t, &u, tol))
+                .flatten();
             let mut counts = BTreeSet::new();
             let mut offset = 0;
             for (k, &(root, d)) in trees.iter().enumerate() {
@@ -1086,10 +1089,12 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
         Plan::Pair { pairs, t } => {
             let (a, b) = (insts[pairs[0].0].sym, insts[pairs[0].1].sym);
             // Pairs of one cluster are a repeated structure; a lone pair is not.
-            let reg = (tol.regular && pairs.len() >= 2).then(|| {
-                let chains: Vec<Vec<usize>> = pairs.iter().map(|&(x, y)| vec![x, y]).collect();
-                regular::sequence(insts, &chains, &t, tol)
-            });
+            let reg = (tol.regular && pairs.len() >= 2)
+                .then(|| {
+                    let chains: Vec<Vec<usize>> = pairs.iter().map(|&(x, y)| vec![x, y]).collect();
+                    regular::sequence(insts, &chains, &t, tol)
+                })
+                .flatten();
             for (k, &(x, y)) in pairs.iter().enumerate() {
                 match &reg {
                     Some(reg) => {
