@@ -272,6 +272,15 @@ fn symmetrize_makes_a_noisy_grid_regular() {
     assert_eq!(constant(t, "P1_TURN"), -90.0);
     assert_eq!(constant(t, "P1_TWIST"), 90.0);
     assert_eq!(constant(t, "P2_N"), 2.0);
+    // The rows are 10 apart and not turned against each other.
+    assert_eq!(constant(t, "P2_STEP"), 10.0);
+    assert!(!t.contains("P2_TURN") && !t.contains("P2_TWIST"), "{t}");
+    // A noisy ring of 24 closes: one sequence turning exactly 15° per step.
+    let ring = infer(&case("noisy-ring"), &opts);
+    let t = &ring.text;
+    assert_eq!((ring.stats.rules, constant(t, "P1_N")), (1, 23.0), "{t}");
+    let turn = constant(t, "P1_TURN") + constant(t, "P1_TWIST");
+    assert_eq!(turn.abs(), 15.0, "{t}");
 }
 
 /// `--symmetrize` on jittered grids and rings (three seeds each): the redraw is

@@ -49,8 +49,15 @@ enum Vary {
 /// taking the frames' origins as the turtle's.
 const TURN_ANY_ORIGIN: usize = 4000;
 
-/// Edges out of an instance that a link may continue with, nearest first.
-const LINKS_OUT: usize = 8;
+/// Edges out of an instance that a link may continue with, nearest first:
+/// a turning chain may curl back past its neighbours (Fig. 5); a growing
+/// one goes on to the nearest instance in the same direction.
+fn links_out(vary: Vary) -> usize {
+    match vary {
+        Vary::Turn => 8,
+        Vary::Grow => 2,
+    }
+}
 
 /// Delta clusters tried per search.
 const TRIES: usize = 3;
@@ -214,9 +221,7 @@ fn search(
         for &l in &cl {
             sizes[l] += 1;
         }
-        let mut tops: Vec<usize> = (0..cc.len())
-            .filter(|&i| sizes[i] >= 2 && gradual(&cc[i], det, vary))
-            .collect();
+        let mut tops: Vec<usize> = (0..cc.len()).filter(|&i| sizes[i] >= 2).collect();
         tops.sort_by(|&x, &y| sizes[y].cmp(&sizes[x]).then(x.cmp(&y)));
         tops.truncate(TRIES);
         for top in tops {
@@ -231,8 +236,8 @@ fn search(
 }
 
 /// The steps between consecutive edges of `group` (an edge into an
-/// instance and one of the nearest edges out of it, not straight back): the
-/// links, and how the transform changes along each.
+/// instance and one of the nearest edges out of it, not straight back) along
+/// which the transform changes gradually: the links, and the changes.
 fn step_links(
     insts: &[Inst],
     edges: &[Edge],
@@ -252,7 +257,7 @@ fn step_links(
     );
     for outs in out_of.values_mut() {
         outs.sort_by(|&a, &b| length(a).total_cmp(&length(b)).then(a.cmp(&b)));
-        outs.truncate(LINKS_OUT);
+        outs.truncate(links_out(vary));
     }
     let mut links = Vec::new();
     let mut changes = Vec::new();
@@ -261,8 +266,13 @@ fn step_links(
             if edges[f].to == edges[k].from {
                 continue;
             }
-            links.push((k, f));
-            changes.push(change(&edges[k].t, &edges[f].t, tol, vary, unit));
+            // Only gradual changes are clustered: most links of a regular
+            // drawing change nothing.
+            let c = change(&edges[k].t, &edges[f].t, tol, vary, unit);
+            if gradual(&c, tol, vary) {
+                links.push((k, f));
+                changes.push(c);
+            }
         }
     }
     (links, changes)
@@ -598,7 +608,11 @@ fn rule(
         pos_se: sol.pos_se,
         drawn: sol.drawn,
         sigma2: sol.sigma2,
-    };
+    }
+    .checked()?;
+    if !p.iter().all(|v| v.is_finite()) {
+        return None;
+    }
     let mut cand = seq_candidate(edges, index, kept, t, Some(delta), 1.0)?;
     if let Plan::Seq {
         place: pl, fitted, ..

@@ -4,15 +4,18 @@
 //! Owns: the paper's loop (§5). Each round compares every live instance with
 //! its nearest neighbours (transforms in one space per pair of kinds), clusters
 //! each space, and proposes candidates: *sequences* (chains of one kind linked
-//! by the same transform, rule r1/r2), *linear sequences* (chains whose turns
-//! change by a constant step, found in the (d, s) subspace: t(m) = t0 + tΔ·m),
+//! by the same transform, rule r1/r2), *linear sequences* (chains whose
+//! transform changes by a constant amount per step, t(m) = t0 + tΔ·m: `linear`),
 //! *branchings* (complete binary trees whose two child transforms come from two
 //! clusters, r3/r4) and, when nothing repeats, *pairs* (r1 with m = 1). The
 //! candidate with the largest importance w = w_n·n + w_h·h + w_φ·φ + w_l·l is
 //! made a rule; its instances are replaced by one new instance each, in the
-//! frame of their first element, and the round repeats. A chain is cut where
+//! frame fitted to all its members, and the round repeats. A chain is cut where
 //! redrawing it with the rule's averaged transform would leave the tolerance,
-//! so what is drawn back stays on the input. Must not print or build syntax.
+//! so what is drawn back stays on the input. With `--symmetrize`
+//! (`Tolerance::regular`) chains also grow at both ends, and a chosen rule is
+//! refitted and made round (`regular`, on the least squares of `fit`). Must not
+//! print or build syntax.
 
 mod fit;
 mod linear;
@@ -1087,7 +1090,9 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
         } => {
             let a = insts[chains[0][0]].sym;
             let reg = fitted.or_else(|| {
-                (tol.regular && delta.is_none()).then(|| regular::sequence(insts, &chains, &t, tol))
+                (tol.regular && delta.is_none())
+                    .then(|| regular::sequence(insts, &chains, &t, tol))
+                    .flatten()
             });
             let mut counts = BTreeSet::new();
             let mut offset = 0;
@@ -1118,7 +1123,8 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
             let a = insts[trees[0].0].sym;
             let reg = tol
                 .regular
-                .then(|| regular::branching(insts, &trees, &child, &t, &u, tol));
+                .then(|| regular::branching(insts, &trees, &child, &t, &u, tol))
+                .flatten();
             let mut counts = BTreeSet::new();
             let mut offset = 0;
             for (k, &(root, d)) in trees.iter().enumerate() {
@@ -1153,10 +1159,12 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
         Plan::Pair { pairs, t } => {
             let (a, b) = (insts[pairs[0].0].sym, insts[pairs[0].1].sym);
             // Pairs of one cluster are a repeated structure; a lone pair is not.
-            let reg = (tol.regular && pairs.len() >= 2).then(|| {
-                let chains: Vec<Vec<usize>> = pairs.iter().map(|&(x, y)| vec![x, y]).collect();
-                regular::sequence(insts, &chains, &t, tol)
-            });
+            let reg = (tol.regular && pairs.len() >= 2)
+                .then(|| {
+                    let chains: Vec<Vec<usize>> = pairs.iter().map(|&(x, y)| vec![x, y]).collect();
+                    regular::sequence(insts, &chains, &t, tol)
+                })
+                .flatten();
             for (k, &(x, y)) in pairs.iter().enumerate() {
                 match &reg {
                     Some(reg) => {

@@ -59,6 +59,21 @@ pub(super) struct Regular {
 }
 
 /// A member of a fit (`tilted`: see `Member`).
+impl Regular {
+    /// The structure, if every number of it is finite and every frame's
+    /// scale positive (else the rule is kept as found).
+    pub(super) fn checked(self) -> Option<Regular> {
+        let frame = |f: &Frame| {
+            f.pos.is_finite() && f.rot.is_finite() && f.scale.is_finite() && f.scale > 0.0
+        };
+        let tr = |t: &Tr| {
+            t.alpha.is_finite() && t.d.is_finite() && t.s.is_finite() && t.beta.is_finite()
+        };
+        (self.t.iter().all(tr) && self.starts.iter().all(frame) && self.drawn.iter().all(frame))
+            .then_some(self)
+    }
+}
+
 fn member(insts: &[Inst], group: usize, i: usize, tilted: bool) -> Member {
     Member {
         group,
@@ -81,7 +96,12 @@ fn elements(insts: &[Inst], members: impl IntoIterator<Item = usize>) -> bool {
 }
 
 /// Chains drawn by `P(m) -> [A] T P(m - 1)` (pairs are chains of two).
-pub(super) fn sequence(insts: &[Inst], chains: &[Vec<usize>], t: &Tr, tol: Tolerance) -> Regular {
+pub(super) fn sequence(
+    insts: &[Inst],
+    chains: &[Vec<usize>],
+    t: &Tr,
+    tol: Tolerance,
+) -> Option<Regular> {
     let rep = elements(insts, chains.iter().flatten().copied());
     let same = chains
         .iter()
@@ -125,6 +145,8 @@ pub(super) fn sequence(insts: &[Inst], chains: &[Vec<usize>], t: &Tr, tol: Toler
         drawn: sol.drawn,
         sigma2: sol.sigma2,
     }
+    .checked()
+    .filter(|r| r.t.iter().all(|t| t.s > 0.0))
 }
 
 /// Complete binary trees drawn by `R(m) -> [A] [T R(m - 1)] [U R(m - 1)]`,
@@ -136,7 +158,7 @@ pub(super) fn branching(
     t: &Tr,
     u: &Tr,
     tol: Tolerance,
-) -> Regular {
+) -> Option<Regular> {
     // Members level by level, as the rule draws them.
     let rep = elements(insts, trees.iter().map(|t| t.0));
     let mut members = Vec::new();
@@ -181,6 +203,8 @@ pub(super) fn branching(
         drawn: sol.drawn,
         sigma2: sol.sigma2,
     }
+    .checked()
+    .filter(|r| r.t.iter().all(|t| t.s > 0.0))
 }
 
 /// Which turns are as uncertain as one element's rotation: `rep`, the
