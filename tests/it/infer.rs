@@ -469,7 +469,7 @@ fn lsyc_drawings_draw_back() {
 fn reflect_makes_mirror_images_one_outline() {
     let plain = infer(&case("mirrored"), &Options::default()).text;
     assert!(
-        plain.contains("// B: 4 in the drawing; drawn as element 2"),
+        plain.contains("// B: 4 in the drawing; element 2 of the drawing"),
         "{plain}"
     );
     let opts = Options {

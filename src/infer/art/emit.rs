@@ -22,7 +22,7 @@ use crate::infer::emit::{comment, node, sym, var};
 use crate::infer::strokes::Seg;
 use crate::span::Span;
 use glam::DVec2;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// What the emitter needs besides the grammar.
 pub struct Settings<'a> {
@@ -231,6 +231,8 @@ fn run(g: &Grammar, r: usize) -> f64 {
 
 struct Consts {
     items: Vec<Node<Item>>,
+    /// The kinds of constant written (`N`, `TURN`, …), for the header's legend.
+    used: BTreeSet<&'static str>,
 }
 
 /// How a jittered constant varies.
@@ -268,7 +270,9 @@ impl Consts {
             name: Ident::new(name),
             value: init,
         }));
-        n.trivia.trailing = Some(comment(note));
+        if !note.is_empty() {
+            n.trivia.trailing = Some(comment(note));
+        }
         self.items.push(n);
         var(name)
     }
@@ -418,7 +422,10 @@ fn describe(names: &Names, s: Sym) -> String {
 pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Settings) -> File {
     let inline = inlined(g);
     let names = Names::new(inst.kinds.len(), g, &inline);
-    let mut consts = Consts { items: Vec::new() };
+    let mut consts = Consts {
+        items: Vec::new(),
+        used: BTreeSet::new(),
+    };
     let element_items = match turned(inst, &g.tilt) {
         Some(inst) => kinds(elements, &inst, &names),
         None => kinds(elements, inst, &names),
@@ -486,7 +493,7 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
         },
     }));
     sys.trivia.blank_before = true;
-    let header = header(elements, inst, g, s, &count_of);
+    let header = header(elements, inst, g, s, &count_of, &consts.used);
     assemble(&header, element_items, consts, decls, sys)
 }
 
@@ -555,12 +562,12 @@ fn kinds(elements: &[Element], inst: &Instancing, names: &Names) -> Vec<Node<Ite
         let drawn = match kind.mirror_of {
             Some(twin) => format!("{} mirrored", names.elements[twin]),
             None => format!(
-                "drawn as element {} of the drawing, {}",
+                "element {} of the drawing, {}",
                 e.number,
                 if kind.given {
-                    "in the frame the drawing gives it"
+                    "in its own frame"
                 } else {
-                    "in the frame that keeps the rules simplest"
+                    "framed for simple rules"
                 }
             ),
         };
@@ -580,15 +587,11 @@ fn count_constants(g: &Grammar, names: &Names, consts: &mut Consts) -> Vec<Optio
     for (r, rule) in g.rules.iter().enumerate() {
         if counted(g, r) && rule.counts.len() == 1 {
             let n = *rule.counts.iter().next().unwrap_or(&0);
-            let what = match rule.body {
-                Body::Branch { .. } => "levels of branching below the first",
-                _ => "repeats after the first",
-            };
-            count_of[r] = Some(consts.add(
-                &format!("{}_N", names.rules[r]),
-                n as f64,
-                &format!("{}: {what}", names.rules[r]),
-            ));
+            consts.used.insert(match rule.body {
+                Body::Branch { .. } => "LEVELS",
+                _ => "N",
+            });
+            count_of[r] = Some(consts.add(&format!("{}_N", names.rules[r]), n as f64, ""));
         }
     }
     count_of
@@ -740,14 +743,20 @@ impl RuleWriter<'_> {
             if v == trivial && j.is_none() {
                 Part::Value(v)
             } else {
+                consts.used.insert(match what {
+                    "TURN" => "TURN",
+                    "STEP" => "STEP",
+                    "SCALE" => "SCALE",
+                    _ => "TWIST",
+                });
                 Part::Expr(consts.add_jittered(&format!("{name}_{what}{suffix}"), v, j, note))
             }
         };
         (
-            part(a, 0.0, "TURN", "degrees, left positive, before the step"),
-            part(d, 0.0, "STEP", "distance, in the current scale"),
-            part(sc, 1.0, "SCALE", "scale factor per step"),
-            part(b, 0.0, "TWIST", "degrees, left positive, after the step"),
+            part(a, 0.0, "TURN", ""),
+            part(d, 0.0, "STEP", ""),
+            part(sc, 1.0, "SCALE", ""),
+            part(b, 0.0, "TWIST", ""),
         )
     }
 
@@ -820,12 +829,8 @@ impl RuleWriter<'_> {
                             };
                         }
                         changing.push(how);
-                        let note = match what {
-                            "STEP" => "change of the step per step of m",
-                            "SCALE" => "change of the scale factor per step of m",
-                            _ => "change of the turn per step of m",
-                        };
-                        let c = consts.add(&format!("{name}_D{what}"), step, note);
+                        consts.used.insert("D");
+                        let c = consts.add(&format!("{name}_D{what}"), step, "");
                         Part::Expr(bin(BinOp::Add, base, bin(BinOp::Mul, c, var("m"))))
                     };
                 let turn = 0.002 / nn;
@@ -986,8 +991,9 @@ fn header(
     g: &Grammar,
     s: &Settings,
     count_of: &[Option<Expr>],
-) -> [String; 4] {
-    [
+    used: &BTreeSet<&'static str>,
+) -> Vec<String> {
+    let mut out = vec![
         format!(
             "Inferred by `lsyc infer{}` from {}.",
             if s.symmetrize { " --symmetrize" } else { "" },
@@ -1003,16 +1009,42 @@ fn header(
             g.rounds,
             if g.rounds == 1 { "" } else { "s" },
         ),
-        match count_of.iter().flatten().next().map(|e| &e.kind) {
-            Some(ExprKind::Var(v)) => format!(
-                "Edit the constants (or override them: lsyc run -D {v}=10) to change counts and"
-            ),
-            _ => {
-                "Edit the constants (or override them with lsyc run -D) to change counts and".into()
-            }
-        },
-        "transforms; replace an element's path to draw something else in its place.".into(),
-    ]
+    ];
+    // One legend for the constants, not a comment on each.
+    let mut legend: Vec<&str> = Vec::new();
+    if used.contains("N") {
+        legend.push("_N repeats after the first");
+    }
+    if used.contains("LEVELS") {
+        legend.push(if used.contains("N") {
+            "levels below the first for a branching"
+        } else {
+            "_N levels of branching below the first"
+        });
+    }
+    if used.contains("TURN") || used.contains("TWIST") {
+        legend.push("_TURN and _TWIST turn left (degrees) before and after the step");
+    }
+    if used.contains("STEP") {
+        legend.push("_STEP moves");
+    }
+    if used.contains("SCALE") {
+        legend.push("_SCALE scales per step");
+    }
+    if used.contains("D") {
+        legend.push("_D… is a change per step of m");
+    }
+    if !legend.is_empty() {
+        out.push(format!("Constants: {}.", legend.join("; ")));
+    }
+    out.push(match count_of.iter().flatten().next().map(|e| &e.kind) {
+        Some(ExprKind::Var(v)) => format!(
+            "Edit them or override them (lsyc run -D {v}=10); replace a path to draw something else."
+        ),
+        _ => "Edit the numbers; replace an element's path to draw something else in its place."
+            .into(),
+    });
+    out
 }
 
 /// The file: elements, constants, module declarations (at the top, so that
