@@ -5,9 +5,7 @@
 //! recovered counts and parameters are those of the generator, and the
 //! programs are snapshots.
 
-use crate::support::{rel, render_plain, root};
-use glam::DVec2;
-use lsyc::geometry::index::PointGrid as Grid;
+use crate::support::{drawing_distance as distance, rel, render_plain, root};
 use lsyc::infer::art::{self, Options, read};
 use lsyc::{fmt, frontend};
 use std::path::Path;
@@ -17,43 +15,6 @@ fn infer(path: &Path, opts: &Options) -> art::Inferred {
     let data = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", rel(path)));
     let name = path.file_name().unwrap().to_string_lossy().into_owned();
     art::from_svg(&data, &name, opts, &mut |_| {}).unwrap_or_else(|e| panic!("{}: {e}", rel(path)))
-}
-
-/// Points spread along every element outline, `step` apart.
-fn samples(svg: &[u8], step: f64) -> Vec<DVec2> {
-    let d = read::read(svg).expect("reads");
-    let mut out = Vec::new();
-    for e in &d.elements {
-        for line in &e.outline {
-            for w in line.windows(2) {
-                let n = (w[0].distance(w[1]) / step).ceil().max(1.0) as usize;
-                for k in 0..n {
-                    out.push(w[0].lerp(w[1], k as f64 / n as f64));
-                }
-            }
-        }
-    }
-    out
-}
-
-fn diagonal(points: &[DVec2]) -> f64 {
-    let (lo, hi) = points.iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    (hi - lo).length()
-}
-
-/// Symmetric Chamfer distance: the mean of both mean nearest distances.
-fn chamfer(a: &[DVec2], b: &[DVec2]) -> f64 {
-    let one_way = |from: &[DVec2], to: &[DVec2]| {
-        let g = Grid::new(to);
-        from.iter()
-            .map(|p| p.distance(to[g.nearest(*p, 1)[0]]))
-            .sum::<f64>()
-            / from.len() as f64
-    };
-    (one_way(a, b) + one_way(b, a)) / 2.0
 }
 
 /// Infers, checks, runs with the `lsyc` binary, and returns the program and
@@ -85,13 +46,6 @@ fn draw(text: &str, name: &str) -> Vec<u8> {
         String::from_utf8_lossy(&out.stderr)
     );
     std::fs::read(&back).expect("output")
-}
-
-/// The Chamfer distance between two drawings, relative to the first's diagonal.
-fn distance(a: &[u8], b: &[u8]) -> f64 {
-    let diag = diagonal(&samples(a, 1.0));
-    let step = diag / 1500.0;
-    chamfer(&samples(a, step), &samples(b, step)) / diag
 }
 
 fn round_trip_file(path: &Path, name: &str, opts: &Options) -> (String, f64) {

@@ -20,12 +20,13 @@
 //! `NOT_YET_PLAIN`) with the reason; a listed case that meets them fails the
 //! test until it is removed from the list.
 
-use crate::support::{lsy_files, read_text, rel, render_plain};
+use crate::support::{
+    drawing_distance as relative_chamfer, lsy_files, read_text, rel, render_plain,
+};
 use glam::DVec2;
 use lsyc::ast::{Expr, ExprKind, File, Item, ModName, Module, PropValue, Stmt};
 use lsyc::check::Checked;
 use lsyc::frontend;
-use lsyc::geometry::index::PointGrid as Grid;
 use lsyc::infer::art::{self, Options, read};
 use lsyc::vm::Random;
 use lsyc::vm::expr::evaluate;
@@ -91,50 +92,6 @@ const REDRAW: f64 = 1e-3;
 const NUMBER: f64 = 1e-3;
 
 // ---------------------------------------------------------------- sampling
-
-/// Points spread along every element outline, `step` apart.
-fn samples(svg: &[u8], step: f64) -> Vec<DVec2> {
-    let d = read::read(svg).expect("reads");
-    let mut out = Vec::new();
-    for e in &d.elements {
-        for line in &e.outline {
-            for w in line.windows(2) {
-                let n = (w[0].distance(w[1]) / step).ceil().max(1.0) as usize;
-                for k in 0..n {
-                    out.push(w[0].lerp(w[1], k as f64 / n as f64));
-                }
-            }
-        }
-    }
-    out
-}
-
-fn diagonal(points: &[DVec2]) -> f64 {
-    let (lo, hi) = points.iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    (hi - lo).length()
-}
-
-/// Symmetric Chamfer distance: the mean of both mean nearest distances.
-fn chamfer(a: &[DVec2], b: &[DVec2]) -> f64 {
-    let one_way = |from: &[DVec2], to: &[DVec2]| {
-        let g = Grid::new(to);
-        from.iter()
-            .map(|p| p.distance(to[g.nearest(*p, 1)[0]]))
-            .sum::<f64>()
-            / from.len() as f64
-    };
-    (one_way(a, b) + one_way(b, a)) / 2.0
-}
-
-/// The Chamfer distance between two drawings, relative to the first one's diagonal.
-fn relative_chamfer(input: &[u8], output: &[u8]) -> f64 {
-    let diag = diagonal(&samples(input, 1.0));
-    let step = diag / 1500.0;
-    chamfer(&samples(input, step), &samples(output, step)) / diag
-}
 
 fn element_count(svg: &[u8]) -> usize {
     read::read(svg).expect("reads").elements.len()

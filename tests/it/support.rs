@@ -56,3 +56,52 @@ pub fn parse_errors(text: &str) -> Vec<Diagnostic> {
         .filter(Diagnostic::is_error)
         .collect()
 }
+
+/// Points spread along every element outline of an SVG drawing, `step` apart.
+fn drawing_samples(svg: &[u8], step: f64) -> Vec<glam::DVec2> {
+    let d = lsyc::infer::art::read::read(svg).expect("reads");
+    let mut out = Vec::new();
+    for e in &d.elements {
+        for line in &e.outline {
+            for w in line.windows(2) {
+                let n = (w[0].distance(w[1]) / step).ceil().max(1.0) as usize;
+                for k in 0..n {
+                    out.push(w[0].lerp(w[1], k as f64 / n as f64));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The diagonal of the points' bounding box.
+fn diagonal(points: &[glam::DVec2]) -> f64 {
+    let (lo, hi) = points.iter().fold(
+        (
+            glam::DVec2::splat(f64::INFINITY),
+            glam::DVec2::splat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    (hi - lo).length()
+}
+
+/// Symmetric Chamfer distance: the mean of both mean nearest distances.
+fn chamfer(a: &[glam::DVec2], b: &[glam::DVec2]) -> f64 {
+    let one_way = |from: &[glam::DVec2], to: &[glam::DVec2]| {
+        let g = lsyc::geometry::index::PointGrid::new(to);
+        from.iter()
+            .map(|p| p.distance(to[g.nearest(*p, 1)[0]]))
+            .sum::<f64>()
+            / from.len() as f64
+    };
+    (one_way(a, b) + one_way(b, a)) / 2.0
+}
+
+/// The Chamfer distance between two SVG drawings' outlines (sampled at
+/// 1/1500 of the first one's diagonal), relative to that diagonal.
+pub fn drawing_distance(a: &[u8], b: &[u8]) -> f64 {
+    let diag = diagonal(&drawing_samples(a, 1.0));
+    let step = diag / 1500.0;
+    chamfer(&drawing_samples(a, step), &drawing_samples(b, step)) / diag
+}
