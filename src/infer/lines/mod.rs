@@ -235,9 +235,56 @@ fn turn(deg: f64, delta: f64) -> Vec<Module> {
     )]
 }
 
+/// Where the program puts the drawing: the heading of the first step
+/// (degrees from +y) and where the turtle starts (user units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Frame {
+    heading: f64,
+    start: DVec2,
+}
+
+/// The turns and moves that put the turtle at `f`'s start and heading.
+fn frame_modules(f: &Frame, angle: f64, tol: f64) -> Vec<Module> {
+    let mut out = Vec::new();
+    if f.start.length() > tol {
+        let r = f.start.length();
+        let beta = nice(
+            turtle::wrap_degrees(f.start.y.atan2(f.start.x).to_degrees() - 90.0),
+            (tol / r).to_degrees().min(1e-3),
+        );
+        out.extend(turn(beta, angle));
+        out.push(sym('f', Some(Expr::num(nice(r, tol)))));
+        out.extend(turn(turtle::wrap_degrees(f.heading - beta), angle));
+    } else {
+        out.extend(turn(f.heading, angle));
+    }
+    out
+}
+
+/// The frame rounded as a person would have drawn it: the heading to a
+/// multiple of δ or a whole degree, the start to the origin, when they are
+/// that close.
+fn rounded(f: &Frame, angle: f64, step: f64) -> Frame {
+    let k = (f.heading / angle).round() * angle;
+    let heading = if (f.heading - k).abs() <= 0.1 {
+        k
+    } else if (f.heading - f.heading.round()).abs() <= 0.1 {
+        f.heading.round()
+    } else {
+        f.heading
+    };
+    let start = if f.start.length() <= 0.05 * step {
+        DVec2::ZERO
+    } else {
+        f.start
+    };
+    Frame { heading, start }
+}
+
 /// The program of a grammar that matched the drawing step by step: the
 /// frame that puts it on the drawing, the text, and the library's redraw;
-/// `None` if the redraw is not within 10⁻³ of the diagonal.
+/// `None` if the redraw is not within 10⁻³ of the diagonal. The frame is
+/// written rounded when that draws as close to the drawing.
 fn finish(
     g: &Grammar,
     r: &Reading,
@@ -247,38 +294,32 @@ fn finish(
     let angle = if r.angles.period.is_some() {
         nice(r.angles.delta, 1e-6)
     } else {
-        nice(r.angles.delta, (2.0 * r.delta_error).max(1e-6))
+        nice(r.angles.delta, (3.0 * r.delta_error).max(1e-6))
     };
-    let step = nice(r.step, (2.0 * r.step_error).max(1e-6 * r.step));
+    let step = nice(r.step, (3.0 * r.step_error).max(1e-4 * r.step));
     let (p_c, k_c) = grammar::first_step(g, &r.angles, work)?;
     let phi = turtle::wrap_degrees(r.heading - f64::from(k_c) * angle);
-    let phi = nice(phi, (2.0 * r.frame_error.0).max(1e-4));
-    let rot = phi.to_radians();
-    let rotated = DVec2::new(
-        p_c.x * rot.cos() - p_c.y * rot.sin(),
-        p_c.x * rot.sin() + p_c.y * rot.cos(),
-    );
-    let p0 = r.start - rotated * step;
-    let tol = (2.0 * r.frame_error.1).max(1e-4 * step);
-    let mut frame = Vec::new();
-    if p0.length() > tol {
-        let beta = nice(
-            turtle::wrap_degrees(p0.y.atan2(p0.x).to_degrees() - 90.0),
-            1e-4,
+    let phi = nice(phi, (3.0 * r.frame_error.0).max(1e-3));
+    let place = |phi: f64| {
+        let rot = phi.to_radians();
+        let rotated = DVec2::new(
+            p_c.x * rot.cos() - p_c.y * rot.sin(),
+            p_c.x * rot.sin() + p_c.y * rot.cos(),
         );
-        frame.extend(turn(beta, angle));
-        frame.push(sym('f', Some(Expr::num(nice(p0.length(), tol)))));
-        frame.extend(turn(turtle::wrap_degrees(phi - beta), angle));
-    } else {
-        frame.extend(turn(phi, angle));
-    }
+        r.start - rotated * step
+    };
+    let tol = (3.0 * r.frame_error.1).max(2e-3 * step);
+    let precise = Frame {
+        heading: phi,
+        start: place(phi),
+    };
     let (source, system) = super::names(name);
     let mut settings = emit::Settings {
         source: &source,
         name: system,
         angle,
         step,
-        frame,
+        frame: frame_modules(&precise, angle, tol),
         redraw: verify::Redraw {
             matched: 0,
             steps: r.steps,
@@ -287,13 +328,25 @@ fn finish(
             diagonal: 0.0,
         },
     };
-    let draft = crate::fmt::format_file(&emit::program(g, &settings));
-    let redraw = verify::redraw(&draft, &r.segments, r.step)?;
-    if redraw.matched != redraw.steps
-        || redraw.drawn != redraw.steps
-        || !(redraw.relative() <= 1e-3)
-    {
-        return None;
+    let check = |settings: &emit::Settings| {
+        let draft = crate::fmt::format_file(&emit::program(g, settings));
+        verify::redraw(&draft, &r.segments, r.step)
+            .filter(|d| d.matched == d.steps && d.drawn == d.steps && d.relative() <= 1e-3)
+    };
+    let mut redraw = check(&settings)?;
+    let mut round = rounded(&precise, angle, step);
+    round.start = if round.start == DVec2::ZERO && p_c == DVec2::ZERO {
+        DVec2::ZERO
+    } else {
+        place(round.heading)
+    };
+    let round_modules = frame_modules(&round, angle, tol);
+    if round_modules != settings.frame {
+        let precise_modules = std::mem::replace(&mut settings.frame, round_modules);
+        match check(&settings) {
+            Some(d) if d.relative() <= (2.0 * redraw.relative()).max(1e-5) => redraw = d,
+            _ => settings.frame = precise_modules,
+        }
     }
     settings.redraw = redraw;
     let file = emit::program(g, &settings);

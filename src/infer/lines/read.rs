@@ -120,40 +120,57 @@ pub fn reading(lines: &[Vec<DVec2>], split: u32) -> Result<Reading, NotLines> {
     if !(shortest.is_finite() && shortest > 0.0) {
         return Err(NotLines::Steps("no segment has a length".into()));
     }
-    // Every segment a whole number of steps, within a tenth of a step.
+    // The step: first from the shortest segment, then from ever longer ones
+    // (a long segment's length pins the step down better than a short one's,
+    // once it is known how many steps it has).
     let mut step = shortest / f64::from(split.max(1));
-    let mut step_error = 0.0;
-    for _ in 0..2 {
-        let mut total = 0usize;
-        let mut sum = 0.0;
-        let (mut rr, mut res) = (0.0, 0.0);
+    let longest = lengths.iter().copied().fold(0.0, f64::max);
+    let mut limit = 4.0;
+    loop {
+        let (mut sum, mut units) = (0.0, 0.0);
         for &len in &lengths {
             let u = len / step;
-            let r = u.round();
-            if r < 1.0 || (u - r).abs() > 0.1 {
-                return Err(NotLines::Steps(format!(
-                    "a segment of length {} is not a whole number of steps of {}",
-                    crate::number::source(crate::infer::art::emit::nice(len, len * 1e-4)),
-                    crate::number::source(crate::infer::art::emit::nice(step, step * 1e-4))
-                )));
+            if u <= limit + 0.5 {
+                sum += len;
+                units += u.round().max(1.0);
             }
-            rr += r * r;
-            res += (len - r * step).powi(2);
-            total = total.saturating_add(r as usize);
-            if total > MAX_STEPS {
-                return Err(NotLines::Steps(format!(
-                    "more than {MAX_STEPS} steps of equal length"
-                )));
-            }
-            sum += len;
         }
-        step = sum / total as f64;
-        step_error = (res / (lengths.len().max(2) - 1) as f64).sqrt() / rr.sqrt();
+        if units > 0.0 {
+            step = sum / units;
+        }
+        if longest / step <= limit {
+            break;
+        }
+        limit *= 4.0;
     }
+    // Every segment a whole number of steps, within a tenth of a step.
+    let (mut total, mut rr, mut res) = (0usize, 0.0, 0.0);
+    for &len in &lengths {
+        let u = len / step;
+        let r = u.round();
+        if r < 1.0 || (u - r).abs() > 0.1 {
+            return Err(NotLines::Steps(format!(
+                "a segment of length {} is not a whole number of steps of {}",
+                crate::number::source(crate::infer::art::emit::nice(len, len * 1e-4)),
+                crate::number::source(crate::infer::art::emit::nice(step, step * 1e-4))
+            )));
+        }
+        rr += r * r;
+        res += (len - r * step).powi(2);
+        total = total.saturating_add(r as usize);
+        if total > MAX_STEPS {
+            return Err(NotLines::Steps(format!(
+                "more than {MAX_STEPS} steps of equal length"
+            )));
+        }
+    }
+    let step_error = (res / (lengths.len().max(2) - 1) as f64).sqrt() / rr.sqrt();
     let origin = segments[0].0;
     let mut b = Builder::new();
-    // Where each drawn step starts (world coordinates), by node.
+    // Where each drawn step starts (world coordinates), by node; the first
+    // node of each segment.
     let mut starts: Vec<(u32, DVec2)> = Vec::new();
+    let mut firsts: Vec<u32> = Vec::with_capacity(segments.len());
     for (&(a, e), &len) in segments.iter().zip(&lengths) {
         let n = (len / step).round().max(1.0) as usize;
         let (wa, we) = (a, e);
@@ -164,18 +181,29 @@ pub fn reading(lines: &[Vec<DVec2>], split: u32) -> Result<Reading, NotLines> {
             b.push(p, q).map_err(|_| {
                 NotLines::Steps("a segment starts away from the drawing by a gap that is not a whole number of steps".into())
             })?;
-            starts.push((b.raw.len() as u32 - 1, wa.lerp(we, k as f64 / n as f64)));
+            let id = b.raw.len() as u32 - 1;
+            if k == 0 {
+                firsts.push(id);
+            }
+            starts.push((id, wa.lerp(we, k as f64 / n as f64)));
         }
     }
-    let (angles, delta_error) = find_delta(&b)?;
-    let tree = b.tree(&angles).map_err(|e| match e {
+    let coarse = find_delta(&b)?;
+    let mut tree = b.tree(&coarse).map_err(|e| match e {
         Unfit::Turn => NotLines::Steps(format!(
             "its turns are not all multiples of one angle ({} degrees)",
-            angles.delta
+            coarse.delta
         )),
         Unfit::Jump => NotLines::Steps("a gap that is not a whole number of steps".into()),
     })?;
-    let (start, heading, frame_error) = fit_frame(&b, &tree, &angles, step, &starts);
+    let headings = headings(&tree);
+    let (angles, theta, delta_error) = refine(&coarse, &segments, &firsts, &headings);
+    for n in &mut tree.nodes {
+        n.turn = angles.norm(n.turn);
+    }
+    let (start, heading_error, start_error) = fit_start(
+        &tree, &headings, theta, &angles, step, &starts, &segments, &firsts,
+    );
     Ok(Reading {
         steps: tree.draws(),
         tree,
@@ -183,52 +211,103 @@ pub fn reading(lines: &[Vec<DVec2>], split: u32) -> Result<Reading, NotLines> {
         step,
         step_error,
         start,
-        heading,
-        frame_error,
+        heading: super::turtle::wrap_degrees(theta.to_degrees() - 90.0),
+        frame_error: (heading_error, start_error),
         segments,
         delta_error,
     })
 }
 
-/// The start point and heading that put the turtle's steps (of `step`,
-/// turning by the tree's whole turns) best on the drawing: the heading is
-/// the mean of every step's own heading less its turns, the start the mean
-/// offset of every step's start. Also how uncertain they are: (degrees,
-/// user units).
-fn fit_frame(
-    b: &Builder,
-    tree: &Tree,
-    angles: &Angles,
-    step: f64,
-    starts: &[(u32, DVec2)],
-) -> (DVec2, f64, (f64, f64)) {
-    let n = tree.nodes.len();
-    // Each node's heading in whole turns from the first node's.
-    let mut k = vec![0i64; n];
+/// Each node's heading in whole turns of δ from the first node's.
+fn headings(tree: &Tree) -> Vec<i64> {
+    let mut k = vec![0i64; tree.nodes.len()];
     for (i, nd) in tree.nodes.iter().enumerate() {
         k[i] = match nd.parent {
             super::turtle::ROOT => i64::from(nd.turn),
             p => k[p as usize] + i64::from(nd.turn),
         };
     }
-    let base = b.raw[0].angle;
-    let delta = angles.delta.to_radians();
-    // Circular mean of each step's offset from the first step's heading.
-    let (mut sx, mut sy) = (0.0, 0.0);
-    let mut offsets = Vec::with_capacity(n);
-    for (i, r) in b.raw.iter().enumerate() {
-        let o = wrap(r.angle - base - k[i] as f64 * delta);
-        offsets.push(o);
-        sx += o.cos();
-        sy += o.sin();
+    k
+}
+
+/// δ and the first heading (radians from +x) by least squares over the
+/// segments' directions, each weighted by its length squared (a long
+/// segment's direction is known better); δ exactly 360/m when that is
+/// within four standard errors. Also δ's standard error, degrees.
+fn refine(
+    coarse: &Angles,
+    segments: &[(DVec2, DVec2)],
+    firsts: &[u32],
+    k: &[i64],
+) -> (Angles, f64, f64) {
+    let d0 = coarse.delta.to_radians();
+    let dir = |s: &(DVec2, DVec2)| (s.1 - s.0).y.atan2((s.1 - s.0).x);
+    let reference = dir(&segments[0]);
+    let (mut sw, mut sk, mut skk, mut sr, mut skr) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let mut rows = Vec::with_capacity(segments.len());
+    for (s, &f) in segments.iter().zip(firsts) {
+        let w = (s.1 - s.0).length_squared();
+        let kk = k[f as usize] as f64;
+        let r = wrap(dir(s) - reference - kk * d0);
+        rows.push((w, kk, r));
+        sw += w;
+        sk += w * kk;
+        skk += w * kk * kk;
+        sr += w * r;
+        skr += w * kk * r;
     }
-    let mean = sy.atan2(sx);
-    let spread = (offsets.iter().map(|o| wrap(o - mean).powi(2)).sum::<f64>()
-        / (n.max(2) - 1) as f64)
-        .sqrt()
-        / (n as f64).sqrt();
-    let theta = base + mean;
-    // The model's points (in steps, from the start) and their offsets.
+    let det = sw * skk - sk * sk;
+    let (a, b, err) = if det > 1e-12 * sw * sw.max(1.0) && rows.len() > 2 {
+        let b = (sw * skr - sk * sr) / det;
+        let a = (sr - b * sk) / sw;
+        let ss: f64 = rows
+            .iter()
+            .map(|&(w, kk, r)| w * (r - a - b * kk).powi(2))
+            .sum();
+        let s2 = ss / (rows.len() - 2) as f64;
+        (a, b, (s2 * sw / det).sqrt().to_degrees())
+    } else {
+        (sr / sw.max(1e-300), 0.0, coarse.tolerance / 3.0)
+    };
+    let _ = a;
+    let delta = (d0 + b).to_degrees();
+    let m = (360.0 / delta).round();
+    let exact = 360.0 / m;
+    let angles = if m >= 2.0 && (exact - delta).abs() <= (4.0 * err).max(1e-6 * delta) {
+        Angles::new(exact, Some(m as i32), coarse.tolerance)
+    } else {
+        // The shortest decimal within three standard errors: the δ a person
+        // would have written.
+        let written = crate::infer::art::emit::nice(delta, (3.0 * err).max(1e-6));
+        Angles::new(written, None, coarse.tolerance)
+    };
+    // The first heading, for that δ: the weighted mean offset.
+    let d = angles.delta.to_radians();
+    let (mut sx, mut sy) = (0.0, 0.0);
+    for (s, &f) in segments.iter().zip(firsts) {
+        let w = (s.1 - s.0).length_squared();
+        let o = wrap(dir(s) - reference - k[f as usize] as f64 * d);
+        sx += w * o.cos();
+        sy += w * o.sin();
+    }
+    (angles, reference + sy.atan2(sx), err)
+}
+
+/// The start point of the turtle's steps, with the heading's and the
+/// start's standard errors (degrees, user units).
+#[allow(clippy::too_many_arguments)]
+fn fit_start(
+    tree: &Tree,
+    k: &[i64],
+    theta: f64,
+    angles: &Angles,
+    step: f64,
+    starts: &[(u32, DVec2)],
+    segments: &[(DVec2, DVec2)],
+    firsts: &[u32],
+) -> (DVec2, f64, f64) {
+    let n = tree.nodes.len();
+    let delta = angles.delta.to_radians();
     let mut ends = vec![DVec2::ZERO; n];
     let mut from = vec![DVec2::ZERO; n];
     for (i, nd) in tree.nodes.iter().enumerate() {
@@ -240,20 +319,33 @@ fn fit_frame(
         from[i] = s;
         ends[i] = s + DVec2::new(a.cos(), a.sin());
     }
-    let mut sum = DVec2::ZERO;
-    for &(i, w) in starts {
-        sum += w - from[i as usize] * step;
-    }
-    let t = sum / starts.len().max(1) as f64;
+    // The first step's own start: the mean offset would be pulled off by
+    // the slightest error of the step or of δ, over a large drawing.
+    let count = starts.len().max(1) as f64;
+    let t = starts.first().map_or(DVec2::ZERO, |&(_, w)| w);
     let scatter = (starts
         .iter()
         .map(|&(i, w)| (w - from[i as usize] * step - t).length_squared())
         .sum::<f64>()
-        / starts.len().max(1) as f64)
+        / count)
         .sqrt()
-        / (starts.len() as f64).sqrt();
-    let heading = super::turtle::wrap_degrees(theta.to_degrees() - 90.0);
-    (t, heading, (spread.to_degrees(), scatter))
+        / count.sqrt();
+    // The heading's error: the spread of the segments' directions about
+    // the model's, weighted by length.
+    let (mut sw, mut ss) = (0.0, 0.0);
+    for (s, &f) in segments.iter().zip(firsts) {
+        let v = s.1 - s.0;
+        let w = v.length_squared();
+        let model = theta + k[f as usize] as f64 * delta;
+        ss += w * wrap(v.y.atan2(v.x) - model).powi(2);
+        sw += w;
+    }
+    let heading_error = if sw > 0.0 {
+        (ss / sw / segments.len() as f64).sqrt().to_degrees()
+    } else {
+        0.0
+    };
+    (t, heading_error, scatter)
 }
 
 /// An angle in radians wrapped to (−π, π].
@@ -263,14 +355,14 @@ fn wrap(a: f64) -> f64 {
 
 /// δ: the largest angle of which every turn is a whole multiple, refined by
 /// least squares; exactly 360/m when that fits as well.
-fn find_delta(b: &Builder) -> Result<(Angles, f64), NotLines> {
+fn find_delta(b: &Builder) -> Result<Angles, NotLines> {
     let turns: Vec<f64> = (1..b.raw.len())
         .map(|i| b.turn_radians(i).to_degrees().abs())
         .collect();
     let nonzero: Vec<f64> = turns.iter().copied().filter(|t| *t > 1.5).collect();
     let Some(smallest) = nonzero.iter().copied().reduce(f64::min) else {
         // Straight lines only: any angle will do.
-        return Ok((Angles::new(90.0, Some(4), 1.0), 0.0));
+        return Ok(Angles::new(90.0, Some(4), 1.0));
     };
     let tol_of = |d: f64| (0.15 * d).clamp(0.75, 4.0);
     let mut found = None;
@@ -290,35 +382,7 @@ fn find_delta(b: &Builder) -> Result<(Angles, f64), NotLines> {
             "its turns are not multiples of one angle".into(),
         ));
     };
-    // Least squares over the turns that are not straight on.
-    let (mut kk, mut kt, mut n) = (0.0, 0.0, 0.0);
-    for &t in &nonzero {
-        let k = (t / d0).round();
-        kk += k * k;
-        kt += k * t;
-        n += 1.0;
-    }
-    let delta = kt / kk;
-    let resid: f64 = nonzero
-        .iter()
-        .map(|&t| {
-            let k = (t / d0).round();
-            (t - k * delta).powi(2)
-        })
-        .sum();
-    let error = if n > 1.0 {
-        (resid / (n - 1.0)).sqrt() / kk.sqrt()
-    } else {
-        tol_of(d0) / 3.0
-    };
-    let m = (360.0 / delta).round();
-    let exact = 360.0 / m;
-    let (delta, period) = if m >= 2.0 && (exact - delta).abs() <= (4.0 * error).max(1e-6 * delta) {
-        (exact, Some(m as i32))
-    } else {
-        (delta, None)
-    };
-    Ok((Angles::new(delta, period, tol_of(delta)), error))
+    Ok(Angles::new(d0, None, tol_of(d0)))
 }
 
 /// Whether a tree draws at all.

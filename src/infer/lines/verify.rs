@@ -152,16 +152,43 @@ pub fn chamfer(a: &[(DVec2, DVec2)], b: &[(DVec2, DVec2)]) -> f64 {
         return f64::INFINITY;
     }
     let (sa, sb) = (samples(a), samples(b));
-    let one_way = |from: &[DVec2], to: &[DVec2]| {
-        let g = PointGrid::new(to);
-        from.iter()
-            .map(|p| {
-                g.nearest(*p, 1)
-                    .first()
-                    .map_or(f64::INFINITY, |&i| p.distance(to[i]))
-            })
-            .sum::<f64>()
-            / from.len() as f64
-    };
-    (one_way(&sa, &sb) + one_way(&sb, &sa)) / 2.0
+    // Cells about the sample spacing: an exact redraw finds each point's
+    // twin in its own cell; others go to the point grid.
+    let spacing = a
+        .iter()
+        .map(|s| s.0.distance(s.1))
+        .fold(0.0, f64::max)
+        .max(1e-12);
+    (one_way(&sa, &sb, spacing) + one_way(&sb, &sa, spacing)) / 2.0
+}
+
+fn one_way(from: &[DVec2], to: &[DVec2], cell: f64) -> f64 {
+    let key = |p: DVec2| ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64);
+    let mut cells: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
+    for (i, p) in to.iter().enumerate() {
+        cells.entry(key(*p)).or_default().push(i as u32);
+    }
+    let mut grid: Option<PointGrid> = None;
+    let mut sum = 0.0;
+    for p in from {
+        let (cx, cy) = key(*p);
+        let mut best = f64::INFINITY;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for &i in cells.get(&(cx + dx, cy + dy)).map_or(&[][..], |v| &v[..]) {
+                    best = best.min(p.distance(to[i as usize]));
+                }
+            }
+        }
+        // Within the 3×3 cells, the nearest is certain only up to one cell.
+        if best > cell {
+            let g = grid.get_or_insert_with(|| PointGrid::new(to));
+            best = g
+                .nearest(*p, 1)
+                .first()
+                .map_or(f64::INFINITY, |&i| p.distance(to[i]));
+        }
+        sum += best;
+    }
+    sum / from.len() as f64
 }
