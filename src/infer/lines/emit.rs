@@ -55,12 +55,13 @@ fn rule(pred: Module, succ: Vec<Module>, interpret: bool) -> Node<Stmt> {
     }))
 }
 
-/// A distance as text: the shortest decimal within a ten-thousandth of it.
-fn short(v: f64) -> String {
-    if v == 0.0 {
+/// A distance as text, two significant digits; below `zero`, 0 (rounding
+/// noise, which differs between platforms' sines and cosines).
+fn short(v: f64, zero: f64) -> String {
+    if !(v.abs() > zero) {
         return "0".into();
     }
-    format!("{:.2e}", v)
+    format!("{:.1e}", v)
 }
 
 /// The header lines.
@@ -82,8 +83,8 @@ fn header(g: &Grammar, s: &Settings) -> Vec<String> {
             "Redrawn: {} of {} segments matched, Chamfer distance {} ({} of the diagonal).",
             r.matched,
             r.steps,
-            short(r.chamfer),
-            short(r.relative())
+            short(r.chamfer, 1e-9 * r.diagonal),
+            short(r.relative(), 1e-9)
         ),
         format!(
             "More steps grow it further: lsyc run FILE.lsy -n {}.",
@@ -118,6 +119,18 @@ pub fn program(g: &Grammar, s: &Settings) -> File {
         if let Some(r) = &l.rule {
             stmts.push(rule(sym(l.name, None), modules(g, r), false));
         }
+    }
+    // The move that places the drawing is not one of the grammar's moves.
+    let placed = s.frame.iter().any(|m| m.name == ModName::Name("f".into()));
+    if placed && g.letters.iter().any(|l| l.name == 'f' && l.rule.is_some()) {
+        let d = || crate::infer::emit::var("d");
+        let mut r = rule(
+            Module::new(ModName::Name("f".into()), Some(vec![d()])),
+            vec![Module::new(ModName::Name("f".into()), Some(vec![d()]))],
+            false,
+        );
+        r.trivia.trailing = Some(comment("the move that puts the drawing in place"));
+        stmts.push(r);
     }
     for &k in &letters {
         let l = &g.letters[k];

@@ -120,6 +120,8 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
     let read_ms = ms(start);
     let mut why = String::new();
     let mut steps = 0;
+    // The size of the drawing's own turtle string (at the first reading).
+    let mut drawing_size = 0;
     let mut timed_out = false;
     let mut stats = Stats {
         read_ms,
@@ -144,7 +146,10 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
                 continue;
             }
         };
-        steps = steps.max(reading.steps);
+        if steps == 0 {
+            steps = reading.steps;
+            drawing_size = drawing_symbols(&reading);
+        }
         stats.steps = reading.steps;
         stats.angle = reading.angles.delta;
         let t = Instant::now();
@@ -156,14 +161,12 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
         timed_out |= proposals.timed_out;
         stats.candidates += proposals.grammars.len();
         let work = 64 * reading.tree.nodes.len() as u64 + 100_000;
-        let drawing_size = drawing_symbols(&reading);
         for g in proposals.grammars {
             if Instant::now() >= deadline {
                 timed_out = true;
                 break;
             }
-            // A grammar no smaller than the drawing explains nothing.
-            if 4 * (g.rule_size() + g.axiom.len()) > 3 * drawing_size {
+            if !explains(&g, drawing_size) {
                 continue;
             }
             stats.compared += 1;
@@ -197,6 +200,19 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
         steps,
         timed_out,
     }
+}
+
+/// Whether a grammar says more than the drawing itself: at most half its
+/// size, and not only rules that lengthen steps (`F -> FF` with the
+/// drawing as the axiom).
+fn explains(g: &Grammar, drawing_size: usize) -> bool {
+    let small = 2 * (g.rule_size() + g.axiom.len()) <= drawing_size;
+    let lengthens = g.letters.iter().enumerate().all(|(k, l)| {
+        l.rule
+            .as_ref()
+            .is_none_or(|r| r.iter().all(|s| *s == grammar::Sym::Letter(k as u8)))
+    });
+    small && !lengthens
 }
 
 /// Roughly how many symbols the drawing's own turtle string has: a grammar

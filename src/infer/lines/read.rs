@@ -40,11 +40,15 @@ pub fn polylines(data: &[u8]) -> Result<Vec<Vec<DVec2>>, NotLines> {
         if !path.is_visible() {
             continue;
         }
-        if path.fill().is_some() {
-            return Err(NotLines::Shapes("a filled shape"));
-        }
         if path.stroke().is_none() {
+            if path.fill().is_some() {
+                return Err(NotLines::Shapes("a filled shape"));
+            }
             continue;
+        }
+        // A fill of no area (a `<line>`, a path back and forth) paints nothing.
+        if path.fill().is_some() && filled_area(path) > 0.0 {
+            return Err(NotLines::Shapes("a filled shape"));
         }
         points = points.saturating_add(path.data().points().len());
         if points > MAX_POINTS {
@@ -82,6 +86,42 @@ pub fn polylines(data: &[u8]) -> Result<Vec<Vec<DVec2>>, NotLines> {
         return Err(NotLines::Shapes("no stroked segments"));
     }
     Ok(out)
+}
+
+/// The area a path's fill covers (the sum of its subpaths' absolute
+/// areas, in its own coordinates), 0 within rounding.
+fn filled_area(path: &usvg::Path) -> f64 {
+    let pts = path.data().points();
+    let (lo, hi) = pts.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| {
+            let q = DVec2::new(f64::from(p.x), f64::from(p.y));
+            (lo.min(q), hi.max(q))
+        },
+    );
+    let size = (hi - lo).max_element();
+    let mut total = 0.0;
+    for sub in strokes::subpaths(path, usvg::Transform::identity()) {
+        let ring: Vec<DVec2> = sub
+            .iter()
+            .filter_map(|s| match *s {
+                Seg::Move(p) | Seg::Line(p) => Some(p),
+                Seg::Quad(_, p) | Seg::Cubic(_, _, p) => Some(p),
+                Seg::Close => None,
+            })
+            .collect();
+        let mut a = 0.0;
+        for (i, p) in ring.iter().enumerate() {
+            let q = ring[(i + 1) % ring.len()];
+            a += p.perp_dot(q);
+        }
+        total += a.abs() / 2.0;
+    }
+    if total <= 1e-9 * size * size {
+        0.0
+    } else {
+        total
+    }
 }
 
 /// A line drawing read as turtle steps.
