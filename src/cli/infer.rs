@@ -162,7 +162,13 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
                 why,
                 steps,
                 timed_out,
+                stats,
             } => {
+                if args.stats
+                    && let Ok(json) = serde_json::to_string(&stats)
+                {
+                    eprintln!("{json}");
+                }
                 let what = if steps > 0 {
                     format!("a line drawing of {steps} steps")
                 } else {

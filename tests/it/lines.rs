@@ -10,7 +10,7 @@
 //! Each is inferred back (`lsyc infer`, the binary) and must give a D0L
 //! system (not the element fallback) whose rules are the original's, or an
 //! equivalent grammar no larger than 1.5 times the original's rule size,
-//! whose redraw (`lsyc run`) lies on the drawing: symmetric Chamfer distance
+//! with the original's angle, whose redraw (`lsyc run`) lies on the drawing: symmetric Chamfer distance
 //! of sampled points at most 10⁻³ of the diagonal. The plain drawing must
 //! give the same rules as the svg one. The svg drawings' programs are
 //! snapshots. A system not recovered yet is listed in `NOT_YET` with the
@@ -275,6 +275,20 @@ fn rule_size(rules: &[(String, String)]) -> usize {
 
 // ---------------------------------------------------------------- one case
 
+/// A program's `angle`.
+fn angle_of(file: &File) -> Option<f64> {
+    file.items.stmts.iter().find_map(|item| match &item.node {
+        Item::Lsystem(l) => l.body.stmts.iter().find_map(|s| match &s.node {
+            Stmt::Angle(e) => match e.kind {
+                lsyc::ast::ExprKind::Num(v) => Some(v),
+                _ => None,
+            },
+            _ => None,
+        }),
+        _ => None,
+    })
+}
+
 /// What one drawing gave.
 #[derive(Debug)]
 struct Outcome {
@@ -287,7 +301,7 @@ struct Outcome {
 }
 
 /// Infers `svg` and judges the result against the original's rules.
-fn judge(name: &str, svg: &Path, original: &[(String, String)], dir: &Path) -> Outcome {
+fn judge(name: &str, svg: &Path, original: &[(String, String)], angle: f64, dir: &Path) -> Outcome {
     let prog = svg.with_extension("lsy");
     let out = lsyc(&["infer", svg.to_str().unwrap(), "-o", prog.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
@@ -322,7 +336,12 @@ fn judge(name: &str, svg: &Path, original: &[(String, String)], dir: &Path) -> O
     let output = std::fs::read(&back).expect("redraw");
     let chamfer = relative_chamfer(&input, &output);
     let mut problem = None;
-    if chamfer > REDRAW {
+    if angle_of(&fe.file) != Some(angle) {
+        problem = Some(format!(
+            "angle {:?}, not the original's {angle}",
+            angle_of(&fe.file)
+        ));
+    } else if chamfer > REDRAW {
         problem = Some(format!("redraw Chamfer {chamfer:.2e} of the diagonal"));
     } else if got != original && 2 * rule_size(&got) > 3 * rule_size(original) {
         problem = Some(format!(
@@ -361,7 +380,7 @@ fn recover(name: &str, depths: [u32; 2]) -> Vec<String> {
             ]),
             name,
         );
-        let a = judge(name, &svg, &original, dir.path());
+        let a = judge(name, &svg, &original, angle, dir.path());
         if let Some(p) = &a.problem {
             problems.push(format!("{name} -n {depth} (svg): {p}"));
         } else {
@@ -388,7 +407,7 @@ fn recover(name: &str, depths: [u32; 2]) -> Vec<String> {
             plain_svg(&derived, angle, &draws, 23.0, 5.3, DVec2::new(40.0, -17.0)),
         )
         .expect("write");
-        let b = judge(name, &plain, &original, dir.path());
+        let b = judge(name, &plain, &original, angle, dir.path());
         match &b.problem {
             Some(p) => problems.push(format!("{name} -n {depth} (plain): {p}")),
             None if a.problem.is_none() && b.rules != a.rules => problems.push(format!(

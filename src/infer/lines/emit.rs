@@ -58,7 +58,7 @@ fn rule(pred: Module, succ: Vec<Module>, interpret: bool) -> Node<Stmt> {
 /// A distance as text, two significant digits; below `zero`, 0 (rounding
 /// noise, which differs between platforms' sines and cosines).
 fn short(v: f64, zero: f64) -> String {
-    if !(v.abs() > zero) {
+    if v.is_nan() || v.abs() <= zero {
         return "0".into();
     }
     format!("{:.1e}", v)

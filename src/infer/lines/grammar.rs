@@ -152,7 +152,13 @@ pub enum Outcome {
 /// Derives `g` and draws it, step by step, against `tree`; `work` is the
 /// most symbols it may read. The first drawn step of the candidate starts
 /// where the drawing's does, so both are compared from their first step.
-pub fn matches(g: &Grammar, tree: &Tree, angles: &Angles, work: u64) -> Outcome {
+pub fn matches(
+    g: &Grammar,
+    tree: &Tree,
+    angles: &Angles,
+    work: u64,
+    deadline: Option<std::time::Instant>,
+) -> Outcome {
     let dirs = Directions::new(angles);
     let mut b = Builder::new();
     let mut frames: Vec<(&[Sym], usize, u32)> = vec![(&g.axiom[..], 0, g.depth)];
@@ -171,6 +177,9 @@ pub fn matches(g: &Grammar, tree: &Tree, angles: &Angles, work: u64) -> Outcome 
         top.1 += 1;
         read += 1;
         if read > work {
+            return Outcome::TooLong;
+        }
+        if read.is_multiple_of(4096) && deadline.is_some_and(|d| std::time::Instant::now() >= d) {
             return Outcome::TooLong;
         }
         match syms[i] {
@@ -331,14 +340,14 @@ mod tests {
             }
         }
         let tree = Tree { nodes };
-        assert_eq!(matches(&g, &tree, &angles, 1000), Outcome::Same);
+        assert_eq!(matches(&g, &tree, &angles, 1000, None), Outcome::Same);
         let mut other = g.clone();
         other.depth = 2;
         assert!(matches!(
-            matches(&other, &tree, &angles, 10_000),
+            matches(&other, &tree, &angles, 10_000, None),
             Outcome::Differs { .. }
         ));
-        assert_eq!(matches(&other, &tree, &angles, 10), Outcome::TooLong);
+        assert_eq!(matches(&other, &tree, &angles, 10, None), Outcome::TooLong);
         assert_eq!(g.rule_size(), 14);
         assert_eq!(g.describe(), "axiom F-F-F-F; F -> F-F+F+FF-F-F+F; derive 1");
         assert_eq!(first_step(&g, &angles, 100), Some((DVec2::ZERO, 0)));

@@ -183,12 +183,12 @@ pub fn reading(lines: &[Vec<DVec2>], split: u32) -> Result<Reading, NotLines> {
         }
         limit *= 4.0;
     }
-    // Every segment a whole number of steps, within a tenth of a step.
+    // Every segment a whole number of steps, within a fifth of a step.
     let (mut total, mut rr, mut res) = (0usize, 0.0, 0.0);
     for &len in &lengths {
         let u = len / step;
         let r = u.round();
-        if r < 1.0 || (u - r).abs() > 0.1 {
+        if r < 1.0 || (u - r).abs() > 0.2 {
             return Err(NotLines::Steps(format!(
                 "a segment of length {} is not a whole number of steps of {}",
                 crate::number::source(crate::infer::art::emit::nice(len, len * 1e-4)),
@@ -211,36 +211,51 @@ pub fn reading(lines: &[Vec<DVec2>], split: u32) -> Result<Reading, NotLines> {
     // node of each segment.
     let mut starts: Vec<(u32, DVec2)> = Vec::new();
     let mut firsts: Vec<u32> = Vec::with_capacity(segments.len());
-    for (&(a, e), &len) in segments.iter().zip(&lengths) {
+    // The segment each node comes from (moves: none).
+    let mut edge_of: Vec<u32> = Vec::new();
+    for (edge, (&(a, e), &len)) in segments.iter().zip(&lengths).enumerate() {
         let n = (len / step).round().max(1.0) as usize;
         let (wa, we) = (a, e);
         let (a, e) = ((a - origin) / step, (e - origin) / step);
         for k in 0..n {
             let p = a.lerp(e, k as f64 / n as f64);
             let q = a.lerp(e, (k + 1) as f64 / n as f64);
-            b.push(p, q).map_err(|_| {
-                NotLines::Steps("a segment starts away from the drawing by a gap that is not a whole number of steps".into())
+            b.push(p, q).map_err(|e| match e {
+                Unfit::TooLarge => NotLines::Steps(format!(
+                    "more than {} steps and moves (gaps of whole steps)",
+                    super::turtle::MAX_NODES
+                )),
+                _ => NotLines::Steps("a segment starts away from the drawing by a gap that is not a whole number of steps".into()),
             })?;
             let id = b.raw.len() as u32 - 1;
+            edge_of.resize(id as usize, u32::MAX);
+            edge_of.push(edge as u32);
             if k == 0 {
                 firsts.push(id);
             }
             starts.push((id, wa.lerp(we, k as f64 / n as f64)));
         }
     }
-    let coarse = find_delta(&b)?;
-    let mut tree = b.tree(&coarse).map_err(|e| match e {
-        Unfit::Turn => NotLines::Steps(format!(
-            "its turns are not all multiples of one angle ({} degrees)",
-            coarse.delta
-        )),
+    // δ roughly, from the turns; the headings in whole turns of it (a
+    // loose reading: a turn between two short segments carries the noise
+    // of both); δ and the first heading by least squares; then each step's
+    // heading read again against its parent's fitted heading, which
+    // carries no noise.
+    let unfit = |e: Unfit| match e {
+        Unfit::Turn => NotLines::Steps("its turns are not all multiples of one angle".into()),
         Unfit::Jump => NotLines::Steps("a gap that is not a whole number of steps".into()),
-    })?;
-    let headings = headings(&tree);
-    let (angles, theta, delta_error) = refine(&coarse, &segments, &firsts, &headings);
+        Unfit::TooLarge => NotLines::Steps("too many steps".into()),
+    };
+    let coarse = find_delta(&b, &edge_of)?;
+    let loose = Angles::new(coarse.delta, None, 0.5 * coarse.delta + 1e-9);
+    let first = headings(&b.tree(&loose).map_err(unfit)?);
+    let (_, theta, _) = refine(&coarse, &segments, &firsts, &first);
+    let (k, mut tree) = requantize(&b, theta, &coarse).map_err(unfit)?;
+    let (angles, theta, delta_error) = refine(&coarse, &segments, &firsts, &k);
     for n in &mut tree.nodes {
         n.turn = angles.norm(n.turn);
     }
+    let headings = k;
     let (start, heading_error, start_error) = fit_start(
         &tree, &headings, theta, &angles, step, &starts, &segments, &firsts,
     );
@@ -311,26 +326,57 @@ fn refine(
     };
     let _ = a;
     let delta = (d0 + b).to_degrees();
+    // The first heading for a δ (the weighted mean offset), and how far the
+    // segments are from it (weighted mean square).
+    let fit = |delta: f64| {
+        let d = delta.to_radians();
+        let offset =
+            |s: &(DVec2, DVec2), f: u32| wrap(dir(s) - reference - k[f as usize] as f64 * d);
+        let (mut sx, mut sy, mut sw) = (0.0, 0.0, 0.0);
+        for (s, &f) in segments.iter().zip(firsts) {
+            let w = (s.1 - s.0).length_squared();
+            let o = offset(s, f);
+            sx += w * o.cos();
+            sy += w * o.sin();
+            sw += w;
+        }
+        let mean = sy.atan2(sx);
+        let ss: f64 = segments
+            .iter()
+            .zip(firsts)
+            .map(|(s, &f)| (s.1 - s.0).length_squared() * wrap(offset(s, f) - mean).powi(2))
+            .sum();
+        (reference + mean, ss / sw.max(1e-300))
+    };
+    // δ as a person would have written it: 360/m or the shortest decimal
+    // within three standard errors, whichever is shorter when both fit the
+    // segments as well (25.7 rather than 360/14 = 25.714286; 60 rather than
+    // a 60.01 that rounding in the drawing suggests; 22.5 = 360/16).
+    let written = crate::infer::art::emit::nice(delta, (3.0 * err).max(1e-6));
     let m = (360.0 / delta).round();
     let exact = 360.0 / m;
-    let angles = if m >= 2.0 && (exact - delta).abs() <= (4.0 * err).max(1e-6 * delta) {
+    let decimals = |v: f64| crate::number::decimals(crate::infer::art::emit::nice(v, 1e-9));
+    let periodic = if m >= 2.0 && (exact - delta).abs() <= 0.02 * exact {
+        let (_, rw) = fit(written);
+        let (_, re) = fit(exact);
+        let close = |a: f64, b: f64| a <= 1.1 * b + 1e-18;
+        if (written - exact).abs() <= 1e-9 * exact {
+            true
+        } else if decimals(exact) <= decimals(written) {
+            close(re, rw)
+        } else {
+            !close(rw, re)
+        }
+    } else {
+        false
+    };
+    let angles = if periodic {
         Angles::new(exact, Some(m as i32), coarse.tolerance)
     } else {
-        // The shortest decimal within three standard errors: the δ a person
-        // would have written.
-        let written = crate::infer::art::emit::nice(delta, (3.0 * err).max(1e-6));
         Angles::new(written, None, coarse.tolerance)
     };
-    // The first heading, for that δ: the weighted mean offset.
-    let d = angles.delta.to_radians();
-    let (mut sx, mut sy) = (0.0, 0.0);
-    for (s, &f) in segments.iter().zip(firsts) {
-        let w = (s.1 - s.0).length_squared();
-        let o = wrap(dir(s) - reference - k[f as usize] as f64 * d);
-        sx += w * o.cos();
-        sy += w * o.sin();
-    }
-    (angles, reference + sy.atan2(sx), err)
+    let (theta, _) = fit(angles.delta);
+    (angles, theta, err)
 }
 
 /// The start point of the turtle's steps, with the heading's and the
@@ -393,14 +439,105 @@ fn wrap(a: f64) -> f64 {
     super::turtle::wrap_degrees(a.to_degrees()).to_radians()
 }
 
-/// δ: the largest angle of which every turn is a whole multiple, refined by
-/// least squares; exactly 360/m when that fits as well.
-fn find_delta(b: &Builder) -> Result<Angles, NotLines> {
+/// Each node's heading in whole turns of δ, read against its parent's
+/// fitted heading (the first heading `theta` plus its turns), and the tree
+/// of those turns.
+fn requantize(b: &Builder, theta: f64, angles: &Angles) -> Result<(Vec<i64>, Tree), Unfit> {
+    let d = angles.delta.to_radians();
+    let tol = 0.35 * d;
+    let mut k = vec![0i64; b.raw.len()];
+    let mut nodes = Vec::with_capacity(b.raw.len());
+    for (i, r) in b.raw.iter().enumerate() {
+        let from = if r.parent == super::turtle::ROOT {
+            0
+        } else {
+            k[r.parent as usize]
+        };
+        let t = wrap(r.angle - theta - from as f64 * d);
+        let q = (t / d).round();
+        if (t - q * d).abs() > tol {
+            return Err(Unfit::Turn);
+        }
+        k[i] = from + q as i64;
+        let turn = if i == 0 {
+            0
+        } else if r.parent == super::turtle::ROOT {
+            k[i] - k[0]
+        } else {
+            q as i64
+        };
+        nodes.push(super::turtle::Node {
+            parent: r.parent,
+            turn: turn.clamp(-1_000_000, 1_000_000) as i32,
+            kind: r.kind,
+        });
+    }
+    Ok((k, Tree { nodes }))
+}
+
+/// δ roughly: the turns between steps of different segments (in one
+/// segment they are 0 by construction) fall into clusters (near 0, near δ,
+/// near 2δ, …, each as wide as the drawing's noise), the peaks of their
+/// histogram; δ is the smallest peak away from 0, or a part of it when the
+/// other peaks are not its multiples.
+fn find_delta(b: &Builder, edge_of: &[u32]) -> Result<Angles, NotLines> {
     let turns: Vec<f64> = (1..b.raw.len())
+        .filter(|&i| {
+            let p = b.raw[i].parent;
+            p == super::turtle::ROOT
+                || edge_of.get(i) != edge_of.get(p as usize)
+                || edge_of.get(i).is_none_or(|&e| e == u32::MAX)
+        })
         .map(|i| b.turn_radians(i).to_degrees().abs())
         .collect();
-    let nonzero: Vec<f64> = turns.iter().copied().filter(|t| *t > 1.5).collect();
-    let Some(smallest) = nonzero.iter().copied().reduce(f64::min) else {
+    // A histogram of quarter degrees, smoothed over a degree each way; its
+    // lumps (runs of bins that are not empty) are the clusters, as wide as
+    // the drawing's noise. The lump from 0 is the straight turns; lumps of
+    // a stray turn or two do not count.
+    const BINS: usize = 4 * 181;
+    let mut hist = vec![0.0f64; BINS];
+    for &t in &turns {
+        let b = ((t * 4.0).round() as usize).min(BINS - 1);
+        hist[b] += 1.0;
+    }
+    let smooth: Vec<f64> = (0..BINS)
+        .map(|i| {
+            (i.saturating_sub(4)..(i + 5).min(BINS))
+                .map(|j| hist[j])
+                .sum()
+        })
+        .collect();
+    let enough = if turns.len() < 20 {
+        1.0
+    } else {
+        (turns.len() as f64 / 200.0).max(2.0)
+    };
+    let mut significant: Vec<f64> = Vec::new();
+    let mut i = 0;
+    while i < BINS {
+        if smooth[i] == 0.0 {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < BINS && smooth[i] > 0.0 {
+            i += 1;
+        }
+        let (lo, hi) = (start as f64 / 4.0 - 1.25, i as f64 / 4.0);
+        let lump: Vec<f64> = turns
+            .iter()
+            .copied()
+            .filter(|t| *t >= lo && *t < hi)
+            .collect();
+        if start == 0 || lump.len() as f64 <= enough.max(1.0) - 1.0 {
+            continue;
+        }
+        if (lump.len() as f64) < enough {
+            continue;
+        }
+        significant.push(lump.iter().sum::<f64>() / lump.len() as f64);
+    }
+    let Some(&smallest) = significant.first() else {
         // Straight lines only: any angle will do.
         return Ok(Angles::new(90.0, Some(4), 1.0));
     };
@@ -411,8 +548,11 @@ fn find_delta(b: &Builder) -> Result<Angles, NotLines> {
         if d < MIN_DELTA {
             break;
         }
-        let tol = tol_of(d);
-        if turns.iter().all(|t| (t - (t / d).round() * d).abs() <= tol) {
+        let tol = (0.2 * d).max(0.75);
+        if significant
+            .iter()
+            .all(|t| (t - (t / d).round() * d).abs() <= tol)
+        {
             found = Some(d);
             break;
         }

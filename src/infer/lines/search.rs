@@ -534,7 +534,7 @@ fn edge_rewriting(
                     break;
                 }
                 for s in 1..=limits.max_moves {
-                    if rest as usize % s == 0 {
+                    if (rest as usize).is_multiple_of(s) {
                         v.push(Sizes { b, c, s });
                     }
                 }
@@ -739,6 +739,33 @@ fn shape_of(nodes: &[Node], start: usize, len: usize, angles: &Angles) -> Option
     Some(out)
 }
 
+/// Whether `nodes[start..start + shape.len()]` has `shape` (as `shape_of`
+/// would find it), without building it.
+fn has_shape(nodes: &[Node], start: usize, shape: &[Step], angles: &Angles) -> bool {
+    let Some(first) = nodes.get(start) else {
+        return false;
+    };
+    for (j, want) in shape.iter().enumerate() {
+        let Some(nd) = nodes.get(start + j) else {
+            return false;
+        };
+        let local = nd.parent != ROOT && nd.parent as usize >= start;
+        let (from, turn) = if j == 0 {
+            (From::Start, 0)
+        } else if local {
+            (From::Local(nd.parent - start as u32), nd.turn)
+        } else if nd.parent == first.parent {
+            (From::Start, angles.norm(nd.turn - first.turn))
+        } else {
+            return false;
+        };
+        if nd.kind != want.kind || from != want.from || turn != want.turn {
+            return false;
+        }
+    }
+    true
+}
+
 /// Whether `nodes[start..start + k]` is a straight run from outside.
 fn straight(nodes: &[Node], start: usize, k: usize) -> bool {
     (start + 1..start + k).all(|j| {
@@ -809,6 +836,10 @@ fn node_rewriting(
         let f1 = h.beta;
         let f2 = h.k * h.beta + h.beta * h.alpha;
         for p in 0..=h.beta {
+            if limits.late() {
+                out.timed_out = true;
+                return;
+            }
             // Offsets of the nested copies: D(n-1) starts after p runs of k^(n-1).
             let mut off = 0usize;
             let mut ok = true;
@@ -880,11 +911,7 @@ fn parse_two_down(
             }
         } else {
             let must_f = pieces.len() < p;
-            if xs < h.alpha
-                && !must_f
-                && at + h.beta <= end
-                && shape_of(nodes, at, h.beta, angles).is_some_and(|s| s == d1)
-            {
+            if xs < h.alpha && !must_f && at + h.beta <= end && has_shape(nodes, at, d1, angles) {
                 let mut next = pieces;
                 next.push(Piece { x: true, start: at });
                 stack.push((next, at + h.beta, fs, 0));
@@ -988,8 +1015,10 @@ mod tests {
                 Sym::Pop => (h, pos) = saved.pop().expect("balanced"),
                 Sym::Letter(k) => {
                     let l = &g.letters[k as usize];
-                    if d > 0 && l.rule.is_some() {
-                        frames.push((l.rule.as_ref().expect("rule"), 0, d - 1));
+                    if d > 0
+                        && let Some(rule) = &l.rule
+                    {
+                        frames.push((rule, 0, d - 1));
                         continue;
                     }
                     let a = (90.0 + angles.delta * f64::from(h)).to_radians();
@@ -1039,7 +1068,7 @@ mod tests {
         let p = propose(&tree, angles, &Limits::default());
         p.grammars
             .into_iter()
-            .find(|c| matches(c, &tree, angles, 10_000_000) == Outcome::Same)
+            .find(|c| matches(c, &tree, angles, 10_000_000, None) == Outcome::Same)
             .unwrap_or_else(|| panic!("nothing draws {}", g.describe()))
     }
 

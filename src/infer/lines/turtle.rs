@@ -20,11 +20,17 @@ pub const ROOT: u32 = u32::MAX;
 /// How close two points (in steps) must be to be one point.
 pub const TOUCH: f64 = 0.3;
 
+/// Points of the branch this much nearer than others (in steps) win a pop.
+const SAME: f64 = 0.05;
+
 /// How far a gap may be from a whole number of steps.
 pub const GAP: f64 = 0.15;
 
 /// The longest gap, in steps, read as moves (`f`).
 pub const MAX_GAP: f64 = 100_000.0;
+
+/// The most nodes (steps and moves) a builder makes.
+pub const MAX_NODES: usize = 2_000_000;
 
 /// What a node does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -124,6 +130,8 @@ pub enum Unfit {
     Jump,
     /// A turn that is not a multiple of δ.
     Turn,
+    /// More than `MAX_NODES` steps and moves.
+    TooLarge,
 }
 
 /// Segments to nodes; see the module note. Coordinates are in steps.
@@ -173,23 +181,30 @@ impl Builder {
         }
     }
 
-    /// The latest place of the chain within `TOUCH` of `p`.
+    /// The place of the chain nearest `p`, within `TOUCH`; of places as
+    /// near (within `SAME`), the latest.
     fn find(&self, p: DVec2) -> Option<usize> {
         let (cx, cy) = cell(p);
-        let mut best: Option<u32> = None;
+        let mut best: Option<(f64, u32)> = None;
         for dx in -1..=1 {
             for dy in -1..=1 {
                 if let Some(v) = self.cells.get(&(cx + dx, cy + dy)) {
-                    for &at in v.iter().rev() {
-                        if self.chain[at as usize].1.distance(p) <= TOUCH {
-                            best = Some(best.map_or(at, |b| b.max(at)));
-                            break;
+                    for &at in v {
+                        let d = self.chain[at as usize].1.distance(p);
+                        if d > TOUCH {
+                            continue;
                         }
+                        best = match best {
+                            None => Some((d, at)),
+                            Some((bd, _)) if d < bd - SAME => Some((d, at)),
+                            Some((bd, b)) if d <= bd + SAME && at > b => Some((d.min(bd), at)),
+                            keep => keep,
+                        };
                     }
                 }
             }
         }
-        best.map(|b| b as usize)
+        best.map(|(_, b)| b as usize)
     }
 
     /// Adds the drawn step from `a` to `b` (and the moves before it, if it
@@ -198,18 +213,21 @@ impl Builder {
         if self.chain.is_empty() {
             self.enter(ROOT, a);
         }
+        // The nearest point of the branch (the current end when it is as
+        // near: the step continues).
         let top = self.chain.len() - 1;
-        let from = if self.chain[top].1.distance(a) <= TOUCH {
-            top
-        } else if let Some(at) = self.find(a) {
+        let from = if let Some(at) = self.find(a) {
             at
         } else {
             let (node, end) = self.chain[top];
             let g = a - end;
             let len = g.length();
             let steps = len.round();
-            if !(steps >= 1.0 && steps <= MAX_GAP && (len - steps).abs() <= GAP) {
+            if !((1.0..=MAX_GAP).contains(&steps) && (len - steps).abs() <= GAP) {
                 return Err(Unfit::Jump);
+            }
+            if self.raw.len() + steps as usize >= MAX_NODES {
+                return Err(Unfit::TooLarge);
             }
             let angle = g.y.atan2(g.x);
             let mut parent = node;
@@ -225,6 +243,9 @@ impl Builder {
             }
             self.chain.len() - 1
         };
+        if self.raw.len() >= MAX_NODES {
+            return Err(Unfit::TooLarge);
+        }
         self.truncate(from);
         let parent = self.chain[from].0;
         let d = b - a;
@@ -283,7 +304,9 @@ impl Builder {
 mod tests {
     use super::*;
 
-    fn tree(segs: &[((f64, f64), (f64, f64))]) -> Tree {
+    type Seg = ((f64, f64), (f64, f64));
+
+    fn tree(segs: &[Seg]) -> Tree {
         let mut b = Builder::new();
         for &((ax, ay), (bx, by)) in segs {
             b.push(DVec2::new(ax, ay), DVec2::new(bx, by))

@@ -84,7 +84,7 @@ pub fn redraw(text: &str, segments: &[(DVec2, DVec2)], step: f64) -> Option<Redr
 
 /// Compares two sets of steps.
 pub fn compare(input: &[(DVec2, DVec2)], drawn: &[(DVec2, DVec2)], step: f64) -> Redraw {
-    let tol = 0.05 * step;
+    let tol = 0.1 * step;
     let cell = step / 2.0;
     let key = |p: DVec2| ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64);
     let mut by_mid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
