@@ -206,7 +206,8 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
         }
         stats.search_ms += ms(t);
     }
-    if why.is_empty() {
+    // Read as steps but unexplained: say that, not why another reading failed.
+    if why.is_empty() || steps > 0 {
         why = "no D0L system with one or two rewritten letters draws it".into();
     }
     Lines::Unexplained {
