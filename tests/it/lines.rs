@@ -600,3 +600,40 @@ fn line_drawings_are_stroked_straight_segments() {
         assert_eq!(got, lines_expected, "{shape}");
     }
 }
+
+#[test]
+fn hostile_line_drawings_end_within_the_budget() {
+    let svg = |d: &str| {
+        format!(
+            r#"<svg xmlns="http://www.w3.org/2000/svg"><path d="{d}" fill="none" stroke="black"/></svg>"#
+        )
+    };
+    let mut cases: Vec<(&str, String)> = Vec::new();
+    // One segment drawn back and forth 100,000 times.
+    let mut d = String::from("M0 0");
+    for k in 0..100_000 {
+        d.push_str(if k % 2 == 0 { " L0 10" } else { " L0 0" });
+    }
+    cases.push(("back and forth", svg(&d)));
+    // A segment a million and one steps long beside a step.
+    cases.push(("too long", svg("M0 0 L0 1 M5 5 L5 1000006")));
+    // Gaps of 90,000 steps, many of them.
+    let mut d = String::new();
+    for k in 0..100 {
+        d.push_str(&format!("M{} 0 L{} 1 ", k * 90_000, k * 90_000));
+    }
+    cases.push(("long gaps", svg(&d)));
+    // A random walk of 20,000 steps.
+    cases.push(("walk", random_walk(20_000)));
+    let opts = lines::Options {
+        budget: Duration::from_millis(2000),
+        ..lines::Options::default()
+    };
+    for (what, data) in cases {
+        let start = Instant::now();
+        let outcome = lines::from_svg(data.as_bytes(), "x.svg", &opts);
+        let took = start.elapsed();
+        assert!(took < Duration::from_secs(30), "{what}: {took:?}");
+        assert!(!matches!(outcome, Lines::Found(_)), "{what}: a D0L system?");
+    }
+}

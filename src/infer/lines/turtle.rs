@@ -23,6 +23,9 @@ pub const TOUCH: f64 = 0.3;
 /// Points of the branch this much nearer than others (in steps) win a pop.
 const SAME: f64 = 0.05;
 
+/// The most points of the branch looked at per cell (the latest).
+pub const PER_CELL: usize = 64;
+
 /// How far a gap may be from a whole number of steps.
 pub const GAP: f64 = 0.15;
 
@@ -189,7 +192,9 @@ impl Builder {
         for dx in -1..=1 {
             for dy in -1..=1 {
                 if let Some(v) = self.cells.get(&(cx + dx, cy + dy)) {
-                    for &at in v {
+                    // The latest few: a drawing that passes one point a
+                    // thousand times must not cost a thousand per step.
+                    for &at in v.iter().rev().take(PER_CELL) {
                         let d = self.chain[at as usize].1.distance(p);
                         if d > TOUCH {
                             continue;

@@ -5,8 +5,8 @@
 //! Owns: the comparison (segments matched, the symmetric Chamfer distance of
 //! points sampled along both drawings). Must not change the program.
 
+use super::turtle::PER_CELL;
 use crate::geometry::index::PointGrid;
-use crate::run;
 use crate::turtle::Sink;
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
@@ -74,9 +74,21 @@ pub fn redraw(text: &str, segments: &[(DVec2, DVec2)], step: f64) -> Option<Redr
         return None;
     }
     let checked = fe.checked.as_ref()?;
-    let derived = run::derive(&fe.file, checked, &run::Options::default(), &|_, _| {}).ok()?;
+    // As `lsyc run` derives and draws (`run::derive`, one layer up).
+    let prog = crate::compile::compile(&fe.file, checked, None).ok()?;
+    let limits = crate::derive::Limits::default();
+    let axiom = crate::derive::axiom(&prog, &vec![0.0; prog.params.len()], 0).ok()?;
+    let string = crate::derive::derive(&prog, axiom, prog.derive, 0, limits, &|_, _| {}).ok()?;
     let mut sink = Segments::default();
-    derived.interpret(0, &mut sink).ok()?;
+    crate::turtle::interpret_limited(
+        &prog,
+        &string,
+        0,
+        crate::turtle::State::default(),
+        limits,
+        &mut sink,
+    )
+    .ok()?;
     let drawn = steps(&sink.0, step);
     let input = steps(segments, step);
     Some(compare(&input, &drawn, step))
@@ -99,7 +111,8 @@ pub fn compare(input: &[(DVec2, DVec2)], drawn: &[(DVec2, DVec2)], step: f64) ->
         let mut hit = None;
         'look: for dx in -1..=1 {
             for dy in -1..=1 {
-                for &i in by_mid.get(&(cx + dx, cy + dy)).map_or(&[][..], |v| &v[..]) {
+                let cell = by_mid.get(&(cx + dx, cy + dy)).map_or(&[][..], |v| &v[..]);
+                for &i in cell.iter().take(PER_CELL) {
                     let t = input[i];
                     let same = (t.0.distance(s.0) <= tol && t.1.distance(s.1) <= tol)
                         || (t.0.distance(s.1) <= tol && t.1.distance(s.0) <= tol);
@@ -175,7 +188,8 @@ fn one_way(from: &[DVec2], to: &[DVec2], cell: f64) -> f64 {
         let mut best = f64::INFINITY;
         for dx in -1..=1 {
             for dy in -1..=1 {
-                for &i in cells.get(&(cx + dx, cy + dy)).map_or(&[][..], |v| &v[..]) {
+                let cell = cells.get(&(cx + dx, cy + dy)).map_or(&[][..], |v| &v[..]);
+                for &i in cell.iter().take(PER_CELL) {
                     best = best.min(p.distance(to[i as usize]));
                 }
             }
