@@ -18,7 +18,7 @@ use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// A drawing of repeated elements (SVG) to turn into sequence and branching rules.
+    /// A drawing (SVG) to turn into an lsystem: a line drawing into the D0L system that draws it, else its repeated elements into sequence and branching rules.
     #[arg(value_name = "ART.svg")]
     pub art: Option<PathBuf>,
 
@@ -67,7 +67,7 @@ pub struct Args {
     #[arg(long, conflicts_with = "skeleton")]
     pub reflect: bool,
 
-    /// Art: print what was found (elements, kinds, clusters, rules, time per phase, program size over SVG size) as JSON on stderr.
+    /// Print what was found as JSON on stderr (line drawings: steps, angle, candidates, rules, times; elements: elements, kinds, clusters, rules, time per phase, program size over SVG size).
     #[arg(long)]
     pub stats: bool,
 
