@@ -6,7 +6,7 @@
 //! Owns: `Grammar` (letters, rules, axiom, depth), its size (rule symbols),
 //! and `matches`. Must not search: `search` proposes, this module checks.
 
-use super::turtle::{Angles, Builder, Kind, Tree};
+use super::turtle::{Angles, Builder, Tree};
 use glam::DVec2;
 
 /// A symbol of an axiom or a successor.
@@ -287,11 +287,6 @@ pub fn first_step(g: &Grammar, angles: &Angles, work: u64) -> Option<(DVec2, i32
     None
 }
 
-/// Whether a tree's steps are all drawn steps.
-pub fn all_drawn(tree: &Tree) -> bool {
-    tree.nodes.iter().all(|n| n.kind == Kind::Draw)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -335,7 +330,7 @@ mod tests {
                 nodes.push(crate::infer::lines::turtle::Node {
                     parent,
                     turn,
-                    kind: Kind::Draw,
+                    kind: crate::infer::lines::turtle::Kind::Draw,
                 });
             }
         }

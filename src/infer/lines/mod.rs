@@ -107,7 +107,9 @@ fn ms(t: Instant) -> f64 {
 /// Infers the D0L system of the line drawing in `data` (named `name`).
 pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
     let start = Instant::now();
-    let deadline = start + opts.budget;
+    // No deadline for a budget beyond what a clock can count.
+    let deadline = start.checked_add(opts.budget);
+    let late = || deadline.is_some_and(|d| Instant::now() >= d);
     if data.len() > super::MAX_SVG_BYTES {
         return Lines::NotLines("too large");
     }
@@ -136,7 +138,7 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
     // Steps as long as the shortest segment, or half as long (a drawing
     // whose steps all come in pairs, such as F -> FF plants).
     for split in [1, 2] {
-        if Instant::now() >= deadline {
+        if late() {
             timed_out = true;
             break;
         }
@@ -160,7 +162,7 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
         stats.angle = reading.angles.delta;
         let t = Instant::now();
         let limits = search::Limits {
-            deadline: Some(deadline),
+            deadline,
             ..opts.limits
         };
         let proposals = search::propose(&reading.tree, &reading.angles, &limits);
@@ -169,7 +171,7 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
         let work = 64 * reading.tree.nodes.len() as u64 + 100_000;
         let mut verified = 0;
         for g in proposals.grammars {
-            if Instant::now() >= deadline {
+            if late() {
                 timed_out = true;
                 break;
             }
@@ -177,8 +179,7 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
                 continue;
             }
             stats.compared += 1;
-            if grammar::matches(&g, &reading.tree, &reading.angles, work, Some(deadline))
-                != Outcome::Same
+            if grammar::matches(&g, &reading.tree, &reading.angles, work, deadline) != Outcome::Same
             {
                 continue;
             }

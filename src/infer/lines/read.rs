@@ -7,7 +7,7 @@
 //! δ (every turn a whole number of δ), the start frame, and the tree of
 //! steps (`turtle::Builder`). Must not search grammars.
 
-use super::turtle::{Angles, Builder, Kind, Tree, Unfit};
+use super::turtle::{Angles, Builder, Tree, Unfit};
 use crate::infer::strokes::{self, Seg};
 use crate::infer::svg;
 use glam::DVec2;
@@ -563,11 +563,6 @@ fn find_delta(b: &Builder, edge_of: &[u32]) -> Result<Angles, NotLines> {
         ));
     };
     Ok(Angles::new(d0, None, tol_of(d0)))
-}
-
-/// Whether a tree draws at all.
-pub fn draws(tree: &Tree) -> bool {
-    tree.nodes.iter().any(|n| n.kind == Kind::Draw)
 }
 
 #[cfg(test)]
