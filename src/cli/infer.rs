@@ -1,5 +1,7 @@
-//! `lsyc infer ART.svg [-o OUT.lsy]`: a drawing of repeated elements to
-//! sequence and branching rules (see `lsyc::infer::art`), and
+//! `lsyc infer ART.svg [-o OUT.lsy]`: a line drawing to the D0L system that
+//! draws it (see `lsyc::infer::lines`), or, when it is not a line drawing or
+//! no D0L system is found within `--budget-ms`, a drawing of repeated
+//! elements to sequence and branching rules (see `lsyc::infer::art`), and
 //! `lsyc infer --skeleton SKETCH.svg [-o TREE.lsy] [--3d]`: a tree sketch to a
 //! recursive L-system (see `lsyc::infer`).
 //!
@@ -8,6 +10,7 @@
 
 use super::Reporter;
 use lsyc::infer::art::{self, rules::Weights};
+use lsyc::infer::lines::{self, Lines};
 use lsyc::infer::{self, MAX_SVG_BYTES, Options};
 use lsyc::source;
 use std::io::{IsTerminal, Write};
@@ -15,7 +18,7 @@ use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// A drawing of repeated elements (SVG) to turn into sequence and branching rules.
+    /// A drawing (SVG) to turn into an lsystem: a line drawing into the D0L system that draws it, else its repeated elements into sequence and branching rules.
     #[arg(value_name = "ART.svg")]
     pub art: Option<PathBuf>,
 
@@ -64,9 +67,17 @@ pub struct Args {
     #[arg(long, conflicts_with = "skeleton")]
     pub reflect: bool,
 
-    /// Art: print what was found (elements, kinds, clusters, rules, time per phase, program size over SVG size) as JSON on stderr.
+    /// Print what was found as JSON on stderr (line drawings: steps, angle, candidates, rules, times; elements: elements, kinds, clusters, rules, time per phase, program size over SVG size).
     #[arg(long)]
     pub stats: bool,
+
+    /// Line drawings: how long the search for a D0L system may take (milliseconds) before inferring elements instead.
+    #[arg(long, value_name = "MS", default_value_t = lines::DEFAULT_BUDGET_MS, conflicts_with = "skeleton")]
+    pub budget_ms: u64,
+
+    /// Line drawings: do not search for a D0L system; infer elements.
+    #[arg(long, conflicts_with = "skeleton")]
+    pub no_lines: bool,
 }
 
 pub fn run(args: &Args, reporter: &Reporter) -> u8 {
@@ -125,6 +136,59 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         Ok(d) => d,
         Err(code) => return code,
     };
+    if !args.no_lines {
+        let opts = lines::Options {
+            budget: std::time::Duration::from_millis(args.budget_ms),
+            ..lines::Options::default()
+        };
+        match lines::from_svg(&data, &name, &opts) {
+            Lines::Found(found) => {
+                if args.stats
+                    && let Ok(json) = serde_json::to_string(&found.stats)
+                {
+                    eprintln!("{json}");
+                }
+                let g = &found.grammar;
+                let summary = format!(
+                    "{name}: a line drawing of {} steps, drawn by a D0L system of {} rule{} at derive {}",
+                    found.redraw.steps,
+                    found.stats.rules,
+                    if found.stats.rules == 1 { "" } else { "s" },
+                    g.depth
+                );
+                return write_program(args.output.as_deref(), &found.text, &summary, reporter);
+            }
+            Lines::Unexplained {
+                why,
+                steps,
+                timed_out,
+                stats,
+            } => {
+                if args.stats
+                    && let Ok(json) = serde_json::to_string(&stats)
+                {
+                    eprintln!("{json}");
+                }
+                let what = if steps > 0 {
+                    format!("a line drawing of {steps} steps")
+                } else {
+                    "a line drawing".to_string()
+                };
+                let how = if timed_out {
+                    format!(
+                        "no D0L system found within {} ms (--budget-ms)",
+                        args.budget_ms
+                    )
+                } else {
+                    why
+                };
+                reporter.note(&format!(
+                    "{name}: {what}, but {how}; inferring its elements instead"
+                ));
+            }
+            Lines::NotLines(_) => {}
+        }
+    }
     let bar = std::io::stderr()
         .is_terminal()
         .then(|| indicatif::ProgressBar::new(0));

@@ -74,9 +74,9 @@ pub enum Command {
         after_help = "Examples:\n  lsyc fmt plant.lsy > tidy.lsy\n  lsyc fmt --write plant.lsy\n  lsyc fmt --check lang-examples/*.lsy"
     )]
     Fmt(fmt::Args),
-    /// Infer a program from a drawing: repeated elements become sequence and branching rules; `--skeleton SKETCH.svg` turns a tree sketch into a recursive L-system.
+    /// Infer a program from a drawing: a line drawing becomes the D0L system that draws it, repeated elements become sequence and branching rules; `--skeleton SKETCH.svg` turns a tree sketch into a recursive L-system.
     #[command(
-        after_help = "Examples:\n  lsyc infer windows.svg -o windows.lsy\n  lsyc infer noisy.svg --symmetrize -o regular.lsy\n  lsyc infer --skeleton sketch.svg -o tree.lsy\n  lsyc infer --skeleton sketch.svg --3d --seed 7 -o tree3d.lsy"
+        after_help = "Examples:\n  lsyc infer koch.svg -o koch.lsy        # a line drawing: its D0L system\n  lsyc infer windows.svg -o windows.lsy\n  lsyc infer noisy.svg --symmetrize -o regular.lsy\n  lsyc infer --skeleton sketch.svg -o tree.lsy\n  lsyc infer --skeleton sketch.svg --3d --seed 7 -o tree3d.lsy"
     )]
     Infer(infer::Args),
     /// Edit a scene's guides with a mass-spring system: drag vertices, move, rotate, scale guides.

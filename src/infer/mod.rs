@@ -6,11 +6,13 @@
 //! (`skeleton`), productions, pre-reduction, the reduction table and the reduced
 //! productions (`productions`), and the program as an AST (`emit`), printed by
 //! `fmt::format_file`; and `lsyc infer ART.svg`, repeated elements to sequence
-//! and branching rules (`art`). Must not write files or print: the CLI does that, and
+//! and branching rules (`art`), or, for a line drawing, the D0L system
+//! that draws it (`lines`). Must not write files or print: the CLI does that, and
 //! must not panic on any input.
 
 pub mod art;
 pub mod emit;
+pub mod lines;
 pub mod productions;
 pub mod skeleton;
 pub mod strokes;

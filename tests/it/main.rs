@@ -13,6 +13,7 @@ mod hostile;
 mod hostile_svg;
 mod infer;
 mod layers;
+mod lines;
 mod roundtrip;
 mod run;
 mod scene;

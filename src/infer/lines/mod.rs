@@ -1,0 +1,414 @@
+//! `lsyc infer ART.svg` on a line drawing: the D0L system that draws it.
+//!
+//! A line drawing (every visible shape stroked, unfilled, straight segments:
+//! the turtle's trace of a Koch curve, a dragon, a bracketed plant) is read
+//! as turtle steps (`read`, `turtle`): equal steps, turns by multiples of one
+//! angle δ, branches where a polyline starts on an earlier point, gaps of
+//! whole steps as moves. The search (`search`) proposes D0L systems from the
+//! drawing's self-similarity; each candidate is derived and drawn step by
+//! step against the drawing (`grammar`), and the first, smallest one that
+//! draws it exactly is derived again by the library and compared with the
+//! drawing (`verify`) before it is written (`emit`).
+//!
+//! Owns: the pipeline, its options and its outcome (a program, not a line
+//! drawing, or a line drawing no grammar explains within the budget). Must
+//! not print or write files (the CLI does), and must not panic on any input.
+
+pub mod emit;
+pub mod grammar;
+pub mod read;
+pub mod search;
+pub mod turtle;
+pub mod verify;
+
+use crate::ast::{Expr, Module};
+use crate::infer::art::emit::nice;
+use crate::infer::emit::sym;
+use glam::DVec2;
+use grammar::{Grammar, Outcome};
+use read::{NotLines, Reading};
+use std::time::{Duration, Instant};
+
+/// Options of the line-drawing search.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// How long the search may take.
+    pub budget: Duration,
+    /// Search limits.
+    pub limits: search::Limits,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            budget: Duration::from_millis(DEFAULT_BUDGET_MS),
+            limits: search::Limits::default(),
+        }
+    }
+}
+
+/// The most candidates per reading that the library derives and draws
+/// again (each as large as the drawing).
+const MAX_REDRAWS: usize = 3;
+
+/// The default time budget of the search, milliseconds.
+pub const DEFAULT_BUDGET_MS: u64 = 4000;
+
+/// What the search did, for `--stats`.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Stats {
+    /// Drawn steps read.
+    pub steps: usize,
+    /// δ, degrees.
+    pub angle: f64,
+    /// Candidates proposed.
+    pub candidates: usize,
+    /// Candidates derived and compared.
+    pub compared: usize,
+    /// Rules of the program (rewriting rules, not `interpret`).
+    pub rules: usize,
+    /// Symbols in their successors.
+    pub rule_symbols: usize,
+    pub depth: u32,
+    pub read_ms: f64,
+    pub search_ms: f64,
+    pub verify_ms: f64,
+}
+
+/// A line drawing and its program.
+pub struct Inferred {
+    pub grammar: Grammar,
+    pub file: crate::ast::File,
+    pub text: String,
+    pub redraw: verify::Redraw,
+    pub stats: Stats,
+}
+
+/// What became of a drawing.
+pub enum Lines {
+    /// A D0L system draws it.
+    Found(Box<Inferred>),
+    /// Not a line drawing (what it has instead).
+    NotLines(&'static str),
+    /// A line drawing no D0L system explains (why), within the search's
+    /// limits; `timed_out` when the budget ended the search.
+    Unexplained {
+        why: String,
+        steps: usize,
+        timed_out: bool,
+        stats: Stats,
+    },
+}
+
+fn ms(t: Instant) -> f64 {
+    (t.elapsed().as_secs_f64() * 1e5).round() / 100.0
+}
+
+/// Infers the D0L system of the line drawing in `data` (named `name`).
+pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
+    let start = Instant::now();
+    // No deadline for a budget beyond what a clock can count.
+    let deadline = start.checked_add(opts.budget);
+    let late = || deadline.is_some_and(|d| Instant::now() >= d);
+    if data.len() > super::MAX_SVG_BYTES {
+        return Lines::NotLines("too large");
+    }
+    let lines = match read::polylines(data) {
+        Ok(l) => l,
+        Err(NotLines::Shapes(what)) => return Lines::NotLines(what),
+        Err(NotLines::Steps(why)) => {
+            return Lines::Unexplained {
+                why,
+                steps: 0,
+                timed_out: false,
+                stats: Stats::default(),
+            };
+        }
+    };
+    let read_ms = ms(start);
+    let mut why = String::new();
+    let mut steps = 0;
+    // The size of the drawing's own turtle string (at the first reading).
+    let mut drawing_size = 0;
+    let mut timed_out = false;
+    let mut stats = Stats {
+        read_ms,
+        ..Stats::default()
+    };
+    // Steps as long as the shortest segment, or half as long (a drawing
+    // whose steps all come in pairs, such as F -> FF plants).
+    for split in [1, 2] {
+        if late() {
+            timed_out = true;
+            break;
+        }
+        let reading = match read::reading(&lines, split) {
+            Ok(r) => r,
+            Err(e) => {
+                if why.is_empty() {
+                    why = match e {
+                        NotLines::Steps(w) => w,
+                        NotLines::Shapes(w) => w.to_string(),
+                    };
+                }
+                continue;
+            }
+        };
+        if steps == 0 {
+            steps = reading.steps;
+            drawing_size = drawing_symbols(&reading);
+        }
+        stats.steps = reading.steps;
+        stats.angle = reading.angles.delta;
+        let t = Instant::now();
+        let limits = search::Limits {
+            deadline,
+            ..opts.limits
+        };
+        let proposals = search::propose(&reading.tree, &reading.angles, &limits);
+        timed_out |= proposals.timed_out;
+        stats.candidates += proposals.grammars.len();
+        let work = 64 * reading.tree.nodes.len() as u64 + 100_000;
+        let mut verified = 0;
+        for g in proposals.grammars {
+            if late() {
+                timed_out = true;
+                break;
+            }
+            if !explains(&g, drawing_size) {
+                continue;
+            }
+            stats.compared += 1;
+            if grammar::matches(&g, &reading.tree, &reading.angles, work, deadline) != Outcome::Same
+            {
+                continue;
+            }
+            // The library's redraw is the costly check: a few per reading.
+            verified += 1;
+            if verified > MAX_REDRAWS {
+                break;
+            }
+            stats.search_ms += ms(t);
+            let tv = Instant::now();
+            if let Some(found) = finish(&g, &reading, name, work) {
+                stats.verify_ms = ms(tv);
+                stats.rules = g.letters.iter().filter(|l| l.rule.is_some()).count();
+                stats.rule_symbols = g.rule_size();
+                stats.depth = g.depth;
+                let (file, text, redraw) = found;
+                return Lines::Found(Box::new(Inferred {
+                    grammar: g,
+                    file,
+                    text,
+                    redraw,
+                    stats,
+                }));
+            }
+        }
+        stats.search_ms += ms(t);
+    }
+    // Read as steps but unexplained: say that, not why another reading failed.
+    if why.is_empty() || steps > 0 {
+        why = "no D0L system with one or two rewritten letters draws it".into();
+    }
+    Lines::Unexplained {
+        why,
+        steps,
+        timed_out,
+        stats,
+    }
+}
+
+/// Whether a grammar says more than the drawing itself: at most half its
+/// size, and not only rules that lengthen steps (`F -> FF` with the
+/// drawing as the axiom).
+fn explains(g: &Grammar, drawing_size: usize) -> bool {
+    let small = 2 * (g.rule_size() + g.axiom.len()) <= drawing_size;
+    let lengthens = g.letters.iter().enumerate().all(|(k, l)| {
+        l.rule
+            .as_ref()
+            .is_none_or(|r| r.iter().all(|s| *s == grammar::Sym::Letter(k as u8)))
+    });
+    small && !lengthens
+}
+
+/// Roughly how many symbols the drawing's own turtle string has: a grammar
+/// must be shorter to explain anything.
+fn drawing_symbols(r: &Reading) -> usize {
+    let turns: usize = r
+        .tree
+        .nodes
+        .iter()
+        .map(|n| n.turn.unsigned_abs() as usize)
+        .sum();
+    let branches = r
+        .tree
+        .nodes
+        .iter()
+        .enumerate()
+        .filter(|(i, n)| n.parent != turtle::ROOT && n.parent as usize + 1 != *i)
+        .count();
+    r.tree.nodes.len() + turns + 2 * branches
+}
+
+/// A turn of `deg` degrees: bare symbols when it is a few turns of δ.
+fn turn(deg: f64, delta: f64) -> Vec<Module> {
+    let k = (deg / delta).round();
+    if (deg - k * delta).abs() <= 1e-6 * delta.max(1.0) && k.abs() <= 4.0 {
+        let c = if k > 0.0 { '+' } else { '-' };
+        return vec![sym(c, None); k.abs() as usize];
+    }
+    let d = nice(deg, 1e-4);
+    if d == 0.0 {
+        return Vec::new();
+    }
+    vec![sym(
+        if d > 0.0 { '+' } else { '-' },
+        Some(Expr::num(d.abs())),
+    )]
+}
+
+/// Where the program puts the drawing: the heading of the first step
+/// (degrees from +y) and where the turtle starts (user units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Frame {
+    heading: f64,
+    start: DVec2,
+}
+
+/// Where the turtle starts so that the first step, which starts at `p_c`
+/// steps from it, starts at `first` once turned by `heading` degrees and
+/// scaled by `step`.
+fn place(first: DVec2, p_c: DVec2, heading: f64, step: f64) -> DVec2 {
+    let rot = heading.to_radians();
+    let rotated = DVec2::new(
+        p_c.x * rot.cos() - p_c.y * rot.sin(),
+        p_c.x * rot.sin() + p_c.y * rot.cos(),
+    );
+    first - rotated * step
+}
+
+/// The turns and moves that put the turtle at `f`'s start and heading.
+fn frame_modules(f: &Frame, angle: f64, tol: f64) -> Vec<Module> {
+    let mut out = Vec::new();
+    if f.start.length() > tol {
+        let r = f.start.length();
+        let beta = nice(
+            turtle::wrap_degrees(f.start.y.atan2(f.start.x).to_degrees() - 90.0),
+            (tol / r).to_degrees().min(1e-3),
+        );
+        out.extend(turn(beta, angle));
+        out.push(sym('f', Some(Expr::num(nice(r, tol)))));
+        out.extend(turn(turtle::wrap_degrees(f.heading - beta), angle));
+    } else {
+        out.extend(turn(f.heading, angle));
+    }
+    out
+}
+
+/// The frame rounded as a person would have drawn it: the heading to a
+/// multiple of δ or a whole degree, the start to the origin, when they are
+/// that close.
+fn rounded(f: &Frame, angle: f64, step: f64) -> Frame {
+    let k = (f.heading / angle).round() * angle;
+    let heading = if (f.heading - k).abs() <= 0.1 {
+        k
+    } else if (f.heading - f.heading.round()).abs() <= 0.1 {
+        f.heading.round()
+    } else {
+        f.heading
+    };
+    let start = if f.start.length() <= 0.05 * step {
+        DVec2::ZERO
+    } else {
+        f.start
+    };
+    Frame { heading, start }
+}
+
+/// The program of a grammar that matched the drawing step by step: the
+/// frame that puts it on the drawing, the text, and the library's redraw;
+/// `None` if the redraw is not within 10⁻³ of the diagonal. The frame is
+/// written rounded when that draws as close to the drawing.
+fn finish(
+    g: &Grammar,
+    r: &Reading,
+    name: &str,
+    work: u64,
+) -> Option<(crate::ast::File, String, verify::Redraw)> {
+    let angle = if r.angles.period.is_some() {
+        nice(r.angles.delta, 1e-6)
+    } else {
+        nice(r.angles.delta, (3.0 * r.delta_error).max(1e-6))
+    };
+    let step = nice(r.step, (3.0 * r.step_error).max(1e-4 * r.step));
+    let (p_c, k_c) = grammar::first_step(g, &r.angles, work)?;
+    let tol = (3.0 * r.frame_error.1).max(2e-3 * step);
+    // The frame for an angle: the first step's heading less its turns, and
+    // where the turtle must start for its first step to start where the
+    // drawing's does.
+    let frame = |angle: f64| {
+        let phi = turtle::wrap_degrees(r.heading - f64::from(k_c) * angle);
+        let heading = nice(phi, (3.0 * r.frame_error.0).max(1e-3));
+        Frame {
+            heading,
+            start: place(r.start, p_c, heading, step),
+        }
+    };
+    // As measured, and as a person would have written it: δ to a twentieth
+    // of a degree, the heading to a multiple of δ or a whole degree, the
+    // start at the origin, when they are that close.
+    let precise = (angle, frame(angle));
+    let round_angle = if r.angles.period.is_some() {
+        angle
+    } else {
+        nice(angle, 0.05)
+    };
+    let mut round = rounded(&frame(round_angle), round_angle, step);
+    if !(round.start == DVec2::ZERO && p_c == DVec2::ZERO) {
+        round.start = place(r.start, p_c, round.heading, step);
+    }
+    let (source, system) = super::names(name);
+    let settings = |(angle, f): (f64, Frame)| emit::Settings {
+        source: &source,
+        name: system.clone(),
+        angle,
+        step,
+        frame: frame_modules(&f, angle, tol),
+        redraw: verify::Redraw {
+            matched: 0,
+            steps: r.steps,
+            drawn: 0,
+            chamfer: 0.0,
+            diagonal: 0.0,
+        },
+    };
+    let check = |settings: &emit::Settings| {
+        let draft = crate::fmt::format_file(&emit::program(g, settings));
+        verify::redraw(&draft, &r.segments, r.step)
+            .filter(|d| d.drawn == d.steps && d.relative() <= 1e-3)
+    };
+    let mut best = settings(precise);
+    let mut redraw = check(&best);
+    let person = settings((round_angle, round));
+    if person.frame != best.frame || person.angle != best.angle {
+        let other = check(&person);
+        let better = match (&other, &redraw) {
+            (Some(o), Some(p)) => {
+                o.matched >= p.matched || o.relative() <= 1.25 * p.relative() + 1e-9
+            }
+            (Some(_), None) => true,
+            _ => false,
+        };
+        if better {
+            best = person;
+            redraw = other;
+        }
+    }
+    let redraw = redraw?;
+    let mut settings = best;
+    settings.redraw = redraw;
+    let file = emit::program(g, &settings);
+    let text = crate::fmt::format_file(&file);
+    Some((file, text, redraw))
+}

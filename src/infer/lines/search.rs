@@ -1,0 +1,1125 @@
+//! The grammar search: D0L systems whose derivation could draw a tree of
+//! turtle steps, proposed from the drawing's own self-similarity.
+//!
+//! Two families, each read off the drawing rather than enumerated blindly:
+//!
+//! - **Edge rewriting** (Koch curves, dragon, Gosper curves, the arrowhead,
+//!   bracketed plants such as `F -> F[+F]F[-F]F`): every drawn letter becomes
+//!   a block of the same number of steps, consecutive in drawing order. For
+//!   a block size b, the drawing is cut into blocks; one or two shapes of
+//!   block (the one or two drawing letters' successors) must recur; each
+//!   block becomes one step of the drawing one derivation earlier, with its
+//!   turn less the successors' leading and trailing turns (tried over all
+//!   values); and again, until what is left is the axiom. The blocks of the
+//!   earlier drawing name the letters inside each successor. Gaps (`f`)
+//!   rewrite to a fixed number of moves.
+//! - **Node rewriting** (`X -> F[+X]F[-X]+X`, `F -> FF`): the counts of steps
+//!   follow f(j+1) = k·f(j) + β·x(j), x(j+1) = α·x(j); for each solution the
+//!   drawing of X one and two steps down is found nested at the place of
+//!   the first X of the successor, and the drawing two steps down is parsed
+//!   into runs of k^1 steps (F) and copies of the drawing one step down (X).
+//!
+//! Owns: proposing candidates, within the work limits of `Limits`. Must not
+//! accept one: `grammar::matches` and the library's own derivation do.
+
+use super::grammar::{Action, Grammar, Letter, Sym, turn_syms};
+use super::turtle::{Angles, Kind, Node, ROOT, Tree};
+use std::collections::HashSet;
+use std::time::Instant;
+
+/// How far the search goes.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    /// Largest number of drawn steps per successor (edge rewriting).
+    pub max_block: usize,
+    /// Largest number of moves per successor of `f`.
+    pub max_moves: usize,
+    /// Largest number of X in a node-rewriting successor.
+    pub max_x: usize,
+    /// Largest number of F in a node-rewriting successor.
+    pub max_f: usize,
+    /// Most candidates proposed.
+    pub max_candidates: usize,
+    /// Largest axiom, in steps.
+    pub max_axiom: usize,
+    /// When to stop proposing.
+    pub deadline: Option<Instant>,
+}
+
+impl Default for Limits {
+    fn default() -> Limits {
+        Limits {
+            max_block: 64,
+            max_moves: 16,
+            max_x: 6,
+            max_f: 24,
+            max_candidates: 2_000,
+            max_axiom: 256,
+            deadline: None,
+        }
+    }
+}
+
+impl Limits {
+    fn late(&self) -> bool {
+        self.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+}
+
+/// What the search proposes, and whether it ran out of time.
+#[derive(Debug, Default)]
+pub struct Proposals {
+    pub grammars: Vec<Grammar>,
+    pub timed_out: bool,
+}
+
+/// Candidates for `tree`, cheapest first (see `Grammar::cost`), no two alike.
+pub fn propose(tree: &Tree, angles: &Angles, limits: &Limits) -> Proposals {
+    let mut out = Proposals::default();
+    let mut seen = HashSet::new();
+    let mut add = |g: Grammar, out: &mut Proposals| {
+        if out.grammars.len() < limits.max_candidates && seen.insert(g.clone()) {
+            out.grammars.push(g);
+        }
+    };
+    if tree.nodes.len() >= 2 {
+        edge_rewriting(
+            tree,
+            angles,
+            limits,
+            &mut |g, o: &mut Proposals| add(g, o),
+            &mut out,
+        );
+        node_rewriting(
+            tree,
+            angles,
+            limits,
+            &mut |g, o: &mut Proposals| add(g, o),
+            &mut out,
+        );
+    }
+    out.grammars.sort_by_cached_key(Grammar::cost);
+    out
+}
+
+type Sink<'a> = dyn FnMut(Grammar, &mut Proposals) + 'a;
+
+// ------------------------------------------------------------ edge rewriting
+
+/// Where a step of a block continues from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum From {
+    /// Step `k` of the same block.
+    Local(u32),
+    /// Outside the block: where the block starts.
+    Start,
+}
+
+/// One step of a block's shape. The first step's turn is 0 (it depends on
+/// the neighbours); steps from the block's start turn from the first step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct Step {
+    kind: Kind,
+    from: From,
+    turn: i32,
+}
+
+/// A successor found as a recurring block shape.
+#[derive(Clone, Debug)]
+struct Shape {
+    kind: Kind,
+    steps: Vec<Step>,
+    /// The step where the next letter's block continues (the successor's end).
+    exit: Option<u32>,
+    /// The letter of each step (shape indices), once a lower level shows them.
+    letters: Option<Vec<u8>>,
+}
+
+/// A letter not known yet (the top level's steps).
+const UNKNOWN: u8 = u8::MAX;
+
+/// A drawing at one derivation step, its steps' letters as shape indices.
+#[derive(Clone, Debug)]
+struct Level {
+    nodes: Vec<Node>,
+    letters: Vec<u8>,
+}
+
+/// A level cut into blocks.
+struct Cut {
+    /// First step of each block.
+    starts: Vec<u32>,
+    /// Shape of each block.
+    shapes: Vec<u8>,
+    /// Block of each step.
+    block_of: Vec<u32>,
+}
+
+/// Block sizes: `b` drawn steps and `c` moves per drawn letter's block,
+/// `s` moves per move's block (0: no moves at all).
+#[derive(Clone, Copy, Debug)]
+struct Sizes {
+    b: usize,
+    c: usize,
+    s: usize,
+}
+
+const MOVE_SHAPE_LIMIT: usize = 1;
+/// Drawing letters (shapes of drawn blocks) at most.
+const MAX_LETTERS: usize = 2;
+
+/// Cuts `nodes` into blocks of `sizes`; new shapes are added to `shapes`
+/// only when `grow`. `None` when the level does not cut.
+fn cut(
+    nodes: &[Node],
+    sizes: Sizes,
+    angles: &Angles,
+    shapes: &mut Vec<Shape>,
+    grow: bool,
+) -> Option<Cut> {
+    let n = nodes.len();
+    let mut starts = Vec::new();
+    let mut kinds = Vec::new();
+    let mut block_of = vec![0u32; n];
+    let mut i = 0usize;
+    let mut steps: Vec<Step> = Vec::new();
+    while i < n {
+        let first = nodes[i];
+        let len = match first.kind {
+            Kind::Draw => sizes.b + sizes.c,
+            Kind::Move => sizes.s,
+        };
+        if len == 0 || i + len > n {
+            return None;
+        }
+        steps.clear();
+        let (mut draws, mut moves) = (0, 0);
+        let block = starts.len() as u32;
+        for (j, nd) in nodes.iter().enumerate().skip(i).take(len) {
+            match nd.kind {
+                Kind::Draw => draws += 1,
+                Kind::Move => moves += 1,
+            }
+            let local = nd.parent != ROOT && nd.parent as usize >= i;
+            let (from, turn) = if j == i {
+                (From::Start, 0)
+            } else if local {
+                (From::Local(nd.parent - i as u32), nd.turn)
+            } else if nd.parent == first.parent {
+                (From::Start, angles.norm(nd.turn - first.turn))
+            } else {
+                return None;
+            };
+            steps.push(Step {
+                kind: nd.kind,
+                from,
+                turn,
+            });
+            block_of[j] = block;
+        }
+        let fits = match first.kind {
+            Kind::Draw => draws == sizes.b && moves == sizes.c,
+            Kind::Move => moves == sizes.s,
+        };
+        if !fits {
+            return None;
+        }
+        let shape = match shapes
+            .iter()
+            .position(|s| s.kind == first.kind && s.steps == steps)
+        {
+            Some(k) => k,
+            None => {
+                if !grow {
+                    return None;
+                }
+                let same_kind = shapes.iter().filter(|s| s.kind == first.kind).count();
+                let limit = match first.kind {
+                    Kind::Draw => MAX_LETTERS,
+                    Kind::Move => MOVE_SHAPE_LIMIT,
+                };
+                if same_kind >= limit {
+                    return None;
+                }
+                if first.kind == Kind::Move
+                    && !steps
+                        .iter()
+                        .enumerate()
+                        .skip(1)
+                        .all(|(j, s)| s.from == From::Local(j as u32 - 1) && s.turn == 0)
+                {
+                    return None;
+                }
+                shapes.push(Shape {
+                    kind: first.kind,
+                    steps: steps.clone(),
+                    exit: None,
+                    letters: None,
+                });
+                shapes.len() - 1
+            }
+        };
+        starts.push(i as u32);
+        kinds.push(shape as u8);
+        i += len;
+    }
+    Some(Cut {
+        starts,
+        shapes: kinds,
+        block_of,
+    })
+}
+
+/// Records where each shape's successor ends (the step the next block
+/// continues from); `false` if two blocks of one shape disagree.
+fn exits(nodes: &[Node], cut: &Cut, shapes: &mut [Shape]) -> bool {
+    for &start in &cut.starts {
+        let first = nodes[start as usize];
+        if first.parent == ROOT {
+            continue;
+        }
+        let pb = cut.block_of[first.parent as usize] as usize;
+        let local = first.parent - cut.starts[pb];
+        let shape = &mut shapes[cut.shapes[pb] as usize];
+        if shape.kind == Kind::Move && local as usize + 1 != shape.steps.len() {
+            return false;
+        }
+        match shape.exit {
+            None => shape.exit = Some(local),
+            Some(e) if e == local => {}
+            Some(_) => return false,
+        }
+    }
+    true
+}
+
+/// Records each shape's letters from a cut level; `false` on disagreement.
+fn letters(level: &Level, cut: &Cut, shapes: &mut [Shape]) -> bool {
+    for (b, &start) in cut.starts.iter().enumerate() {
+        let shape = &mut shapes[cut.shapes[b] as usize];
+        let len = shape.steps.len();
+        let got = &level.letters[start as usize..start as usize + len];
+        if got.contains(&UNKNOWN) {
+            continue;
+        }
+        match &shape.letters {
+            None => shape.letters = Some(got.to_vec()),
+            Some(l) if l[..] == got[..] => {}
+            Some(_) => return false,
+        }
+    }
+    true
+}
+
+/// Leading and trailing turns of each shape's successor.
+#[derive(Clone, Debug)]
+struct Ends {
+    lead: Vec<i32>,
+    tail: Vec<i32>,
+}
+
+/// The level one derivation step earlier: one step per block.
+fn collapse(level: &Level, cut: &Cut, shapes: &[Shape], ends: &Ends, angles: &Angles) -> Level {
+    let mut nodes = Vec::with_capacity(cut.starts.len());
+    let first_shape = cut.shapes.first().copied().unwrap_or(0) as usize;
+    for (b, &start) in cut.starts.iter().enumerate() {
+        let first = level.nodes[start as usize];
+        let shape = cut.shapes[b] as usize;
+        let (parent, turn) = if first.parent == ROOT {
+            let t = if b == 0 {
+                0
+            } else {
+                first.turn - ends.lead[shape] + ends.lead[first_shape]
+            };
+            (ROOT, t)
+        } else {
+            let pb = cut.block_of[first.parent as usize];
+            let ps = cut.shapes[pb as usize] as usize;
+            (pb, first.turn - ends.tail[ps] - ends.lead[shape])
+        };
+        nodes.push(Node {
+            parent,
+            turn: angles.norm(turn),
+            kind: shapes[shape].kind,
+        });
+    }
+    Level {
+        nodes,
+        letters: cut.shapes.clone(),
+    }
+}
+
+/// The turn counts tried for a successor's leading or trailing turns.
+fn turn_range(angles: &Angles) -> Vec<i32> {
+    match angles.period {
+        Some(m) if m <= 12 => (0..m).map(|k| angles.norm(k)).collect(),
+        Some(_) | None => vec![0, 1, -1, 2, -2],
+    }
+}
+
+/// Every way to choose leading and trailing turns: the first drawing
+/// letter's leading turn is 0 unless moves are rewritten (then only sums of
+/// a tail and a lead are seen, and one of them may be fixed).
+fn all_ends(shapes: &[Shape], angles: &Angles) -> Vec<Ends> {
+    let range = turn_range(angles);
+    let moves = shapes.iter().any(|s| s.kind == Kind::Move);
+    // (shape, whether its leading turn): sums of a tail and a lead are all
+    // the drawing shows, so the first letter's lead is 0 unless moves
+    // (whose ends are 0) tell leads and tails apart.
+    let mut free: Vec<(usize, bool)> = Vec::new();
+    for (k, s) in shapes.iter().enumerate() {
+        if s.kind != Kind::Draw {
+            continue;
+        }
+        if moves || k != 0 {
+            free.push((k, true));
+        }
+        free.push((k, false));
+    }
+    let mut out = Vec::new();
+    let total = range.len().pow(free.len() as u32);
+    for mut code in 0..total {
+        let mut e = Ends {
+            lead: vec![0; shapes.len()],
+            tail: vec![0; shapes.len()],
+        };
+        for &(k, lead) in &free {
+            let v = range[code % range.len()];
+            code /= range.len();
+            if lead {
+                e.lead[k] = v;
+            } else {
+                e.tail[k] = v;
+            }
+        }
+        out.push(e);
+    }
+    out
+}
+
+/// A successor from a shape: its steps as a bracketed string that ends at
+/// the exit, then the trailing turns.
+fn successor(
+    shape: &Shape,
+    lead: i32,
+    tail: i32,
+    sym: &dyn Fn(u8, Kind) -> Sym,
+    angles: &Angles,
+) -> Option<Vec<Sym>> {
+    let n = shape.steps.len();
+    let letters = shape.letters.clone().unwrap_or_else(|| vec![UNKNOWN; n]);
+    let mut kids: Vec<Vec<u32>> = vec![Vec::new(); n + 1];
+    let start = n as u32;
+    for (j, s) in shape.steps.iter().enumerate() {
+        match s.from {
+            From::Start => kids[n].push(j as u32),
+            From::Local(p) => kids[p as usize].push(j as u32),
+        }
+    }
+    let exit = shape.exit.unwrap_or_else(|| {
+        // The end of the chain of last children.
+        let mut at = start;
+        while let Some(&c) = kids[at as usize].last() {
+            at = c;
+        }
+        at
+    });
+    if exit >= start {
+        return None;
+    }
+    // The main path: from the start to the exit.
+    let mut main = vec![false; n + 1];
+    main[n] = true;
+    let mut at = exit;
+    loop {
+        main[at as usize] = true;
+        match shape.steps[at as usize].from {
+            From::Start => break,
+            From::Local(p) => at = p,
+        }
+    }
+    let turn = |j: u32| {
+        let s = shape.steps[j as usize];
+        if j == 0 {
+            lead
+        } else if s.from == From::Start {
+            s.turn + lead
+        } else {
+            s.turn
+        }
+    };
+    let mut out = write_tree(
+        &kids,
+        Some(&main),
+        &turn,
+        &|j| sym(letters[j as usize], shape.steps[j as usize].kind),
+        angles,
+    )?;
+    out.extend(turn_syms(tail, angles));
+    Some(out)
+}
+
+/// Writes a tree of steps as a bracketed string: `kids[n]` are the children
+/// of the start; a child is bracketed unless it is the last (or, given
+/// `main`, unless it is on the main path, which must then be the last).
+/// Iterative: trees may be deep.
+fn write_tree(
+    kids: &[Vec<u32>],
+    main: Option<&[bool]>,
+    turn: &dyn Fn(u32) -> i32,
+    sym: &dyn Fn(u32) -> Sym,
+    angles: &Angles,
+) -> Option<Vec<Sym>> {
+    let root = kids.len() - 1;
+    let mut out = Vec::new();
+    // (node, next child, opened with a bracket)
+    let mut stack: Vec<(usize, usize, bool)> = vec![(root, 0, false)];
+    while let Some(top) = stack.last_mut() {
+        let (node, next) = (top.0, top.1);
+        if next < kids[node].len() {
+            top.1 += 1;
+            let c = kids[node][next] as usize;
+            let last = next + 1 == kids[node].len();
+            let bracket = match main {
+                Some(m) if m[node] => {
+                    if m[c] && !last {
+                        return None;
+                    }
+                    !m[c]
+                }
+                _ => !last,
+            };
+            if bracket {
+                out.push(Sym::Push);
+            }
+            out.extend(turn_syms(turn(c as u32), angles));
+            out.push(sym(c as u32));
+            stack.push((c, 0, bracket));
+        } else {
+            let (_, _, bracket) = stack.pop()?;
+            if bracket {
+                out.push(Sym::Pop);
+            }
+        }
+    }
+    Some(out)
+}
+
+fn edge_rewriting(
+    tree: &Tree,
+    angles: &Angles,
+    limits: &Limits,
+    sink: &mut Sink<'_>,
+    out: &mut Proposals,
+) {
+    let nodes = &tree.nodes;
+    let draws = nodes.iter().filter(|n| n.kind == Kind::Draw).count();
+    let moves = nodes.len() - draws;
+    let top = Level {
+        nodes: nodes.clone(),
+        letters: vec![UNKNOWN; nodes.len()],
+    };
+    for b in 2..=limits.max_block.min(draws) {
+        if draws % b != 0 {
+            continue;
+        }
+        let size_options: Vec<Sizes> = if moves == 0 {
+            vec![Sizes { b, c: 0, s: 0 }]
+        } else {
+            let mut v = Vec::new();
+            let up = draws / b;
+            for c in 0..=b.min(limits.max_moves * 4) {
+                let rest = moves as i64 - (c * up) as i64;
+                if rest < 0 {
+                    break;
+                }
+                for s in 1..=limits.max_moves {
+                    if (rest as usize).is_multiple_of(s) {
+                        v.push(Sizes { b, c, s });
+                    }
+                }
+            }
+            v
+        };
+        for sizes in size_options {
+            if limits.late() {
+                out.timed_out = true;
+                return;
+            }
+            let mut shapes = Vec::new();
+            let Some(c0) = cut(&top.nodes, sizes, angles, &mut shapes, true) else {
+                continue;
+            };
+            if !exits(&top.nodes, &c0, &mut shapes) {
+                continue;
+            }
+            for ends in all_ends(&shapes, angles) {
+                if limits.late() {
+                    out.timed_out = true;
+                    return;
+                }
+                let mut sh = shapes.clone();
+                let mut level = collapse(&top, &c0, &sh, &ends, angles);
+                let mut depth = 1u32;
+                loop {
+                    let mut trial = sh.clone();
+                    let Some(c) = cut(&level.nodes, sizes, angles, &mut trial, false) else {
+                        break;
+                    };
+                    if !exits(&level.nodes, &c, &mut trial) || !letters(&level, &c, &mut trial) {
+                        break;
+                    }
+                    sh = trial;
+                    level = collapse(&level, &c, &sh, &ends, angles);
+                    depth += 1;
+                }
+                if level.nodes.len() > limits.max_axiom {
+                    continue;
+                }
+                for g in edge_grammars(&level, &sh, &ends, depth, angles) {
+                    sink(g, out);
+                }
+            }
+        }
+    }
+}
+
+/// Letter names of drawing shapes: `F` alone, `L` and `R` for two.
+fn draw_names(count: usize) -> Vec<char> {
+    if count <= 1 {
+        vec!['F']
+    } else {
+        vec!['L', 'R']
+    }
+}
+
+/// Grammars from a collapsed edge-rewriting hierarchy; a shape whose
+/// letters no lower level showed gets each plausible guess.
+fn edge_grammars(
+    axiom: &Level,
+    shapes: &[Shape],
+    ends: &Ends,
+    depth: u32,
+    angles: &Angles,
+) -> Vec<Grammar> {
+    let draw: Vec<usize> = (0..shapes.len())
+        .filter(|&k| shapes[k].kind == Kind::Draw)
+        .collect();
+    let mv: Option<usize> = (0..shapes.len()).find(|&k| shapes[k].kind == Kind::Move);
+    let names = draw_names(draw.len());
+    // Shape index to letter index: drawing shapes first, then `f`.
+    let mut index = vec![0u8; shapes.len()];
+    for (i, &k) in draw.iter().enumerate() {
+        index[k] = i as u8;
+    }
+    let f_index = draw.len() as u8;
+    if let Some(k) = mv {
+        index[k] = f_index;
+    }
+    let has_moves = mv.is_some()
+        || shapes
+            .iter()
+            .any(|s| s.steps.iter().any(|t| t.kind == Kind::Move))
+        || axiom.nodes.iter().any(|n| n.kind == Kind::Move);
+    // Letter guesses for shapes whose letters are unknown.
+    let known: Vec<Option<Vec<u8>>> = shapes.iter().map(|s| s.letters.clone()).collect();
+    let mut variants: Vec<Vec<Option<Vec<u8>>>> = vec![known.clone()];
+    if draw.len() == 2 && draw.iter().any(|&k| known[k].is_none()) {
+        let other = |k: usize| draw.iter().copied().find(|&j| j != k).unwrap_or(k);
+        let mut same = known.clone();
+        let mut swapped = known.clone();
+        for &k in &draw {
+            if known[k].is_none()
+                && let Some(l) = &known[other(k)]
+            {
+                same[k] = Some(l.clone());
+                swapped[k] = Some(
+                    l.iter()
+                        .map(|&x| {
+                            if x == k as u8 {
+                                other(k) as u8
+                            } else if x == other(k) as u8 {
+                                k as u8
+                            } else {
+                                x
+                            }
+                        })
+                        .collect(),
+                );
+            }
+        }
+        variants = vec![same, swapped];
+    }
+    let mut out = Vec::new();
+    'variant: for letters in variants {
+        let sym = |shape: u8, kind: Kind| -> Sym {
+            match kind {
+                Kind::Move => Sym::Letter(f_index),
+                Kind::Draw => {
+                    if shape == UNKNOWN || shape as usize >= index.len() {
+                        Sym::Letter(0)
+                    } else {
+                        Sym::Letter(index[shape as usize])
+                    }
+                }
+            }
+        };
+        let mut grammar_letters = Vec::new();
+        for (i, &k) in draw.iter().enumerate() {
+            let mut sh = shapes[k].clone();
+            sh.letters = letters[k].clone();
+            if sh.letters.is_none() && draw.len() > 1 {
+                continue 'variant;
+            }
+            let Some(rule) = successor(&sh, ends.lead[k], ends.tail[k], &sym, angles) else {
+                continue 'variant;
+            };
+            grammar_letters.push(Letter {
+                name: names[i],
+                action: Action::Draw,
+                rule: Some(rule),
+            });
+        }
+        if has_moves {
+            let rule = mv.map(|k| shapes[k].steps.len()).filter(|&s| s > 1);
+            grammar_letters.push(Letter {
+                name: 'f',
+                action: Action::Move,
+                rule: rule.map(|s| vec![Sym::Letter(f_index); s]),
+            });
+        }
+        // The axiom: the last level, drawn from the start.
+        let n = axiom.nodes.len();
+        let mut kids: Vec<Vec<u32>> = vec![Vec::new(); n + 1];
+        for (j, nd) in axiom.nodes.iter().enumerate() {
+            if nd.parent == ROOT {
+                kids[n].push(j as u32);
+            } else {
+                kids[nd.parent as usize].push(j as u32);
+            }
+        }
+        let turn = |j: u32| axiom.nodes[j as usize].turn;
+        let letter = |j: u32| sym(axiom.letters[j as usize], axiom.nodes[j as usize].kind);
+        let Some(ax) = write_tree(&kids, None, &turn, &letter, angles) else {
+            continue;
+        };
+        out.push(Grammar {
+            letters: grammar_letters,
+            axiom: ax,
+            depth,
+        });
+    }
+    out
+}
+
+// ------------------------------------------------------------ node rewriting
+
+/// The shape of a drawn copy of X one step down: its steps' sources and turns.
+fn shape_of(nodes: &[Node], start: usize, len: usize, angles: &Angles) -> Option<Vec<Step>> {
+    let first = nodes.get(start)?;
+    let mut out = Vec::with_capacity(len);
+    for j in start..start + len {
+        let nd = nodes.get(j)?;
+        let local = nd.parent != ROOT && nd.parent as usize >= start;
+        let (from, turn) = if j == start {
+            (From::Start, 0)
+        } else if local {
+            (From::Local(nd.parent - start as u32), nd.turn)
+        } else if nd.parent == first.parent {
+            (From::Start, angles.norm(nd.turn - first.turn))
+        } else {
+            return None;
+        };
+        out.push(Step {
+            kind: nd.kind,
+            from,
+            turn,
+        });
+    }
+    Some(out)
+}
+
+/// Whether `nodes[start..start + shape.len()]` has `shape` (as `shape_of`
+/// would find it), without building it.
+fn has_shape(nodes: &[Node], start: usize, shape: &[Step], angles: &Angles) -> bool {
+    let Some(first) = nodes.get(start) else {
+        return false;
+    };
+    for (j, want) in shape.iter().enumerate() {
+        let Some(nd) = nodes.get(start + j) else {
+            return false;
+        };
+        let local = nd.parent != ROOT && nd.parent as usize >= start;
+        let (from, turn) = if j == 0 {
+            (From::Start, 0)
+        } else if local {
+            (From::Local(nd.parent - start as u32), nd.turn)
+        } else if nd.parent == first.parent {
+            (From::Start, angles.norm(nd.turn - first.turn))
+        } else {
+            return false;
+        };
+        if nd.kind != want.kind || from != want.from || turn != want.turn {
+            return false;
+        }
+    }
+    true
+}
+
+/// Whether `nodes[start..start + k]` is a straight run from outside.
+fn straight(nodes: &[Node], start: usize, k: usize) -> bool {
+    (start + 1..start + k).all(|j| {
+        nodes
+            .get(j)
+            .is_some_and(|n| n.parent as usize == j - 1 && n.turn == 0)
+    }) && nodes
+        .get(start)
+        .is_some_and(|n| n.parent == ROOT || (n.parent as usize) < start)
+}
+
+/// A block of the drawing two steps down: F (a run of k steps) or X (a copy
+/// of the drawing one step down).
+#[derive(Clone, Copy, Debug)]
+struct Piece {
+    x: bool,
+    start: usize,
+}
+
+struct NodeHypothesis {
+    k: usize,
+    alpha: usize,
+    beta: usize,
+    depth: u32,
+}
+
+fn node_rewriting(
+    tree: &Tree,
+    angles: &Angles,
+    limits: &Limits,
+    sink: &mut Sink<'_>,
+    out: &mut Proposals,
+) {
+    let nodes = &tree.nodes;
+    if nodes.iter().any(|n| n.kind != Kind::Draw) {
+        return;
+    }
+    let total = nodes.len() as u128;
+    let mut hyps = Vec::new();
+    for k in 1..=3usize {
+        for alpha in 1..=limits.max_x {
+            for beta in 1..=limits.max_f {
+                let (mut f, mut x) = (0u128, 1u128);
+                for depth in 1..=64u32 {
+                    f = k as u128 * f + beta as u128 * x;
+                    x *= alpha as u128;
+                    if f > total {
+                        break;
+                    }
+                    if f == total && depth >= 2 {
+                        hyps.push(NodeHypothesis {
+                            k,
+                            alpha,
+                            beta,
+                            depth,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    for h in hyps {
+        if limits.late() {
+            out.timed_out = true;
+            return;
+        }
+        // f(1), f(2): drawn steps of X one and two steps down.
+        let f1 = h.beta;
+        let f2 = h.k * h.beta + h.beta * h.alpha;
+        for p in 0..=h.beta {
+            if limits.late() {
+                out.timed_out = true;
+                return;
+            }
+            // Offsets of the nested copies: D(n-1) starts after p runs of k^(n-1).
+            let mut off = 0usize;
+            let mut ok = true;
+            for j in (3..=h.depth).rev() {
+                let run = (h.k as u128).pow(j - 1) * p as u128;
+                if run > nodes.len() as u128 {
+                    ok = false;
+                    break;
+                }
+                off += run as usize;
+            }
+            let s2 = off;
+            let s1 = s2 + p * h.k;
+            if !ok || s2 + f2 > nodes.len() || s1 + f1 > s2 + f2 {
+                continue;
+            }
+            let Some(d1) = shape_of(nodes, s1, f1, angles) else {
+                continue;
+            };
+            for pieces in parse_two_down(nodes, s2, f2, &h, p, &d1, angles) {
+                if let Some(g) = node_grammar(nodes, s2, f2, &h, &pieces, angles) {
+                    sink(g, out);
+                }
+            }
+        }
+    }
+}
+
+/// The ways (at most a few) to cut the drawing two steps down into F runs
+/// and X copies, the first `p` pieces runs and the next a copy.
+fn parse_two_down(
+    nodes: &[Node],
+    s2: usize,
+    f2: usize,
+    h: &NodeHypothesis,
+    p: usize,
+    d1: &[Step],
+    angles: &Angles,
+) -> Vec<Vec<Piece>> {
+    const MAX_PARSES: usize = 16;
+    let end = s2 + f2;
+    let mut found = Vec::new();
+    // Depth-first over choices, with an explicit stack of (pieces so far, next choice).
+    let mut stack: Vec<(Vec<Piece>, usize, usize, u8)> = vec![(Vec::new(), s2, 0, 0)];
+    let mut work = 0usize;
+    while let Some((pieces, at, fs, choice)) = stack.pop() {
+        work += 1;
+        if work > 10_000 || found.len() >= MAX_PARSES {
+            break;
+        }
+        if at == end {
+            if fs == h.beta && pieces.len() == h.beta + h.alpha {
+                found.push(pieces);
+            }
+            continue;
+        }
+        let xs = pieces.len() - fs;
+        // Choice 0: a run of F; choice 1: a copy of X.
+        if choice == 0 {
+            stack.push((pieces.clone(), at, fs, 1));
+            let must_x = pieces.len() == p;
+            if fs < h.beta && !must_x && at + h.k <= end && straight(nodes, at, h.k) {
+                let mut next = pieces;
+                next.push(Piece {
+                    x: false,
+                    start: at,
+                });
+                stack.push((next, at + h.k, fs + 1, 0));
+            }
+        } else {
+            let must_f = pieces.len() < p;
+            if xs < h.alpha && !must_f && at + h.beta <= end && has_shape(nodes, at, d1, angles) {
+                let mut next = pieces;
+                next.push(Piece { x: true, start: at });
+                stack.push((next, at + h.beta, fs, 0));
+            }
+        }
+    }
+    found
+}
+
+/// The node-rewriting grammar of a parse of the drawing two steps down.
+fn node_grammar(
+    nodes: &[Node],
+    s2: usize,
+    f2: usize,
+    h: &NodeHypothesis,
+    pieces: &[Piece],
+    angles: &Angles,
+) -> Option<Grammar> {
+    let n = pieces.len();
+    let len = |p: &Piece| if p.x { h.beta } else { h.k };
+    // Which piece each step is in.
+    let piece_of = |j: usize| {
+        pieces
+            .iter()
+            .rposition(|p| p.start <= j && j < p.start + len(p))
+    };
+    let mut kids: Vec<Vec<u32>> = vec![Vec::new(); n + 1];
+    let mut turns = vec![0i32; n];
+    let first = nodes[s2];
+    for (i, p) in pieces.iter().enumerate() {
+        let nd = nodes[p.start];
+        let outside =
+            nd.parent == ROOT || (nd.parent as usize) < s2 || nd.parent as usize >= s2 + f2;
+        if outside {
+            if nd.parent != first.parent {
+                return None;
+            }
+            kids[n].push(i as u32);
+            turns[i] = if i == 0 {
+                0
+            } else {
+                angles.norm(nd.turn - first.turn)
+            };
+        } else {
+            let q = piece_of(nd.parent as usize)?;
+            let qp = &pieces[q];
+            // Only the end of a run of F continues; copies of X end branches.
+            if qp.x || nd.parent as usize != qp.start + len(qp) - 1 {
+                return None;
+            }
+            kids[q].push(i as u32);
+            turns[i] = nd.turn;
+        }
+    }
+    let (f, x) = (0u8, 1u8);
+    let turn = |j: u32| turns[j as usize];
+    let sym = |j: u32| Sym::Letter(if pieces[j as usize].x { x } else { f });
+    let succ = write_tree(&kids, None, &turn, &sym, angles)?;
+    Some(Grammar {
+        letters: vec![
+            Letter {
+                name: 'F',
+                action: Action::Draw,
+                rule: (h.k > 1).then(|| vec![Sym::Letter(f); h.k]),
+            },
+            Letter {
+                name: 'X',
+                action: Action::Nothing,
+                rule: Some(succ),
+            },
+        ],
+        axiom: vec![Sym::Letter(x)],
+        depth: h.depth,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::infer::lines::grammar::{Outcome, matches};
+    use crate::infer::lines::turtle::Builder;
+    use glam::DVec2;
+
+    /// Draws a grammar with the builder, as a drawing would be read.
+    fn draw(g: &Grammar, angles: &Angles) -> Tree {
+        let mut frames: Vec<(&[Sym], usize, u32)> = vec![(&g.axiom[..], 0, g.depth)];
+        let (mut h, mut pos) = (0i32, DVec2::ZERO);
+        let mut saved = Vec::new();
+        let mut b = Builder::new();
+        while let Some(top) = frames.last_mut() {
+            let (syms, i, d) = (top.0, top.1, top.2);
+            if i >= syms.len() {
+                frames.pop();
+                continue;
+            }
+            top.1 += 1;
+            match syms[i] {
+                Sym::Plus => h += 1,
+                Sym::Minus => h -= 1,
+                Sym::Push => saved.push((h, pos)),
+                Sym::Pop => (h, pos) = saved.pop().expect("balanced"),
+                Sym::Letter(k) => {
+                    let l = &g.letters[k as usize];
+                    if d > 0
+                        && let Some(rule) = &l.rule
+                    {
+                        frames.push((rule, 0, d - 1));
+                        continue;
+                    }
+                    let a = (90.0 + angles.delta * f64::from(h)).to_radians();
+                    let next = pos + DVec2::new(a.cos(), a.sin());
+                    match l.action {
+                        Action::Draw => b.push(pos, next).expect("fits"),
+                        Action::Move => {}
+                        Action::Nothing => continue,
+                    }
+                    pos = next;
+                }
+            }
+        }
+        b.tree(angles).expect("turns")
+    }
+
+    fn parse(text: &str, letters: &[(char, Action)]) -> Vec<Sym> {
+        text.chars()
+            .map(|c| match c {
+                '+' => Sym::Plus,
+                '-' => Sym::Minus,
+                '[' => Sym::Push,
+                ']' => Sym::Pop,
+                c => Sym::Letter(letters.iter().position(|l| l.0 == c).expect("letter") as u8),
+            })
+            .collect()
+    }
+
+    fn grammar(axiom: &str, rules: &[(char, Action, &str)], depth: u32) -> Grammar {
+        let ls: Vec<(char, Action)> = rules.iter().map(|r| (r.0, r.1)).collect();
+        Grammar {
+            letters: rules
+                .iter()
+                .map(|r| Letter {
+                    name: r.0,
+                    action: r.1,
+                    rule: (!r.2.is_empty()).then(|| parse(r.2, &ls)),
+                })
+                .collect(),
+            axiom: parse(axiom, &ls),
+            depth,
+        }
+    }
+
+    fn finds(g: &Grammar, angles: &Angles) -> Grammar {
+        let tree = draw(g, angles);
+        let p = propose(&tree, angles, &Limits::default());
+        p.grammars
+            .into_iter()
+            .find(|c| matches(c, &tree, angles, 10_000_000, None) == Outcome::Same)
+            .unwrap_or_else(|| panic!("nothing draws {}", g.describe()))
+    }
+
+    #[test]
+    fn koch_island() {
+        let a = Angles::new(90.0, Some(4), 1.0);
+        let g = grammar("F-F-F-F", &[('F', Action::Draw, "F-F+F+FF-F-F+F")], 2);
+        assert_eq!(finds(&g, &a).describe(), g.describe());
+    }
+
+    #[test]
+    fn dragon_and_arrowhead() {
+        let a = Angles::new(90.0, Some(4), 1.0);
+        let g = grammar(
+            "L",
+            &[('L', Action::Draw, "L+R+"), ('R', Action::Draw, "-L-R")],
+            6,
+        );
+        // The smaller L -> L+R, R -> L-R draws the same dragon.
+        assert_eq!(
+            finds(&g, &a).describe(),
+            "axiom L; L -> L+R; R -> L-R; derive 6"
+        );
+        let a = Angles::new(60.0, Some(6), 1.0);
+        let g = grammar(
+            "R",
+            &[('L', Action::Draw, "R+L+R"), ('R', Action::Draw, "L-R-L")],
+            4,
+        );
+        let found = finds(&g, &a);
+        assert_eq!(found.rule_size(), g.rule_size(), "{}", found.describe());
+    }
+
+    #[test]
+    fn bracketed_plants() {
+        let a = Angles::new(25.7, None, 1.0);
+        let g = grammar("F", &[('F', Action::Draw, "F[+F]F[-F]F")], 3);
+        assert_eq!(finds(&g, &a).describe(), g.describe());
+        let a = Angles::new(22.5, Some(16), 1.0);
+        let g = grammar("F", &[('F', Action::Draw, "FF-[-F+F+F]+[+F-F-F]")], 3);
+        assert!(finds(&g, &a).rule_size() <= g.rule_size());
+        let a = Angles::new(20.0, Some(18), 1.0);
+        let g = grammar(
+            "X",
+            &[
+                ('X', Action::Nothing, "F[+X]F[-X]+X"),
+                ('F', Action::Draw, "FF"),
+            ],
+            4,
+        );
+        let found = finds(&g, &a);
+        assert!(found.rule_size() <= g.rule_size(), "{}", found.describe());
+    }
+}
