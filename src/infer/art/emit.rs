@@ -115,7 +115,13 @@ fn inlined(g: &Grammar) -> Vec<bool> {
     };
     for rule in &g.rules {
         match &rule.body {
-            Body::Seq { a, .. } | Body::Branch { a, .. } => count(a),
+            Body::Seq { a, tip, .. } => {
+                count(a);
+                if let Some(b) = tip {
+                    count(b);
+                }
+            }
+            Body::Branch { a, .. } => count(a),
             Body::Pair { a, b, .. } => {
                 count(a);
                 count(b);
@@ -176,8 +182,16 @@ fn steps(
     match s {
         Sym::Element(_) => (BTreeMap::new(), 0),
         Sym::Rule(r, m) => match &g.rules[r].body {
-            Body::Seq { a, .. } | Body::Branch { a, .. } => {
-                let (mut names, n) = steps(g, *a, named, inline);
+            Body::Seq { a, tip, .. } | Body::Branch { a, tip, .. } => {
+                let (mut names, mut n) = steps(g, *a, named, inline);
+                if let Some(b) = tip {
+                    let (y, k) = steps(g, *b, named, inline);
+                    for (name, c) in y {
+                        let e = names.entry(name).or_default();
+                        *e = (*e).max(c);
+                    }
+                    n = n.max(k);
+                }
                 if !counted(g, r) {
                     return (names, n + 1);
                 }
@@ -462,20 +476,26 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
         };
         match &rule.body {
             Body::Seq {
-                a, t, delta, place, ..
+                a,
+                t,
+                delta,
+                place,
+                tip,
             } if counted_r => {
                 w.sequence(
                     &mut consts,
                     run(g, r),
-                    *a,
+                    (*a, tip.unwrap_or(*a)),
                     t,
                     delta.as_ref(),
                     place.as_ref(),
                 );
             }
-            Body::Branch { a, t, u } => w.branching(&mut consts, run(g, r), *a, t, u),
+            Body::Branch { a, t, u, tip } => {
+                w.branching(&mut consts, run(g, r), (*a, tip.unwrap_or(*a)), t, u)
+            }
             // A sequence used only with m = 1 is the pair P -> A T A.
-            Body::Seq { a, t, .. } => w.pair(*a, t, *a),
+            Body::Seq { a, t, tip, .. } => w.pair(*a, t, tip.unwrap_or(*a)),
             Body::Pair { a, t, b } => w.pair(*a, t, *b),
         }
     }
@@ -779,14 +799,14 @@ impl RuleWriter<'_> {
         out
     }
 
-    /// `P(m) : m > 0 -> [a] T P(m - 1); P(m) : m == 0 -> [a]`; for a linear
-    /// sequence (`delta`) each number of T that changes is `X + DX * m`, the
-    /// paper's t(m) = t0 + tΔ·m, with named constants for t0 and tΔ.
+    /// `P(m) : m > 0 -> [a] T P(m - 1); P(m) : m == 0 -> [tip]`; for a
+    /// linear sequence (`delta`) each number of T that changes is `X + DX *
+    /// m`, the paper's t(m) = t0 + tΔ·m, with named constants for t0 and tΔ.
     fn sequence(
         &mut self,
         consts: &mut Consts,
         n: f64,
-        a: Sym,
+        (a, tip): (Sym, Sym),
         t: &Tr,
         delta: Option<&Tr>,
         place: Option<&Tr>,
@@ -869,9 +889,13 @@ impl RuleWriter<'_> {
                 hows.push(how);
             }
         }
+        let what = if tip == a {
+            format!("m + 1 {}", self.describe(a))
+        } else {
+            format!("m {} ending in {}", self.describe(a), self.describe(tip))
+        };
         let note = format!(
-            "{name}(m): a sequence of m + 1 {}{}",
-            self.describe(a),
+            "{name}(m): a sequence of {what}{}",
             if hows.is_empty() {
                 String::new()
             } else {
@@ -880,14 +904,14 @@ impl RuleWriter<'_> {
         );
         self.add(m_is(BinOp::Gt), succ, Some(note));
         let last = match place {
-            Some(_) => self.placed_at(a, place),
-            None => self.unit(a, n, false).0,
+            Some(_) if tip == a => self.placed_at(a, place),
+            _ => self.unit(tip, n, false).0,
         };
         self.add(m_is(BinOp::Eq), last, None);
     }
 
     /// `R(m) : m > 0 -> [a] [T R(m - 1)] [U R(m - 1)]; R(m) : m == 0 -> [a]`.
-    fn branching(&mut self, consts: &mut Consts, n: f64, a: Sym, t: &Tr, u: &Tr) {
+    fn branching(&mut self, consts: &mut Consts, n: f64, (a, tip): (Sym, Sym), t: &Tr, u: &Tr) {
         let (ta, td, ts, tb) = self.parts(consts, t, "1", n);
         let (ua, ud, us, ub) = self.parts(consts, u, "2", n);
         let mut succ = self.unit_in_place(a, n);
@@ -903,7 +927,7 @@ impl RuleWriter<'_> {
             self.describe(a)
         );
         self.add(m_is(BinOp::Gt), succ, Some(note));
-        let (last, _) = self.unit(a, n, false);
+        let (last, _) = self.unit(tip, n, false);
         self.add(m_is(BinOp::Eq), last, None);
     }
 

@@ -188,7 +188,11 @@ pub fn from_svg(
         .elements
         .iter()
         .zip(&inst.of)
-        .map(|(e, (k, f))| Inst::new(Sym::Element(*k), *f, e.min, e.max))
+        .zip(&inst.shapes)
+        .map(|((e, (k, f)), sh)| {
+            Inst::new(Sym::Element(*k), *f, e.min, e.max)
+                .symmetric(inst.kinds[*k].symmetry, sh.centroid)
+        })
         .collect();
     let grammar = rules::infer(insts, opts.weights, tol, progress).map_err(too_much)?;
     stats.rules = grammar.rules.len();

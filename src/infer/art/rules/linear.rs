@@ -24,7 +24,7 @@
 //! a fit does not draw back within the tolerance is dropped. Must not choose
 //! among candidates of other kinds.
 
-use super::fit::{Fit, Member, nice, nice_angle, solve_linear};
+use super::fit::{Fit, Member, Solution, nice, nice_angle, solve_linear};
 use super::regular::Regular;
 use super::{
     Budget, Candidate, Edge, Index, Inst, LINEAR_STEP_MAX, Plan, Tolerance, TooMuchWork, close,
@@ -119,8 +119,20 @@ pub(super) fn linear(
     budget: &mut Budget,
 ) -> Result<Option<Candidate>, TooMuchWork> {
     let mut best: Option<Candidate> = None;
-    for vary in [Vary::Turn, Vary::Grow] {
-        for cand in search(insts, edges, index, ks, tol, budget, vary)? {
+    // Turning chains are looked for twice: among edges of one scale, whatever
+    // the frames' origin, and among edges of one step and scale, the frames'
+    // origins taken as the turtle's (given frames, or a chain whose edges of
+    // one scale happen to change alike out of order).
+    let searches = [
+        (Vary::Turn, ks.len() <= TURN_ANY_ORIGIN),
+        (Vary::Turn, false),
+        (Vary::Grow, false),
+    ];
+    for (i, &(vary, any_origin)) in searches.iter().enumerate() {
+        if i == 1 && !searches[0].1 {
+            continue;
+        }
+        for cand in search(insts, edges, index, ks, tol, budget, vary, any_origin)? {
             if best.as_ref().is_none_or(|b| better(&cand, b)) {
                 best = Some(cand);
             }
@@ -189,8 +201,8 @@ fn search(
     tol: Tolerance,
     budget: &mut Budget,
     vary: Vary,
+    any_origin: bool,
 ) -> Result<Vec<Candidate>, TooMuchWork> {
-    let any_origin = vary == Vary::Turn && ks.len() <= TURN_ANY_ORIGIN;
     // Changes are told apart at twice the exact tolerance at most: a
     // relaxed tolerance would take most steps of a gradual change for none.
     let det = Tolerance {
@@ -225,7 +237,7 @@ fn search(
         tops.sort_by(|&x, &y| sizes[y].cmp(&sizes[x]).then(x.cmp(&y)));
         tops.truncate(TRIES);
         for top in tops {
-            let chains = linear_chains(edges, &links, &changes, &cl, (top, &cc[top]));
+            let chains = linear_chains(insts, edges, &links, &changes, &cl, (top, &cc[top]));
             budget.spend(chains.iter().map(Vec::len).sum())?;
             if let Some(cand) = rule(insts, edges, index, chains, tol, vary) {
                 out.push(cand);
@@ -283,6 +295,7 @@ fn step_links(
 /// node-disjoint, longest first. Links nearest the centre link first: a
 /// chain's own links agree, links that skip an instance only roughly.
 fn linear_chains(
+    insts: &[Inst],
     edges: &[Edge],
     links: &[(usize, usize)],
     changes: &[Point],
@@ -290,8 +303,23 @@ fn linear_chains(
     top: (usize, &Point),
 ) -> Vec<Vec<usize>> {
     let off = |i: usize| -> f64 { (0..4).map(|c| (changes[i][c] - top.1[c]).powi(2)).sum() };
+    // A chain read backwards changes alike: among the links that agree within
+    // the tolerance, those that follow the drawing's order link first.
+    let backward = |i: usize| {
+        let (k, f) = links[i];
+        [k, f]
+            .iter()
+            .filter(|&&e| insts[edges[e].from].order > insts[edges[e].to].order)
+            .count()
+    };
     let mut order: Vec<usize> = (0..links.len()).filter(|&i| labels[i] == top.0).collect();
-    order.sort_by(|&x, &y| off(x).total_cmp(&off(y)).then(x.cmp(&y)));
+    order.sort_by(|&x, &y| {
+        (off(x) > 1.0)
+            .cmp(&(off(y) > 1.0))
+            .then(backward(x).cmp(&backward(y)))
+            .then(off(x).total_cmp(&off(y)))
+            .then(x.cmp(&y))
+    });
     let mut next: BTreeMap<usize, usize> = BTreeMap::new();
     let mut has_prev: HashSet<usize> = HashSet::new();
     for i in order {
@@ -442,14 +470,14 @@ fn free(vary: Vary, pivot: bool) -> Vec<usize> {
 }
 
 /// The members of chains for a fit (their rotations weigh at their radius).
-fn members(insts: &[Inst], chains: &[Vec<usize>]) -> Vec<Member> {
+fn members(insts: &[Inst], chains: &[Vec<usize>], turned: &Turned) -> Vec<Member> {
     chains
         .iter()
         .enumerate()
         .flat_map(|(g, c)| c.iter().map(move |&i| (g, i)))
         .map(|(g, i)| Member {
             group: g,
-            frame: insts[i].frame,
+            frame: frame_of(insts, i, turned),
             lever: insts[i].size() / 2.5,
             rot_se: insts[i].rot_se,
             pos_se: insts[i].pos_se,
@@ -465,6 +493,7 @@ fn draws_back(
     p: &[f64],
     drawn: &[Frame],
     tol: Tolerance,
+    turned: &Turned,
 ) -> bool {
     let mut k = 0;
     for c in chains {
@@ -476,7 +505,7 @@ fn draws_back(
             // The step that led here (the first: the one that leaves it).
             let m = (n - 1 - q.saturating_sub(1)) as f64;
             let step = at(p, m).d.abs() * d.scale;
-            if !close(d, &insts[i].frame, step, insts[i].size(), tol) {
+            if !close(d, &frame_of(insts, i, turned), step, insts[i].size(), tol) {
                 return false;
             }
             k += 1;
@@ -522,7 +551,7 @@ fn rule(
     let size = first.iter().map(|&i| insts[i].size()).sum::<f64>() / first.len() as f64;
     let lens = [first.len()];
     let model1 = |p: &[f64], out: &mut Vec<Frame>| model(p, &lens, out);
-    let ms = members(insts, std::slice::from_ref(first));
+    let ms = members(insts, std::slice::from_ref(first), &Turned::new());
     // The frames' own origin first (the kind's origin may be the base
     // already), then the point the chain says the turtle turned about.
     let attempt = |q: DVec2, moves: bool| {
@@ -537,7 +566,14 @@ fn rule(
         }
         fit.solve(&mut p, &free);
         let (sol, _) = fit.result(&p, &free);
-        if !draws_back(insts, std::slice::from_ref(first), &p, &sol.drawn, tol) {
+        if !draws_back(
+            insts,
+            std::slice::from_ref(first),
+            &p,
+            &sol.drawn,
+            tol,
+            &Turned::new(),
+        ) {
             return None;
         }
         let off: f64 = ms
@@ -548,7 +584,7 @@ fn rule(
         Some((p, free, (off / ms.len() as f64).sqrt() / size))
     };
     let own = attempt(DVec2::ZERO, false);
-    let (mut p, mut free, _) = match own {
+    let (p, free, _) = match own {
         // Within a hundredth of the elements' size: the origin is the base.
         Some(a) if a.2 < 0.01 || vary == Vary::Grow => a,
         _ => {
@@ -570,28 +606,36 @@ fn rule(
     for c in chains.iter().skip(1) {
         let lens = [c.len()];
         let model_c = |p: &[f64], out: &mut Vec<Frame>| model(p, &lens, out);
-        let ms = members(insts, std::slice::from_ref(c));
+        let ms = members(insts, std::slice::from_ref(c), &Turned::new());
         let fit = Fit::new(&ms, 1, &model_c, None);
         let (sol, _) = fit.result(&p, &[]);
-        if draws_back(insts, std::slice::from_ref(c), &p, &sol.drawn, tol) {
+        if draws_back(
+            insts,
+            std::slice::from_ref(c),
+            &p,
+            &sol.drawn,
+            tol,
+            &Turned::new(),
+        ) {
             kept.push(c.clone());
         }
     }
-    // The rule fitted to all of them (and made round with --symmetrize).
-    let lens: Vec<usize> = kept.iter().map(Vec::len).collect();
-    let model_all = |p: &[f64], out: &mut Vec<Frame>| model(p, &lens, out);
-    let ms = members(insts, &kept);
-    let mut fit = Fit::new(&ms, kept.len(), &model_all, None);
-    if kept.len() > 1 {
-        fit.solve_robust(&mut p, &free);
-    }
-    if tol.regular {
-        round(&mut fit, &mut p, &mut free, tol, size);
-    }
-    let (sol, _) = fit.result(&p, &free);
-    if !draws_back(insts, &kept, &p, &sol.drawn, tol) {
-        return None;
-    }
+    // A sequence that ends in something else (Fig. 5 ends its leaves with a
+    // bud): the chains with their tips, counted one further, first.
+    let with_tips = (offset(&p).pos.length() <= 1e-9 * size)
+        .then(|| tips(insts, edges, &kept, &p, tol))
+        .flatten()
+        .map(|(tips, turned)| {
+            let chains: Vec<Vec<usize>> = kept
+                .iter()
+                .zip(tips)
+                .map(|(c, t)| c.iter().copied().chain([t]).collect())
+                .collect();
+            (chains, shifted(&p), turned)
+        });
+    let (kept, p, sol) = with_tips
+        .and_then(|(chains, p, turned)| finish(insts, &turned, chains, p, free.clone(), tol, size))
+        .or_else(|| finish(insts, &Turned::new(), kept, p, free, tol, size))?;
     let t = at(&p, 0.0);
     let delta = Tr {
         alpha: p[4],
@@ -622,6 +666,98 @@ fn rule(
         *fitted = Some(reg);
     }
     Some(cand)
+}
+
+/// The rule fitted to all of `kept`, each number made as round as its
+/// support allows (within the tolerance: the exact one unless
+/// --symmetrize); `None` when it does not draw them all back.
+fn finish(
+    insts: &[Inst],
+    turned: &Turned,
+    kept: Vec<Vec<usize>>,
+    mut p: Vec<f64>,
+    mut free: Vec<usize>,
+    tol: Tolerance,
+    size: f64,
+) -> Option<(Vec<Vec<usize>>, Vec<f64>, Solution)> {
+    let lens: Vec<usize> = kept.iter().map(Vec::len).collect();
+    let model_all = |p: &[f64], out: &mut Vec<Frame>| model(p, &lens, out);
+    let ms = members(insts, &kept, turned);
+    let mut fit = Fit::new(&ms, kept.len(), &model_all, None);
+    if kept.len() > 1 {
+        fit.solve_robust(&mut p, &free);
+    } else {
+        fit.solve(&mut p, &free);
+    }
+    round(&mut fit, &mut p, &mut free, tol, size);
+    let (sol, _) = fit.result(&p, &free);
+    draws_back(insts, &kept, &p, &sol.drawn, tol, turned).then_some((kept, p, sol))
+}
+
+/// Instances of symmetric kinds taken in another of their frames.
+type Turned = BTreeMap<usize, Frame>;
+
+fn frame_of(insts: &[Inst], i: usize, turned: &Turned) -> Frame {
+    turned.get(&i).copied().unwrap_or(insts[i].frame)
+}
+
+/// The parameters counted one further: t'(m) = t(m − 1).
+fn shifted(p: &[f64]) -> Vec<f64> {
+    let mut q = p.to_vec();
+    q[0] = p[0] - p[4];
+    q[1] = p[1] - p[5];
+    q[2] = p[2] - p[6];
+    q[3] = p[3] - p[4] - p[7];
+    q
+}
+
+/// The tip of each chain: where the rule would put a next member (after
+/// the transform of counter 0, which the last member does not use), an instance of one other kind, the same for every chain; `None`
+/// when a chain has none.
+fn tips(
+    insts: &[Inst],
+    edges: &[Edge],
+    chains: &[Vec<usize>],
+    p: &[f64],
+    tol: Tolerance,
+) -> Option<(Vec<usize>, Turned)> {
+    let a = insts[chains.first()?[0]].sym;
+    let ends: BTreeMap<usize, usize> = chains
+        .iter()
+        .enumerate()
+        .filter_map(|(c, ch)| Some((*ch.last()?, c)))
+        .collect();
+    let next = at(p, 0.0);
+    let mut best: Vec<Option<(f64, usize, Frame)>> = vec![None; chains.len()];
+    for e in edges {
+        let Some(&c) = ends.get(&e.from) else {
+            continue;
+        };
+        let b = &insts[e.to];
+        if !b.alive || b.sym == a {
+            continue;
+        }
+        let want = next.apply(&insts[e.from].frame);
+        let step = next.d.abs() * want.scale;
+        let Some(have) = b
+            .variants(want.rot)
+            .into_iter()
+            .find(|f| close(&want, f, step, b.size(), tol))
+        else {
+            continue;
+        };
+        let off = want.pos.distance(have.pos);
+        if best[c].is_none_or(|(o, _, _)| off < o) {
+            best[c] = Some((off, e.to, have));
+        }
+    }
+    let best: Vec<(f64, usize, Frame)> = best.into_iter().collect::<Option<_>>()?;
+    let tips: Vec<usize> = best.iter().map(|b| b.1).collect();
+    let turned: Turned = best.iter().map(|b| (b.1, b.2)).collect();
+    let sym = insts[tips[0]].sym;
+    let distinct: HashSet<usize> = tips.iter().copied().collect();
+    (distinct.len() == tips.len() && tips.iter().all(|&i| insts[i].sym == sym))
+        .then_some((tips, turned))
 }
 
 /// `--symmetrize`: each free number in turn snapped to the roundest value

@@ -39,18 +39,26 @@ pub enum Sym {
 /// What a rule draws.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Body {
-    /// `P(m) : m > 0 -> [a] T(t(m)) P(m - 1); P(m) : m == 0 -> [a]` with
+    /// `P(m) : m > 0 -> [a] T(t(m)) P(m - 1); P(m) : m == 0 -> [tip]` with
     /// t(m) = t + delta·m (delta only for linear sequences); `a` is drawn
     /// from the turtle moved by `place` (when its frame's origin is not where
-    /// the turtle turns).
+    /// the turtle turns); `tip` is `a` unless the sequence ends in something
+    /// else (the paper's Fig. 5 ends its leaves with a bud).
     Seq {
         a: Sym,
         t: Tr,
         delta: Option<Tr>,
         place: Option<Tr>,
+        tip: Option<Sym>,
     },
-    /// `R(m) : m > 0 -> [a] [T R(m - 1)] [U R(m - 1)]; R(m) : m == 0 -> [a]`.
-    Branch { a: Sym, t: Tr, u: Tr },
+    /// `R(m) : m > 0 -> [a] [T R(m - 1)] [U R(m - 1)]; R(m) : m == 0 ->
+    /// [tip]` (`tip` is `a` unless the tips are something else).
+    Branch {
+        a: Sym,
+        t: Tr,
+        u: Tr,
+        tip: Option<Sym>,
+    },
     /// `Q -> [a] T [b]`.
     Pair { a: Sym, t: Tr, b: Sym },
 }
@@ -136,6 +144,11 @@ pub struct Inst {
     /// The place in the drawing of the first element it draws: structures
     /// read in the drawing's order where the geometry leaves a choice.
     order: usize,
+    /// An element's rotational symmetry (1 for none, k for k-fold, 0 for
+    /// round) and its centroid: its frame could as well be turned about
+    /// the centroid by a k-th of a turn.
+    turns: usize,
+    centroid: DVec2,
 }
 
 impl Inst {
@@ -156,6 +169,32 @@ impl Inst {
                 Sym::Rule(..) => Vec::new(),
             },
             order: usize::MAX,
+            turns: 1,
+            centroid: frame.pos,
+        }
+    }
+
+    /// The element is symmetric: `turns`-fold (0: round) about `centroid`.
+    pub fn symmetric(mut self, turns: usize, centroid: DVec2) -> Inst {
+        self.turns = turns;
+        self.centroid = centroid;
+        self
+    }
+
+    /// The frames it could as well have: turned about its centroid by its
+    /// symmetry (for a round one, the one turned to `rot`).
+    fn variants(&self, rot: f64) -> Vec<Frame> {
+        let f = self.frame;
+        let turn = |a: f64| Frame {
+            pos: self.centroid + crate::infer::art::shape::rotate(f.pos - self.centroid, a),
+            rot: wrap(f.rot + a),
+            scale: f.scale,
+        };
+        match self.turns {
+            0 => vec![turn(wrap(rot - f.rot))],
+            k => (0..k)
+                .map(|j| turn(std::f64::consts::TAU * j as f64 / k as f64))
+                .collect(),
         }
     }
 
@@ -1089,6 +1128,7 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
             fitted,
         } => {
             let a = insts[chains[0][0]].sym;
+            let tip = chains[0].last().map(|&i| insts[i].sym).filter(|&b| b != a);
             let reg = fitted.or_else(|| {
                 (tol.regular && delta.is_none())
                     .then(|| regular::sequence(insts, &chains, &t, tol))
@@ -1115,7 +1155,13 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
             }
             let t = reg.map_or(t, |reg| reg.t[0]);
             g.rules.push(Rule {
-                body: Body::Seq { a, t, delta, place },
+                body: Body::Seq {
+                    a,
+                    t,
+                    delta,
+                    place,
+                    tip,
+                },
                 counts,
             });
         }
@@ -1152,7 +1198,7 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
             }
             let (t, u) = reg.map_or((t, u), |reg| (reg.t[0], reg.t[1]));
             g.rules.push(Rule {
-                body: Body::Branch { a, t, u },
+                body: Body::Branch { a, t, u, tip: None },
                 counts,
             });
         }
@@ -1241,8 +1287,19 @@ impl Grammar {
         match s {
             Sym::Element(_) => 1,
             Sym::Rule(r, m) => match &self.rules[r].body {
-                Body::Seq { a, .. } => (u64::from(m) + 1) * self.covered(*a),
-                Body::Branch { a, .. } => ((1u64 << (m + 1).min(62)) - 1) * self.covered(*a),
+                Body::Seq { a, tip: None, .. } => (u64::from(m) + 1) * self.covered(*a),
+                Body::Seq {
+                    a, tip: Some(b), ..
+                } => u64::from(m) * self.covered(*a) + self.covered(*b),
+                Body::Branch { a, tip: None, .. } => {
+                    ((1u64 << (m + 1).min(62)) - 1) * self.covered(*a)
+                }
+                Body::Branch {
+                    a, tip: Some(b), ..
+                } => {
+                    let leaves = 1u64 << m.min(62);
+                    (leaves - 1) * self.covered(*a) + leaves * self.covered(*b)
+                }
                 Body::Pair { a, b, .. } => self.covered(*a) + self.covered(*b),
             },
         }
