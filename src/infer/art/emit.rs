@@ -921,8 +921,13 @@ impl RuleWriter<'_> {
             succ.push(self.recurse());
             succ.push(sym(']', None));
         }
+        let tips = if tip == a {
+            String::new()
+        } else {
+            format!(", {} at the tips", self.describe(tip))
+        };
         let note = format!(
-            "{}(m): {} branching in two, m levels deep",
+            "{}(m): {} branching in two, m levels deep{tips}",
             self.name,
             self.describe(a)
         );

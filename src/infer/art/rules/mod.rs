@@ -427,6 +427,31 @@ fn mean(ts: &[Tr]) -> Tr {
     }
 }
 
+/// The mean of `ts` with each number made as round as the transforms
+/// support: the roundest value within three standard errors of the mean (at
+/// most the tolerance). A drawing written with rounded coordinates gives
+/// back `f(28)`, not `f(27.998)`.
+fn supported_mean(ts: &[Tr], tol: Tolerance) -> Tr {
+    let m = mean(ts);
+    let n = ts.len() as f64;
+    if ts.len() < 2 {
+        return m;
+    }
+    let se = |dev: &dyn Fn(&Tr) -> f64| {
+        (ts.iter().map(|t| dev(t).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt() * 3.0
+    };
+    let a = se(&|t| wrap(t.alpha - m.alpha)).min(tol.angle);
+    let d = se(&|t| t.d - m.d).min(tol.distance * m.d.abs());
+    let sc = se(&|t| t.s - m.s).min(tol.scale * m.s.abs());
+    let b = se(&|t| wrap(t.beta - m.beta)).min(tol.angle);
+    Tr {
+        alpha: fit::nice_angle(m.alpha, a),
+        d: fit::nice(m.d, d),
+        s: fit::nice(m.s, sc),
+        beta: fit::nice_angle(m.beta, b),
+    }
+}
+
 /// Whether `f` is where `want` is, within the tolerance (relative to `step`,
 /// the distance moved to get there, and the frame's scale).
 fn close(f: &Frame, want: &Frame, step: f64, size: f64, tol: Tolerance) -> bool {
@@ -582,7 +607,7 @@ fn sequence(
         .flat_map(|c| c.windows(2))
         .filter_map(|w| index.get(&(w[0], w[1])).map(|&k| edges[k].t))
         .collect();
-    let t = mean(&used);
+    let t = supported_mean(&used, tol);
     let mut chains = cut_drift(insts, chains, |_, _| t, tol);
     if let Some(near) = near {
         chains = extend(insts, chains, &t, near, tol);
@@ -871,10 +896,11 @@ fn branching(
         .filter(|&(_, d)| d >= 1)
         .collect();
     roots.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
-    let t = mean(&x.iter().map(|&k| edges[k].t).collect::<Vec<_>>());
-    let u = mean(&y.iter().map(|&k| edges[k].t).collect::<Vec<_>>());
+    let t = supported_mean(&x.iter().map(|&k| edges[k].t).collect::<Vec<_>>(), tol);
+    let u = supported_mean(&y.iter().map(|&k| edges[k].t).collect::<Vec<_>>(), tol);
     let mut claimed: HashSet<usize> = HashSet::new();
     let mut trees = Vec::new();
+    let mut leaves: Vec<(usize, Frame)> = Vec::new();
     let mut pairs = 0;
     let mut gap = 0.0;
     for (r, d) in roots {
@@ -914,9 +940,25 @@ fn branching(
         pairs += nodes.len() - 1;
         gap += tree_gap;
         trees.push((r, d));
+        leaves.extend(level);
     }
     if trees.is_empty() {
         return None;
+    }
+    let (mut cx, mut cy) = (cx, cy);
+    if let Some(tips) = tree_tips(insts, edges, &leaves, [&t, &u], &claimed, tol) {
+        for (&(leaf, _), [x, y]) in leaves.iter().zip(tips) {
+            cx.insert(leaf, x);
+            cy.insert(leaf, y);
+            gap += [x, y]
+                .iter()
+                .map(|&c| index.get(&(leaf, c)).map_or(1.0, |&k| edges[k].gap))
+                .sum::<f64>();
+        }
+        pairs += 2 * leaves.len();
+        for tree in &mut trees {
+            tree.1 += 1;
+        }
     }
     let length = trees.iter().map(|t| t.1 as f64 + 1.0).sum::<f64>() / trees.len() as f64;
     Some(Candidate {
@@ -931,6 +973,58 @@ fn branching(
             u,
         },
     })
+}
+
+/// The tips of complete trees: where the transforms `tr` put the children
+/// of every leaf (`leaves`, with their frames as the trees draw them), two
+/// instances of one other kind that no tree claims (buds at the tips: the
+/// `m == 0` rule draws them); `None` unless every leaf has both.
+fn tree_tips(
+    insts: &[Inst],
+    edges: &[Edge],
+    leaves: &[(usize, Frame)],
+    tr: [&Tr; 2],
+    claimed: &HashSet<usize>,
+    tol: Tolerance,
+) -> Option<Vec<[usize; 2]>> {
+    let a = insts[leaves.first()?.0].sym;
+    let at: HashMap<usize, usize> = leaves.iter().enumerate().map(|(k, l)| (l.0, k)).collect();
+    let mut best: Vec<[Option<(f64, usize)>; 2]> = vec![[None; 2]; leaves.len()];
+    for e in edges {
+        let Some(&k) = at.get(&e.from) else {
+            continue;
+        };
+        let b = &insts[e.to];
+        if !b.alive || b.sym == a || claimed.contains(&e.to) {
+            continue;
+        }
+        let f = leaves[k].1;
+        for side in 0..2 {
+            let want = tr[side].apply(&f);
+            let step = tr[side].d * f.scale;
+            let Some(have) = b
+                .variants(want.rot)
+                .into_iter()
+                .find(|v| close(&want, v, step, b.size(), tol))
+            else {
+                continue;
+            };
+            let off = want.pos.distance(have.pos);
+            if best[k][side].is_none_or(|(o, _)| off < o) {
+                best[k][side] = Some((off, e.to));
+            }
+        }
+    }
+    let tips: Vec<[usize; 2]> = best
+        .into_iter()
+        .map(|[x, y]| Some([x?.1, y?.1]))
+        .collect::<Option<_>>()?;
+    let sym = insts[tips[0][0]].sym;
+    let mut seen = HashSet::new();
+    tips.iter()
+        .flatten()
+        .all(|&i| insts[i].sym == sym && seen.insert(i))
+        .then_some(tips)
 }
 
 /// Importances closer than this are equal (the two directions of one chain
@@ -1167,6 +1261,10 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
         }
         Plan::Branch { trees, child, t, u } => {
             let a = insts[trees[0].0].sym;
+            let tip = tree_members(&child, trees[0].0, trees[0].1)
+                .last()
+                .map(|&i| insts[i].sym)
+                .filter(|&b| b != a);
             let reg = tol
                 .regular
                 .then(|| regular::branching(insts, &trees, &child, &t, &u, tol))
@@ -1198,7 +1296,7 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
             }
             let (t, u) = reg.map_or((t, u), |reg| (reg.t[0], reg.t[1]));
             g.rules.push(Rule {
-                body: Body::Branch { a, t, u, tip: None },
+                body: Body::Branch { a, t, u, tip },
                 counts,
             });
         }
