@@ -38,10 +38,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Cases whose `<use>` drawing does not give back the program's rules and
 /// numbers yet, with the reason.
-const NOT_YET: &[(&str, &str)] = &[(
-    "ternary-branching",
-    "a branching in three is not a rule kind: a binary branching, sequences and pairs (11 rules)",
-)];
+const NOT_YET: &[(&str, &str)] = &[];
 
 /// Cases whose plain drawing does not give back the program's rules and
 /// numbers yet, with the reason.
@@ -61,10 +58,6 @@ const NOT_YET_PLAIN: &[(&str, &str)] = &[
     (
         "spiral",
         "one sequence with its scale and turn, but the arrow's pen starts at (-1, 0), not at the writer's origin (0, 0): the step is 13.4, not 12",
-    ),
-    (
-        "ternary-branching",
-        "a branching in three is not a rule kind: a binary branching, sequences and pairs (11 rules)",
     ),
     (
         "tip-buds",

@@ -121,7 +121,12 @@ fn inlined(g: &Grammar) -> Vec<bool> {
                     count(b);
                 }
             }
-            Body::Branch { a, .. } => count(a),
+            Body::Branch { a, tip, .. } => {
+                count(a);
+                if let Some(b) = tip {
+                    count(b);
+                }
+            }
             Body::Pair { a, b, .. } => {
                 count(a);
                 count(b);
@@ -491,8 +496,8 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
                     place.as_ref(),
                 );
             }
-            Body::Branch { a, t, u, tip } => {
-                w.branching(&mut consts, run(g, r), (*a, tip.unwrap_or(*a)), t, u)
+            Body::Branch { a, ts, tip } => {
+                w.branching(&mut consts, run(g, r), (*a, tip.unwrap_or(*a)), ts)
             }
             // A sequence used only with m = 1 is the pair P -> A T A.
             Body::Seq { a, t, tip, .. } => w.pair(*a, t, tip.unwrap_or(*a)),
@@ -910,12 +915,15 @@ impl RuleWriter<'_> {
         self.add(m_is(BinOp::Eq), last, None);
     }
 
-    /// `R(m) : m > 0 -> [a] [T R(m - 1)] [U R(m - 1)]; R(m) : m == 0 -> [a]`.
-    fn branching(&mut self, consts: &mut Consts, n: f64, (a, tip): (Sym, Sym), t: &Tr, u: &Tr) {
-        let (ta, td, ts, tb) = self.parts(consts, t, "1", n);
-        let (ua, ud, us, ub) = self.parts(consts, u, "2", n);
+    /// `R(m) : m > 0 -> [a] [T R(m - 1)] [U R(m - 1)]…; R(m) : m == 0 -> [tip]`.
+    fn branching(&mut self, consts: &mut Consts, n: f64, (a, tip): (Sym, Sym), ts: &[Tr]) {
+        let parts: Vec<_> = ts
+            .iter()
+            .enumerate()
+            .map(|(i, t)| self.parts(consts, t, &(i + 1).to_string(), n))
+            .collect();
         let mut succ = self.unit_in_place(a, n);
-        for (pa, pd, ps, pb) in [(ta, td, ts, tb), (ua, ud, us, ub)] {
+        for (pa, pd, ps, pb) in parts {
             succ.push(sym('[', None));
             succ.extend(transform(pa, pd, ps, pb));
             succ.push(self.recurse());
@@ -927,9 +935,14 @@ impl RuleWriter<'_> {
             format!(", {} at the tips", self.describe(tip))
         };
         let note = format!(
-            "{}(m): {} branching in two, m levels deep{tips}",
+            "{}(m): {} branching in {}, m levels deep{tips}",
             self.name,
-            self.describe(a)
+            self.describe(a),
+            match ts.len() {
+                2 => "two".to_string(),
+                3 => "three".to_string(),
+                k => k.to_string(),
+            }
         );
         self.add(m_is(BinOp::Gt), succ, Some(note));
         let (last, _) = self.unit(tip, n, false);

@@ -51,12 +51,12 @@ pub enum Body {
         place: Option<Tr>,
         tip: Option<Sym>,
     },
-    /// `R(m) : m > 0 -> [a] [T R(m - 1)] [U R(m - 1)]; R(m) : m == 0 ->
-    /// [tip]` (`tip` is `a` unless the tips are something else).
+    /// `R(m) : m > 0 -> [a] [T R(m - 1)] [U R(m - 1)]…; R(m) : m == 0 ->
+    /// [tip]`, one bracket per transform of `ts` (two or three); `tip` is
+    /// `a` unless the tips are something else.
     Branch {
         a: Sym,
-        t: Tr,
-        u: Tr,
+        ts: Vec<Tr>,
         tip: Option<Sym>,
     },
     /// `Q -> [a] T [b]`.
@@ -244,9 +244,9 @@ enum Plan {
     },
     Branch {
         trees: Vec<(usize, u32)>,
-        child: [HashMap<usize, usize>; 2],
-        t: Tr,
-        u: Tr,
+        /// Per transform, each node's child by it.
+        child: Vec<HashMap<usize, usize>>,
+        ts: Vec<Tr>,
     },
     Pair {
         pairs: Vec<(usize, usize)>,
@@ -500,15 +500,19 @@ fn candidates(
             }
         }
         if a == b {
-            // Branchings: two clusters of one kind, each node with a child in both.
+            // Branchings: two or three clusters of one kind, each node with
+            // a child in each.
             let mut big: Vec<&Vec<usize>> = groups.iter().filter(|g| g.len() >= 2).collect();
             big.sort_by_key(|g| std::cmp::Reverse(g.len()));
-            big.truncate(6);
-            for x in 0..big.len() {
-                for y in x + 1..big.len() {
-                    if let Some(c) = branching(insts, edges, &index, big[x], big[y], tol) {
-                        out.push(c);
-                    }
+            big.truncate(8);
+            let n = big.len();
+            let pairs = (0..n).flat_map(|x| (x + 1..n).map(move |y| vec![x, y]));
+            let triples = (0..n)
+                .flat_map(|x| (x + 1..n).flat_map(move |y| (y + 1..n).map(move |z| vec![x, y, z])));
+            for set in pairs.chain(triples) {
+                let groups: Vec<&[usize]> = set.iter().map(|&g| big[g].as_slice()).collect();
+                if let Some(c) = branching(insts, edges, &index, &groups, tol) {
+                    out.push(c);
                 }
             }
             out.extend(linear::linear(insts, edges, &index, ks, tol, budget)?);
@@ -801,26 +805,22 @@ fn seq_candidate(
     })
 }
 
-/// The depth of the complete binary tree below `v` whose children are
-/// `cx[v]` and `cy[v]` (0 for a leaf), memoised in `memo`. A node met again
+/// The depth of the complete tree below `v` whose children are `child[i][v]`
+/// (one per transform; 0 for a leaf), memoised in `memo`. A node met again
 /// while its own depth is being found (`open`: a cycle) counts as a leaf.
 /// Iterative, so that a long chain cannot overflow the stack: each frame is
-/// one step of the recursive definition
-/// `depth(v) = 1 + min(depth(cx[v]), depth(cy[v]))`.
+/// one step of the recursive definition `depth(v) = 1 + min_i depth(child[i][v])`.
 fn depth_of(
     v: usize,
-    cx: &HashMap<usize, usize>,
-    cy: &HashMap<usize, usize>,
+    child: &[HashMap<usize, usize>],
     memo: &mut HashMap<usize, u32>,
     open: &mut HashSet<usize>,
 ) -> u32 {
     enum Step {
         /// Find the depth of this node.
         Enter(usize),
-        /// The first child's depth is found; find the second's (node, second child).
-        Second(usize, usize),
-        /// Both are found (node, first child's depth).
-        Done(usize, u32),
+        /// Child `i` of the node is found; the least depth of its children so far.
+        After(usize, usize, u32),
     }
     let mut calls = vec![Step::Enter(v)];
     let mut found = 0;
@@ -831,10 +831,14 @@ fn depth_of(
                     found = d;
                     continue;
                 }
-                match (cx.get(&v), cy.get(&v)) {
-                    (Some(&a), Some(&b)) if a != b && open.insert(v) => {
-                        calls.push(Step::Second(v, b));
-                        calls.push(Step::Enter(a));
+                let kids: Option<Vec<usize>> = child.iter().map(|c| c.get(&v).copied()).collect();
+                let distinct = kids
+                    .as_ref()
+                    .is_some_and(|k| k.iter().enumerate().all(|(i, a)| !k[..i].contains(a)));
+                match kids {
+                    Some(k) if distinct && open.insert(v) => {
+                        calls.push(Step::After(v, 0, u32::MAX));
+                        calls.push(Step::Enter(k[0]));
                     }
                     _ => {
                         memo.insert(v, 0);
@@ -842,28 +846,30 @@ fn depth_of(
                     }
                 }
             }
-            Step::Second(v, b) => {
-                calls.push(Step::Done(v, found));
-                calls.push(Step::Enter(b));
-            }
-            Step::Done(v, first) => {
-                let d = first.min(found).saturating_add(1);
-                open.remove(&v);
-                memo.insert(v, d);
-                found = d;
+            Step::After(v, i, least) => {
+                let least = least.min(found);
+                if i + 1 < child.len() {
+                    calls.push(Step::After(v, i + 1, least));
+                    calls.push(Step::Enter(child[i + 1][&v]));
+                } else {
+                    let d = least.saturating_add(1);
+                    open.remove(&v);
+                    memo.insert(v, d);
+                    found = d;
+                }
             }
         }
     }
     found
 }
 
-/// Complete binary trees whose children come from clusters `x` and `y`.
+/// Complete trees whose children come from `groups` (clusters of edges, one
+/// per transform).
 fn branching(
     insts: &[Inst],
     edges: &[Edge],
     index: &Index,
-    x: &[usize],
-    y: &[usize],
+    groups: &[&[usize]],
     tol: Tolerance,
 ) -> Option<Candidate> {
     let child_map = |g: &[usize]| {
@@ -875,9 +881,13 @@ fn branching(
         }
         m
     };
-    let (cx, cy) = (child_map(x), child_map(y));
+    let mut child: Vec<HashMap<usize, usize>> = groups.iter().map(|g| child_map(g)).collect();
     let both: Vec<usize> = {
-        let mut v: Vec<usize> = cx.keys().copied().filter(|k| cy.contains_key(k)).collect();
+        let mut v: Vec<usize> = child[0]
+            .keys()
+            .copied()
+            .filter(|k| child[1..].iter().all(|c| c.contains_key(k)))
+            .collect();
         v.sort_unstable();
         v
     };
@@ -888,7 +898,7 @@ fn branching(
     let mut depth: HashMap<usize, u32> = HashMap::new();
     let mut open = HashSet::new();
     for &v in &both {
-        depth_of(v, &cx, &cy, &mut depth, &mut open);
+        depth_of(v, &child, &mut depth, &mut open);
     }
     let mut roots: Vec<(usize, u32)> = both
         .iter()
@@ -896,8 +906,10 @@ fn branching(
         .filter(|&(_, d)| d >= 1)
         .collect();
     roots.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
-    let t = supported_mean(&x.iter().map(|&k| edges[k].t).collect::<Vec<_>>(), tol);
-    let u = supported_mean(&y.iter().map(|&k| edges[k].t).collect::<Vec<_>>(), tol);
+    let ts: Vec<Tr> = groups
+        .iter()
+        .map(|g| supported_mean(&g.iter().map(|&k| edges[k].t).collect::<Vec<_>>(), tol))
+        .collect();
     let mut claimed: HashSet<usize> = HashSet::new();
     let mut trees = Vec::new();
     let mut leaves: Vec<(usize, Frame)> = Vec::new();
@@ -913,7 +925,7 @@ fn branching(
         for _ in 0..d {
             let mut below = Vec::new();
             for &(v, f) in &level {
-                for (map, tr) in [(&cx, &t), (&cy, &u)] {
+                for (map, tr) in child.iter().zip(&ts) {
                     let c = map[&v];
                     let want = tr.apply(&f);
                     if claimed.contains(&c)
@@ -945,17 +957,14 @@ fn branching(
     if trees.is_empty() {
         return None;
     }
-    let (mut cx, mut cy) = (cx, cy);
-    if let Some(tips) = tree_tips(insts, edges, &leaves, [&t, &u], &claimed, tol) {
-        for (&(leaf, _), [x, y]) in leaves.iter().zip(tips) {
-            cx.insert(leaf, x);
-            cy.insert(leaf, y);
-            gap += [x, y]
-                .iter()
-                .map(|&c| index.get(&(leaf, c)).map_or(1.0, |&k| edges[k].gap))
-                .sum::<f64>();
+    if let Some(tips) = tree_tips(insts, edges, &leaves, &ts, &claimed, tol) {
+        for (&(leaf, _), below) in leaves.iter().zip(tips) {
+            for (map, &c) in child.iter_mut().zip(&below) {
+                map.insert(leaf, c);
+                gap += index.get(&(leaf, c)).map_or(1.0, |&k| edges[k].gap);
+            }
         }
-        pairs += 2 * leaves.len();
+        pairs += ts.len() * leaves.len();
         for tree in &mut trees {
             tree.1 += 1;
         }
@@ -966,12 +975,7 @@ fn branching(
         phi: 1.0,
         length,
         pairs,
-        plan: Plan::Branch {
-            trees,
-            child: [cx, cy],
-            t,
-            u,
-        },
+        plan: Plan::Branch { trees, child, ts },
     })
 }
 
@@ -983,13 +987,13 @@ fn tree_tips(
     insts: &[Inst],
     edges: &[Edge],
     leaves: &[(usize, Frame)],
-    tr: [&Tr; 2],
+    tr: &[Tr],
     claimed: &HashSet<usize>,
     tol: Tolerance,
-) -> Option<Vec<[usize; 2]>> {
+) -> Option<Vec<Vec<usize>>> {
     let a = insts[leaves.first()?.0].sym;
     let at: HashMap<usize, usize> = leaves.iter().enumerate().map(|(k, l)| (l.0, k)).collect();
-    let mut best: Vec<[Option<(f64, usize)>; 2]> = vec![[None; 2]; leaves.len()];
+    let mut best: Vec<Vec<Option<(f64, usize)>>> = vec![vec![None; tr.len()]; leaves.len()];
     for e in edges {
         let Some(&k) = at.get(&e.from) else {
             continue;
@@ -999,7 +1003,7 @@ fn tree_tips(
             continue;
         }
         let f = leaves[k].1;
-        for side in 0..2 {
+        for side in 0..tr.len() {
             let want = tr[side].apply(&f);
             let step = tr[side].d * f.scale;
             let Some(have) = b
@@ -1015,9 +1019,13 @@ fn tree_tips(
             }
         }
     }
-    let tips: Vec<[usize; 2]> = best
+    let tips: Vec<Vec<usize>> = best
         .into_iter()
-        .map(|[x, y]| Some([x?.1, y?.1]))
+        .map(|b| {
+            b.into_iter()
+                .map(|x| Some(x?.1))
+                .collect::<Option<Vec<_>>>()
+        })
         .collect::<Option<_>>()?;
     let sym = insts[tips[0][0]].sym;
     let mut seen = HashSet::new();
@@ -1196,14 +1204,13 @@ fn fitted_start(insts: &[Inst], chain: &[usize], t: &Tr) -> Frame {
 }
 
 /// The members of a complete binary tree, level by level.
-fn tree_members(child: &[HashMap<usize, usize>; 2], root: usize, depth: u32) -> Vec<usize> {
+fn tree_members(child: &[HashMap<usize, usize>], root: usize, depth: u32) -> Vec<usize> {
     let mut members = vec![root];
     let mut level = vec![root];
     for _ in 0..depth {
         level = level
             .iter()
-            .flat_map(|v| [child[0].get(v), child[1].get(v)])
-            .flatten()
+            .flat_map(|v| child.iter().filter_map(move |c| c.get(v)))
             .copied()
             .collect();
         members.extend(level.iter().copied());
@@ -1259,7 +1266,7 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
                 counts,
             });
         }
-        Plan::Branch { trees, child, t, u } => {
+        Plan::Branch { trees, child, ts } => {
             let a = insts[trees[0].0].sym;
             let tip = tree_members(&child, trees[0].0, trees[0].1)
                 .last()
@@ -1267,7 +1274,7 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
                 .filter(|&b| b != a);
             let reg = tol
                 .regular
-                .then(|| regular::branching(insts, &trees, &child, &t, &u, tol))
+                .then(|| regular::branching(insts, &trees, &child, &ts, tol))
                 .flatten();
             let mut counts = BTreeSet::new();
             let mut offset = 0;
@@ -1294,9 +1301,9 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
                 }
                 offset += members.len();
             }
-            let (t, u) = reg.map_or((t, u), |reg| (reg.t[0], reg.t[1]));
+            let ts = reg.map_or(ts, |reg| reg.t);
             g.rules.push(Rule {
-                body: Body::Branch { a, t, u, tip },
+                body: Body::Branch { a, ts, tip },
                 counts,
             });
         }
@@ -1389,14 +1396,17 @@ impl Grammar {
                 Body::Seq {
                     a, tip: Some(b), ..
                 } => u64::from(m) * self.covered(*a) + self.covered(*b),
-                Body::Branch { a, tip: None, .. } => {
-                    ((1u64 << (m + 1).min(62)) - 1) * self.covered(*a)
-                }
-                Body::Branch {
-                    a, tip: Some(b), ..
-                } => {
-                    let leaves = 1u64 << m.min(62);
-                    (leaves - 1) * self.covered(*a) + leaves * self.covered(*b)
+                Body::Branch { a, ts, tip } => {
+                    // k^m leaves below k^m − 1 … 1 nodes: (k^m − 1)/(k − 1).
+                    let k = ts.len().max(2) as u64;
+                    let leaves = k.saturating_pow(m);
+                    let inner = (leaves - 1) / (k - 1);
+                    match tip {
+                        None => (inner + leaves).saturating_mul(self.covered(*a)),
+                        Some(b) => inner
+                            .saturating_mul(self.covered(*a))
+                            .saturating_add(leaves.saturating_mul(self.covered(*b))),
+                    }
                 }
                 Body::Pair { a, b, .. } => self.covered(*a) + self.covered(*b),
             },

@@ -149,14 +149,14 @@ pub(super) fn sequence(
     .filter(|r| r.t.iter().all(|t| t.s > 0.0))
 }
 
-/// Complete binary trees drawn by `R(m) -> [A] [T R(m - 1)] [U R(m - 1)]`,
-/// given as (root, depth); `child` are the two children of each node.
+/// Complete trees drawn by `R(m) -> [A] [T R(m - 1)] [U R(m - 1)]…`, given
+/// as (root, depth); `child` are the children of each node, one map per
+/// transform of `ts`.
 pub(super) fn branching(
     insts: &[Inst],
     trees: &[(usize, u32)],
-    child: &[std::collections::HashMap<usize, usize>; 2],
-    t: &Tr,
-    u: &Tr,
+    child: &[std::collections::HashMap<usize, usize>],
+    ts: &[Tr],
     tol: Tolerance,
 ) -> Option<Regular> {
     // Members level by level, as the rule draws them.
@@ -168,16 +168,16 @@ pub(super) fn branching(
         for _ in 0..depth {
             level = level
                 .iter()
-                .flat_map(|v| [child[0].get(v), child[1].get(v)])
-                .flatten()
+                .flat_map(|v| child.iter().filter_map(move |c| c.get(v)))
                 .copied()
                 .collect();
             members.extend(level.iter().map(|&i| member(insts, g, i, rep)));
         }
     }
     let depths: Vec<u32> = trees.iter().map(|t| t.1).collect();
+    let k = ts.len();
     let model = |p: &[f64], out: &mut Vec<Frame>| {
-        let (t, u) = (transform(&p[..4]), transform(&p[4..8]));
+        let trs: Vec<Tr> = (0..k).map(|i| transform(&p[4 * i..4 * i + 4])).collect();
         out.clear();
         for &d in &depths {
             let mut level = vec![identity()];
@@ -185,18 +185,18 @@ pub(super) fn branching(
             for _ in 0..d {
                 level = level
                     .iter()
-                    .flat_map(|f| [t.apply(f), u.apply(f)])
+                    .flat_map(|f| trs.iter().map(|t| t.apply(f)).collect::<Vec<_>>())
                     .collect();
                 out.extend(level.iter().copied());
             }
         }
     };
-    let mut p: Vec<f64> = params(t).into_iter().chain(params(u)).collect();
+    let mut p: Vec<f64> = ts.iter().flat_map(params).collect();
     p.push(0.0);
     let loose = Loose { rep, same: true };
     let sol = snap(&members, trees.len(), &model, &mut p, tol, None, loose);
     Regular {
-        t: vec![transform(&p[..4]), transform(&p[4..8])],
+        t: (0..k).map(|i| transform(&p[4 * i..4 * i + 4])).collect(),
         starts: sol.starts,
         rot_se: sol.rot_se,
         pos_se: sol.pos_se,
