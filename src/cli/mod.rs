@@ -4,6 +4,7 @@
 //! error) and where output goes: results on stdout, diagnostics on stderr.
 
 mod check;
+mod docs;
 mod edit;
 mod fmt;
 mod infer;
@@ -84,6 +85,16 @@ pub enum Command {
         after_help = "Examples:\n  lsyc edit palm.lsy --move frond4.v4=100,480 --pin trunk1\n  lsyc edit palm.lsy --by trunk3.v2=30,-5 --pin trunk2\n  lsyc edit palm.lsy --pin trunk1 --translate frond1=10,0 --rotate frond1=15 --write"
     )]
     Edit(edit::Args),
+    /// Print a shell completion script: bash, zsh, fish, elvish or powershell.
+    #[command(
+        after_help = "Examples:\n  lsyc completions bash > ~/.local/share/bash-completion/completions/lsyc\n  lsyc completions zsh > ~/.zfunc/_lsyc\n  lsyc completions fish > ~/.config/fish/completions/lsyc.fish"
+    )]
+    Completions(docs::CompletionsArgs),
+    /// Print a manual page (roff), generated from this command line's own help.
+    #[command(
+        after_help = "Examples:\n  lsyc man | man -l -\n  lsyc man run | man -l -\n  lsyc man > lsyc.1"
+    )]
+    Man(docs::ManArgs),
 }
 
 /// Where diagnostics go and how they look.
@@ -221,6 +232,8 @@ pub fn main() -> ExitCode {
         Command::Run(args) => run::run(args, &reporter),
         Command::Infer(args) => infer::run(args, &reporter),
         Command::Edit(args) => edit::run(args, &reporter),
+        Command::Completions(args) => docs::completions(args, &reporter),
+        Command::Man(args) => docs::man(args, &reporter),
     };
     ExitCode::from(status)
 }
