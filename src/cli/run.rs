@@ -14,8 +14,8 @@ pub struct Args {
     /// The .lsy program to run.
     pub file: PathBuf,
 
-    /// Derivation steps (default: the program's `derive`).
-    #[arg(short = 'n', long = "steps", value_name = "STEPS")]
+    /// Derivation steps, 0 to 1000000 (default: the program's `derive`).
+    #[arg(short = 'n', long = "steps", value_name = "STEPS", allow_negative_numbers = true, value_parser = parse_steps)]
     pub steps: Option<u32>,
 
     /// Output file; its extension picks the format: .svg .png .obj .txt
@@ -75,6 +75,18 @@ pub struct Args {
     /// to the element's size, in the drawing's colours); repeatable.
     #[arg(long = "element", value_name = "NAME=FILE.svg")]
     pub elements: Vec<String>,
+}
+
+/// `-n STEPS`: a whole number within derive's own limit, with derive's message.
+fn parse_steps(text: &str) -> Result<u32, String> {
+    let max = lsyc::derive::MAX_STEPS;
+    text.trim()
+        .parse::<u32>()
+        .ok()
+        .filter(|&n| n <= max)
+        .ok_or_else(|| {
+            format!("the number of derivation steps must be a whole number from 0 to {max}")
+        })
 }
 
 pub fn run(args: &Args, reporter: &Reporter) -> u8 {
