@@ -260,3 +260,54 @@ pub fn summary(diags: &[Diagnostic]) -> String {
         (e, w) => format!("{}, {}", part(e, "error"), part(w, "warning")),
     }
 }
+
+/// Reads a program for `run`, `check` and `fmt`, reporting why not (exit 1):
+/// a file that cannot be read, or a drawing given where a program belongs (one
+/// clear error pointing at `lsyc infer`, not a cascade of parse errors).
+pub fn read_program(path: &std::path::Path, reporter: &Reporter) -> Option<lsyc::source::Source> {
+    let name = path.display().to_string();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if matches!(ext.as_deref(), Some("svg" | "svgz")) {
+        refuse_drawing(&name, reporter);
+        return None;
+    }
+    let src = match lsyc::source::read(path) {
+        Ok(s) => s,
+        Err(d) => {
+            reporter.emit(&[d], &name, "");
+            return None;
+        }
+    };
+    if looks_like_svg(&src.text) {
+        refuse_drawing(&name, reporter);
+        return None;
+    }
+    Some(src)
+}
+
+/// Whether a text is an SVG document: it starts (after a byte-order mark and
+/// blank space) with an XML declaration, an SVG doctype or an `<svg` element.
+fn looks_like_svg(text: &str) -> bool {
+    let t = text.trim_start_matches('\u{feff}').trim_start();
+    t.starts_with("<?xml") || t.starts_with("<svg") || t.starts_with("<!DOCTYPE svg")
+}
+
+fn refuse_drawing(name: &str, reporter: &Reporter) {
+    let path = std::path::Path::new(name);
+    let stem = path.file_stem().map_or("art".into(), |s| s.to_string_lossy());
+    // Never suggest writing over the drawing itself.
+    let out = if path.extension().is_some_and(|e| e == "lsy") {
+        format!("{stem}-inferred.lsy")
+    } else {
+        format!("{stem}.lsy")
+    };
+    reporter.error(
+        &format!("`{name}` is a drawing (SVG), not an .lsy program"),
+        Some(&format!(
+            "to turn a drawing into a program, run `lsyc infer {name} -o {out}`"
+        )),
+    );
+}

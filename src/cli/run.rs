@@ -185,10 +185,7 @@ fn load(
     ovr: &[lsyc::check::Override],
     reporter: &Reporter,
 ) -> Result<(source::Source, frontend::Frontend), u8> {
-    let src = source::read(&args.file).map_err(|d| {
-        reporter.emit(&[d], &args.file.display().to_string(), "");
-        1u8
-    })?;
+    let src = super::read_program(&args.file, reporter).ok_or(1u8)?;
     if let Some(out) = &args.output
         && same_file(out, &args.file)
     {
