@@ -18,11 +18,17 @@ pub struct Args {
     #[arg(short = 'n', long = "steps", value_name = "STEPS", allow_negative_numbers = true, value_parser = parse_steps)]
     pub steps: Option<u32>,
 
-    /// Output file; its extension picks the format: .svg .png .obj .txt
+    /// Output file; its extension picks the format: .svg .png .obj .txt;
+    /// `-o -` writes to stdout (SVG unless --format says otherwise).
     #[arg(short = 'o', long = "output", value_name = "OUT")]
     pub output: Option<PathBuf>,
 
-    /// Print statistics as one JSON object on stdout.
+    /// The output format when the extension cannot say (`-o -`): svg, png, obj or txt.
+    #[arg(long, value_name = "FORMAT", requires = "output")]
+    pub format: Option<String>,
+
+    /// Print statistics as one JSON object on stdout (on stderr when the drawing
+    /// itself goes to stdout with `-o -`).
     #[arg(long)]
     pub stats: bool,
 
@@ -147,12 +153,56 @@ fn run_inner(args: &Args, reporter: &Reporter) -> Result<(), u8> {
     run_system(args, reporter, &src, &fe, &opts, format, background)
 }
 
-/// The output format, from the output file's extension.
+/// Whether an output path means stdout (`-o -`).
+fn is_stdout(path: &std::path::Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// The output format: `--format`, else the output file's extension; SVG for `-o -`.
 fn output_format(args: &Args, reporter: &Reporter) -> Result<Option<Format>, u8> {
     let Some(p) = &args.output else {
         return Ok(None);
     };
-    Format::from_path(p).map(Some).ok_or_else(|| {
+    let named = match &args.format {
+        None => None,
+        Some(f) => {
+            // The format of a file with that extension.
+            let format = Format::from_path(std::path::Path::new(&format!("out.{f}")));
+            if format.is_none() {
+                reporter.error(
+                    &format!("`--format {f}` is not an output format"),
+                    Some("the formats are svg, png, obj and txt"),
+                );
+                return Err(2);
+            }
+            format
+        }
+    };
+    if is_stdout(p) {
+        let format = named.unwrap_or(Format::Svg);
+        if format == Format::Png && std::io::stdout().is_terminal() {
+            reporter.error(
+                "a PNG is not written to a terminal",
+                Some("redirect it (`-o - --format png > out.png`) or name a file: -o out.png"),
+            );
+            return Err(2);
+        }
+        return Ok(Some(format));
+    }
+    if let (Some(named), Some(by_name)) = (named, Format::from_path(p))
+        && named != by_name
+    {
+        reporter.error(
+            &format!(
+                "`--format {}` disagrees with the extension of `{}`",
+                args.format.as_deref().unwrap_or_default(),
+                p.display()
+            ),
+            Some("leave out --format, or give the file the format's extension"),
+        );
+        return Err(2);
+    }
+    named.or_else(|| Format::from_path(p)).map(Some).ok_or_else(|| {
         reporter.error(
             &format!("cannot tell the output format of `{}`", p.display()),
             Some("use a file ending in .svg, .png, .obj or .txt"),
@@ -264,11 +314,12 @@ fn run_system(
     let stats = Stats::new(&derived, &drawn, start.elapsed().as_secs_f64() * 1000.0);
     let wrote = report_stats(args, &stats);
     reporter.info(&format!(
-        "{}: {} modules, {} segments, {} elements after {} steps (derive {:.0} ms, draw {:.0} ms){wrote}",
+        "{}: {} modules, {} segments, {} elements, {} polygons after {} steps (derive {:.0} ms, draw {:.0} ms){wrote}",
         stats.system,
         stats.modules,
         stats.segments,
         stats.elements,
+        stats.polygons,
         stats.steps,
         stats.derive_ms,
         stats.interpret_ms
@@ -288,7 +339,7 @@ fn write_file<T>(
 ) -> Option<T> {
     let mut result = None;
     let mut failed = None;
-    let written = source::write_atomic_with(path, |w| match fill(w) {
+    let fill_or_fail = |w: &mut dyn Write| match fill(w) {
         Ok(v) => {
             result = Some(v);
             Ok(())
@@ -298,7 +349,17 @@ fn write_file<T>(
             failed = Some(d);
             Err(std::io::Error::other("stopped by an error"))
         }
-    });
+    };
+    let written = if is_stdout(path) {
+        // All or nothing on stdout too: the bytes go out once the drawing is complete.
+        let mut bytes = Vec::new();
+        fill_or_fail(&mut bytes).and_then(|()| {
+            let mut out = std::io::stdout().lock();
+            out.write_all(&bytes).and_then(|()| out.flush())
+        })
+    } else {
+        source::write_atomic_with(path, fill_or_fail)
+    };
     if let Some(d) = failed {
         reporter.emit(&[d], &src.name, &src.text);
         return None;
@@ -307,7 +368,7 @@ fn write_file<T>(
         reporter.emit(
             &[Diagnostic::error(
                 Code::WriteOutput,
-                format!("cannot write `{}`: {e}", path.display()),
+                format!("cannot write `{}`: {e}", output_name(path)),
             )],
             &src.name,
             &src.text,
@@ -317,17 +378,39 @@ fn write_file<T>(
     result
 }
 
-/// Prints `--stats` as one JSON object on stdout; returns the ", wrote OUT" part
-/// of the summary line.
+/// Prints `--stats` as one JSON object: on stdout, or on stderr when stdout
+/// carries the drawing (`-o -`). Returns the end of the summary line: where
+/// the output went, or how to write one.
 fn report_stats(args: &Args, stats: &impl serde::Serialize) -> String {
+    let on_stdout = args.output.as_deref().is_some_and(is_stdout);
     if args.stats
         && let Ok(s) = serde_json::to_string(stats)
     {
-        println!("{s}");
+        if on_stdout {
+            eprintln!("{s}");
+        } else {
+            println!("{s}");
+        }
     }
-    args.output
-        .as_ref()
-        .map_or(String::new(), |p| format!(", wrote {}", p.display()))
+    match &args.output {
+        Some(p) => format!(", wrote {}", output_name(p)),
+        None => {
+            let stem = args
+                .file
+                .file_stem()
+                .map_or("out".into(), |s| s.to_string_lossy());
+            format!("; no output written, add -o {stem}.svg to draw it")
+        }
+    }
+}
+
+/// How the summary names an output: `stdout` for `-o -`.
+fn output_name(p: &std::path::Path) -> String {
+    if is_stdout(p) {
+        "stdout".to_string()
+    } else {
+        p.display().to_string()
+    }
 }
 
 fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
@@ -395,12 +478,13 @@ fn run_scene(
     };
     let wrote = report_stats(args, &stats);
     reporter.info(&format!(
-        "scene {}: {} systems, {} modules, {} segments, {} elements, {} queries, {} messages after {} steps{wrote}",
+        "scene {}: {} systems, {} modules, {} segments, {} elements, {} polygons, {} queries, {} messages after {} steps{wrote}",
         stats.scene,
         stats.systems,
         stats.modules,
         stats.segments,
         stats.elements,
+        stats.polygons,
         stats.queries,
         stats.messages,
         stats.steps
