@@ -68,7 +68,8 @@ pub struct Args {
     #[arg(long)]
     pub disasm: bool,
 
-    /// For a scene: also draw the guides' outlines and the links.
+    /// For a scene: also draw the guides' outlines and the links (SVG and PNG;
+    /// OBJ and text hold only what the systems draw).
     #[arg(long)]
     pub guides: bool,
 
