@@ -333,17 +333,12 @@ fn runtime_errors_point_at_the_expression() {
 }
 
 #[test]
-fn an_explosion_stops_quickly_with_a_clear_error() {
+fn an_explosion_stops_with_a_clear_error() {
+    // How quickly it stops is measured by `cargo bench --bench limits`.
     let src = "lsystem Boom { axiom F; F -> FFFFFFFFFF; }";
-    let start = std::time::Instant::now();
     let Err(err) = derive_text(src, Some(40)) else {
         panic!("expected an error");
     };
-    assert!(
-        start.elapsed().as_secs_f64() < 1.0,
-        "took {:?}",
-        start.elapsed()
-    );
     assert!(
         err.contains("error[E0903]") && err.contains("modules"),
         "{err}"
