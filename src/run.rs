@@ -517,7 +517,10 @@ fn scene_png(
             }
         }
         for l in &r.scene.links {
-            let (a, b) = (SceneFrame::edge_mid(r, l.from), SceneFrame::edge_mid(r, l.to));
+            let (a, b) = (
+                SceneFrame::edge_mid(r, l.from),
+                SceneFrame::edge_mid(r, l.to),
+            );
             crate::turtle::Sink::segment(&mut w, a, b, 0.0, 8);
         }
     }

@@ -412,8 +412,14 @@ impl Checker<'_> {
             super::names_in(e, &mut names);
             let mut seen = std::collections::HashSet::new();
             for (n, _) in names.into_iter().filter(|(n, _)| seen.insert(n.clone())) {
-                if let Some(o) = self.consts.get(n.as_str()).and_then(|c| c.overridden.as_ref()) {
-                    d = d.note(format!("`{n}` has its value from `{o}` on the command line"));
+                if let Some(o) = self
+                    .consts
+                    .get(n.as_str())
+                    .and_then(|c| c.overridden.as_ref())
+                {
+                    d = d.note(format!(
+                        "`{n}` has its value from `{o}` on the command line"
+                    ));
                 }
             }
             self.diags.push(d);

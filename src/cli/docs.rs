@@ -50,7 +50,8 @@ pub fn man(args: &ManArgs, reporter: &Reporter) -> u8 {
     if let Err(e) = clap_mangen::Man::new(page)
         .source(format!("lsyc {}", env!("CARGO_PKG_VERSION")))
         .manual("lsyc manual")
-        .render(&mut out) {
+        .render(&mut out)
+    {
         reporter.error(&format!("cannot render the manual page: {e}"), None);
         return 1;
     }

@@ -297,7 +297,9 @@ fn looks_like_svg(text: &str) -> bool {
 
 fn refuse_drawing(name: &str, reporter: &Reporter) {
     let path = std::path::Path::new(name);
-    let stem = path.file_stem().map_or("art".into(), |s| s.to_string_lossy());
+    let stem = path
+        .file_stem()
+        .map_or("art".into(), |s| s.to_string_lossy());
     // Never suggest writing over the drawing itself.
     let out = if path.extension().is_some_and(|e| e == "lsy") {
         format!("{stem}-inferred.lsy")

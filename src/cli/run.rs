@@ -203,13 +203,16 @@ fn output_format(args: &Args, reporter: &Reporter) -> Result<Option<Format>, u8>
         );
         return Err(2);
     }
-    named.or_else(|| Format::from_path(p)).map(Some).ok_or_else(|| {
-        reporter.error(
-            &format!("cannot tell the output format of `{}`", p.display()),
-            Some("use a file ending in .svg, .png, .obj or .txt"),
-        );
-        2
-    })
+    named
+        .or_else(|| Format::from_path(p))
+        .map(Some)
+        .ok_or_else(|| {
+            reporter.error(
+                &format!("cannot tell the output format of `{}`", p.display()),
+                Some("use a file ending in .svg, .png, .obj or .txt"),
+            );
+            2
+        })
 }
 
 /// The PNG background as RGBA.
@@ -315,13 +318,13 @@ fn run_system(
     let stats = Stats::new(&derived, &drawn, start.elapsed().as_secs_f64() * 1000.0);
     let wrote = report_stats(args, &stats);
     reporter.info(&format!(
-        "{}: {} modules, {} segments, {} elements, {} polygons after {} steps (derive {:.0} ms, draw {:.0} ms){wrote}",
+        "{}: {}, {}, {}, {} after {} (derive {:.0} ms, draw {:.0} ms){wrote}",
         stats.system,
-        stats.modules,
-        stats.segments,
-        stats.elements,
-        stats.polygons,
-        stats.steps,
+        count(stats.modules, "module"),
+        count(stats.segments, "segment"),
+        count(stats.elements, "element"),
+        count(stats.polygons, "polygon"),
+        count(stats.steps, "step"),
         stats.derive_ms,
         stats.interpret_ms
     ));
@@ -394,7 +397,8 @@ fn report_stats(args: &Args, stats: &impl serde::Serialize) -> String {
         }
     }
     match &args.output {
-        Some(p) => format!(", wrote {}", output_name(p)),
+        Some(p) if is_stdout(p) => ", wrote it to stdout".to_string(),
+        Some(p) => format!(", wrote {}", p.display()),
         None => {
             let stem = args
                 .file
@@ -402,6 +406,16 @@ fn report_stats(args: &Args, stats: &impl serde::Serialize) -> String {
                 .map_or("out".into(), |s| s.to_string_lossy());
             format!("; no output written, add -o {stem}.svg to draw it")
         }
+    }
+}
+
+/// "1 polygon", "2 polygons", "3 queries".
+fn count(n: impl std::fmt::Display, what: &str) -> String {
+    let n = n.to_string();
+    match (n.as_str(), what.strip_suffix('y')) {
+        ("1", _) => format!("1 {what}"),
+        (_, Some(stem)) => format!("{n} {stem}ies"),
+        _ => format!("{n} {what}s"),
     }
 }
 
@@ -479,16 +493,16 @@ fn run_scene(
     };
     let wrote = report_stats(args, &stats);
     reporter.info(&format!(
-        "scene {}: {} systems, {} modules, {} segments, {} elements, {} polygons, {} queries, {} messages after {} steps{wrote}",
+        "scene {}: {}, {}, {}, {}, {}, {}, {} after {}{wrote}",
         stats.scene,
-        stats.systems,
-        stats.modules,
-        stats.segments,
-        stats.elements,
-        stats.polygons,
-        stats.queries,
-        stats.messages,
-        stats.steps
+        count(stats.systems, "system"),
+        count(stats.modules, "module"),
+        count(stats.segments, "segment"),
+        count(stats.elements, "element"),
+        count(stats.polygons, "polygon"),
+        count(stats.queries, "query"),
+        count(stats.messages, "message"),
+        count(stats.steps, "step")
     ));
     0
 }
