@@ -20,6 +20,9 @@ Examples:
   lsyc run lang-examples/koch-island.lsy -o koch.svg
   lsyc run lang-examples/plant-e.lsy -o plant.png --stats
   lsyc run lang-examples/palm.lsy -o palm.svg --guides
+  lsyc run lang-examples/plant-e.lsy -o - | gzip > plant.svgz   # -o -: stdout
+  lsyc completions bash > ~/.local/share/bash-completion/completions/lsyc
+  lsyc man run | man -l -
   lsyc edit lang-examples/palm.lsy --by trunk3.v2=30,-5 --pin trunk2 --write
   lsyc infer art.svg -o art.lsy
   lsyc infer --skeleton sketch.svg -o tree.lsy

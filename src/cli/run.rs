@@ -159,11 +159,32 @@ fn is_stdout(path: &std::path::Path) -> bool {
     path.as_os_str() == "-"
 }
 
-/// The output format: `--format`, else the output file's extension; SVG for `-o -`.
+/// The output format, from the output file's extension (or `--format`, which
+/// `-o -` needs).
 fn output_format(args: &Args, reporter: &Reporter) -> Result<Option<Format>, u8> {
     let Some(p) = &args.output else {
         return Ok(None);
     };
+    if let Some(format) = requested_format(args, p, reporter)? {
+        return Ok(Some(format));
+    }
+    Format::from_path(p).map(Some).ok_or_else(|| {
+        reporter.error(
+            &format!("cannot tell the output format of `{}`", p.display()),
+            Some("use a file ending in .svg, .png, .obj or .txt"),
+        );
+        2
+    })
+}
+
+/// The format `--format` names, SVG for `-o -` without it, or `None` to go by
+/// the extension; a usage error if `--format` names no format, disagrees with
+/// the file's extension, or asks for a PNG on a terminal.
+fn requested_format(
+    args: &Args,
+    p: &std::path::Path,
+    reporter: &Reporter,
+) -> Result<Option<Format>, u8> {
     let named = match &args.format {
         None => None,
         Some(f) => {
@@ -203,16 +224,7 @@ fn output_format(args: &Args, reporter: &Reporter) -> Result<Option<Format>, u8>
         );
         return Err(2);
     }
-    named
-        .or_else(|| Format::from_path(p))
-        .map(Some)
-        .ok_or_else(|| {
-            reporter.error(
-                &format!("cannot tell the output format of `{}`", p.display()),
-                Some("use a file ending in .svg, .png, .obj or .txt"),
-            );
-            2
-        })
+    Ok(named)
 }
 
 /// The PNG background as RGBA.

@@ -434,7 +434,7 @@ fn steps_out_of_range_get_derives_message() {
     let dir = tempfile::tempdir().expect("tempdir");
     write(dir.path(), "depth.lsy", DEPTH_PROGRAM);
     let mut shown = String::new();
-    for n in ["-1", "2.5", "1000001"] {
+    for n in ["-1", "2.5", "1000001", "4000000000"] {
         let r = run_in(dir.path(), &["run", "depth.lsy", "-n", n]);
         assert_eq!(r.status, 2, "-n {n}: {}", r.stderr);
         assert!(!r.stderr.contains("-- "), "-n {n}: {}", r.stderr);

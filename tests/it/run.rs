@@ -345,6 +345,18 @@ fn an_explosion_stops_with_a_clear_error() {
     );
 }
 
+/// Derive's own limit on steps (the CLI's `-n` stops earlier, as a usage error).
+#[test]
+fn steps_beyond_the_limit_are_an_error() {
+    let Err(err) = derive_text("lsystem Still { axiom F; }", Some(4_000_000_000)) else {
+        panic!("expected an error");
+    };
+    assert!(
+        err.contains("error[E0907]") && err.contains("the most is 1000000"),
+        "{err}"
+    );
+}
+
 #[test]
 fn endless_interpretation_is_an_error() {
     let src = "lsystem I { axiom A; interpret A -> B; interpret B -> A F; }";
