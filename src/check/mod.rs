@@ -352,6 +352,9 @@ impl<'a> Checker<'a> {
                     .min();
                 if let Some(s) = same_letters.or_else(|| suggest(&o.name, names.iter().copied())) {
                     d = d.help(format!("did you mean `{s}`?"));
+                    if let Some(c) = self.consts.get(s) {
+                        d = d.secondary(c.span, format!("`{s}` is declared here"));
+                    }
                 } else if names.is_empty() {
                     d = d.note("the program declares no constants; add `const NAME = VALUE;` to make a value overridable");
                 } else {
