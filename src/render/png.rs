@@ -14,7 +14,8 @@ const BATCH: usize = 4096;
 
 /// An element ready to paint: its outline, fill, and optional stroke colour
 /// with the stroke's width in pixels (the element's `width`, as SVG draws it).
-type Painted = (tiny_skia::Path, [u8; 3], Option<([u8; 3], f32)>);
+/// (`fill "none"`: no fill, as in SVG).
+type Painted = (tiny_skia::Path, Option<[u8; 3]>, Option<([u8; 3], f32)>);
 
 pub struct PngWriter {
     pixmap: Pixmap,
@@ -91,11 +92,10 @@ impl PngWriter {
         let elements = elements
             .iter()
             .map(|e| {
-                let fill = e
-                    .fill
-                    .as_deref()
-                    .and_then(parse_color)
-                    .unwrap_or([63, 127, 58]);
+                let fill = match e.fill.as_deref() {
+                    Some("none") => None,
+                    f => Some(f.and_then(parse_color).unwrap_or([63, 127, 58])),
+                };
                 let width = e.width.unwrap_or(1.0) as f32;
                 let stroke = e
                     .stroke
@@ -226,11 +226,13 @@ impl Sink for PngWriter {
             ((self.max.y - o.y) * k + self.off.y) as f32,
         );
         let mut paint = Paint::default();
-        paint.set_color_rgba8(fill[0], fill[1], fill[2], 255);
         paint.anti_alias = true;
         let path = path.clone();
-        self.pixmap
-            .fill_path(&path, &paint, FillRule::Winding, t, None);
+        if let Some(fill) = fill {
+            paint.set_color_rgba8(fill[0], fill[1], fill[2], 255);
+            self.pixmap
+                .fill_path(&path, &paint, FillRule::Winding, t, None);
+        }
         if let Some((s, width)) = *stroke {
             paint.set_color_rgba8(s[0], s[1], s[2], 255);
             let stroke = Stroke {

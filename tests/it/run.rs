@@ -556,3 +556,34 @@ fn png_guides_draw_links() {
     let with = red_pixels(true);
     assert!(with > 500, "{with} link pixels");
 }
+
+/// An element's `width` is in pixels of the picture in PNG as in SVG
+/// (`non-scaling-stroke`): an outline of width 4 covers about four times the
+/// pixels of width 1, and width 0 draws no outline.
+#[test]
+fn png_element_width_is_in_pixels() {
+    let inked = |width: &str| {
+        let src = format!(
+            "element A {{ path \"M0 0 C18 15 -18 40 0 60\"; stroke \"#000000\"; fill \"none\"; width {width}; }}\nlsystem W {{ axiom A; }}"
+        );
+        let d = derive_text(&src, None).expect("derives");
+        let mut png = Vec::new();
+        let picture = Picture {
+            size: 200,
+            ..Picture::default()
+        };
+        if run::write_output(&d, Format::Png, picture, 0, &mut png).is_err() {
+            panic!("draws");
+        }
+        let pixmap = tiny_skia::Pixmap::decode_png(&png).expect("a PNG");
+        pixmap.pixels().iter().filter(|p| p.red() < 128).count()
+    };
+    let (none, one, four) = (inked("0"), inked("1"), inked("4"));
+    assert_eq!(none, 0);
+    assert!(one > 50, "{one} pixels at width 1");
+    let ratio = four as f64 / one as f64;
+    assert!(
+        (3.0..5.5).contains(&ratio),
+        "width 4: {four}, width 1: {one}"
+    );
+}
