@@ -490,7 +490,8 @@ fn scene_svg(
     Ok(())
 }
 
-/// A scene as PNG, guide outlines drawn as hairlines.
+/// A scene as PNG; with `guides`, the outlines and links drawn as hairlines
+/// in the colours SVG gives them (palette 10 and 8).
 fn scene_png(
     r: &SceneRun,
     frame: &SceneFrame,
@@ -514,6 +515,13 @@ fn scene_png(
             for i in 0..pts.len() {
                 crate::turtle::Sink::segment(&mut w, pts[i], pts[(i + 1) % pts.len()], 0.0, 10);
             }
+        }
+        for l in &r.scene.links {
+            let (a, b) = (
+                SceneFrame::edge_mid(r, l.from),
+                SceneFrame::edge_mid(r, l.to),
+            );
+            crate::turtle::Sink::segment(&mut w, a, b, 0.0, 8);
         }
     }
     let bytes = w.finish().map_err(std::io::Error::other)?;

@@ -149,7 +149,7 @@ pub struct Drawn {
     pub elements: u64,
     pub polygons: u64,
     /// [min x, min y, max x, max y] of drawn geometry (segments, polygon points,
-    /// element origins); `None` when nothing was drawn.
+    /// element outlines by their control points); `None` when nothing was drawn.
     pub bbox: Option<[f64; 4]>,
 }
 
@@ -216,6 +216,15 @@ pub fn interpret_limited(
             cos: 1.0,
         },
         cands: Vec::new(),
+        element_boxes: prog
+            .elements
+            .iter()
+            .map(|e| {
+                crate::path::parse(&e.path)
+                    .ok()
+                    .and_then(|p| crate::path::control_bounds(&p))
+            })
+            .collect(),
     };
     let has_interp = prog.interpret.iter().any(|r| !r.is_empty());
     let mut p = 0usize;
@@ -253,6 +262,8 @@ struct Turtle<'a> {
     max_modules: usize,
     /// Modules the current module of the string has expanded into.
     expanded_here: usize,
+    /// Each element's outline box in its own frame, for `Drawn::bbox`.
+    element_boxes: Vec<Option<[f64; 4]>>,
 }
 
 impl Turtle<'_> {
@@ -430,8 +441,14 @@ impl Turtle<'_> {
             }
             Action::Element(i) => {
                 self.drawn.elements += 1;
-                self.drawn.grow(self.state.pos);
                 let st = self.state;
+                self.drawn.grow(st.pos);
+                if let Some(&Some(b)) = self.element_boxes.get(i as usize) {
+                    // The outline's box, placed as the sinks place the element.
+                    for (x, y) in [(b[0], b[1]), (b[2], b[1]), (b[0], b[3]), (b[2], b[3])] {
+                        self.drawn.grow(st.pos + (-st.l * x + st.h * y) * st.scale);
+                    }
+                }
                 self.sink.element(i, st.pos, st.h, st.l, st.scale, st.color);
             }
             Action::Query(kind) => {

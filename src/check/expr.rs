@@ -405,10 +405,24 @@ impl Checker<'_> {
             } else {
                 format!("a whole number from {lo} to {hi}")
             };
-            self.diags.push(
-                Diagnostic::error(Code::OutOfRange, format!("{what} must be {range}"))
-                    .primary(e.span, format!("this is {v}")),
-            );
+            let mut d = Diagnostic::error(Code::OutOfRange, format!("{what} must be {range}"))
+                .primary(e.span, format!("this is {v}"));
+            // A value from the command line: say which `-D` gave it.
+            let mut names = Vec::new();
+            super::names_in(e, &mut names);
+            let mut seen = std::collections::HashSet::new();
+            for (n, _) in names.into_iter().filter(|(n, _)| seen.insert(n.clone())) {
+                if let Some(o) = self
+                    .consts
+                    .get(n.as_str())
+                    .and_then(|c| c.overridden.as_ref())
+                {
+                    d = d.note(format!(
+                        "`{n}` has its value from `{o}` on the command line"
+                    ));
+                }
+            }
+            self.diags.push(d);
             return None;
         }
         Some(v as i64)

@@ -87,6 +87,8 @@ struct ConstInfo<'a> {
     value: Option<Value>,
     /// Drawn from the run's generator (directly or through another constant).
     random: bool,
+    /// The `-D NAME=VALUE` that gave it its value, if one did.
+    overridden: Option<String>,
 }
 
 struct ModuleInfo {
@@ -272,6 +274,7 @@ impl<'a> Checker<'a> {
                     ty: Ty::Err,
                     value: None,
                     random: false,
+                    overridden: None,
                 },
             );
         }
@@ -320,6 +323,9 @@ impl<'a> Checker<'a> {
                 && let Some(v) = self.override_value(o, ty, decl.value.span)
             {
                 (value, random) = (Some(v), false);
+                if let Some(info) = self.consts.get_mut(n) {
+                    info.overridden = Some(format!("-D {}={}", o.name, o.value));
+                }
             }
             if let Some(info) = self.consts.get_mut(n) {
                 info.ty = ty;
@@ -338,8 +344,17 @@ impl<'a> Checker<'a> {
                     format!("`-D {}`: the program has no constant `{}`", o.name, o.name),
                 );
                 let names: Vec<&str> = self.consts.keys().copied().collect();
-                if let Some(s) = suggest(&o.name, names.iter().copied()) {
+                // `-D depth=3` for `DEPTH`: the case alone differs, whatever the length.
+                let same_letters = names
+                    .iter()
+                    .copied()
+                    .filter(|n| n.eq_ignore_ascii_case(&o.name))
+                    .min();
+                if let Some(s) = same_letters.or_else(|| suggest(&o.name, names.iter().copied())) {
                     d = d.help(format!("did you mean `{s}`?"));
+                    if let Some(c) = self.consts.get(s) {
+                        d = d.secondary(c.span, format!("`{s}` is declared here"));
+                    }
                 } else if names.is_empty() {
                     d = d.note("the program declares no constants; add `const NAME = VALUE;` to make a value overridable");
                 } else {

@@ -3,7 +3,7 @@
 use super::{Reporter, summary};
 use lsyc::check::Override;
 use lsyc::diagnostic::{Code, Diagnostic};
-use lsyc::{frontend, source};
+use lsyc::frontend;
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -40,13 +40,9 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     };
     let mut status = 0;
     for path in &args.files {
-        let src = match source::read(path) {
-            Ok(s) => s,
-            Err(d) => {
-                reporter.emit(&[d], &path.display().to_string(), "");
-                status = 1;
-                continue;
-            }
+        let Some(src) = super::read_program(path, reporter) else {
+            status = 1;
+            continue;
         };
         let fe = frontend::run(&src.text, src.diagnostics, &ovr);
         reporter.emit(&fe.diagnostics, &src.name, &src.text);

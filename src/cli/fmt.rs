@@ -23,13 +23,9 @@ pub struct Args {
 pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     let mut status = 0;
     for path in &args.files {
-        let src = match source::read(path) {
-            Ok(s) => s,
-            Err(d) => {
-                reporter.emit(&[d], &path.display().to_string(), "");
-                status = 1;
-                continue;
-            }
+        let Some(src) = super::read_program(path, reporter) else {
+            status = 1;
+            continue;
         };
         let parsed = parser::parse(&src.text);
         let mut diags = src.diagnostics;

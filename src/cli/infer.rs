@@ -26,7 +26,7 @@ pub struct Args {
     #[arg(long, value_name = "SKETCH.svg", conflicts_with = "art")]
     pub skeleton: Option<PathBuf>,
 
-    /// Where to write the program (default: stdout).
+    /// Where to write the program (default, or `-o -`: stdout).
     #[arg(short = 'o', long = "output", value_name = "OUT.lsy")]
     pub output: Option<PathBuf>,
 
@@ -67,7 +67,7 @@ pub struct Args {
     #[arg(long, conflicts_with = "skeleton")]
     pub reflect: bool,
 
-    /// Print what was found as JSON on stderr (line drawings: steps, angle, candidates, rules, times; elements: elements, kinds, clusters, rules, time per phase, program size over SVG size).
+    /// Print what was found as JSON: on stdout, or on stderr when the program itself goes to stdout (no -o, or -o -) (line drawings: steps, angle, candidates, rules, times; elements: elements, kinds, clusters, rules, time per phase, program size over SVG size).
     #[arg(long)]
     pub stats: bool,
 
@@ -143,10 +143,8 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         };
         match lines::from_svg(&data, &name, &opts) {
             Lines::Found(found) => {
-                if args.stats
-                    && let Ok(json) = serde_json::to_string(&found.stats)
-                {
-                    eprintln!("{json}");
+                if args.stats {
+                    print_stats(args, &found.stats);
                 }
                 let g = &found.grammar;
                 let summary = format!(
@@ -164,10 +162,8 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
                 timed_out,
                 stats,
             } => {
-                if args.stats
-                    && let Ok(json) = serde_json::to_string(&stats)
-                {
-                    eprintln!("{json}");
+                if args.stats {
+                    print_stats(args, &stats);
                 }
                 let what = if steps > 0 {
                     format!("a line drawing of {steps} steps")
@@ -224,11 +220,8 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
             "{name}: skipped {s} (only paths and shapes are elements)"
         ));
     }
-    if args.stats
-        && let Ok(json) = serde_json::to_string(&inferred.stats)
-    {
-        // Already one JSON object: the same line in either error format.
-        eprintln!("{json}");
+    if args.stats {
+        print_stats(args, &inferred.stats);
     }
     let st = &inferred.stats;
     let summary = format!(
@@ -240,6 +233,25 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         if st.rules == 1 { "" } else { "s" },
     );
     write_program(args.output.as_deref(), &inferred.text, &summary, reporter)
+}
+
+/// Whether the program goes to stdout (no `-o`, or `-o -`).
+fn program_on_stdout(out: Option<&std::path::Path>) -> bool {
+    out.is_none_or(|p| p.as_os_str() == "-")
+}
+
+/// `--stats` as one JSON object, by the rule `lsyc run` follows too: on
+/// stdout, unless stdout carries the result itself (then on stderr, where it
+/// is the same line in either error format).
+fn print_stats(args: &Args, stats: &impl serde::Serialize) {
+    let Ok(json) = serde_json::to_string(stats) else {
+        return;
+    };
+    if program_on_stdout(args.output.as_deref()) {
+        eprintln!("{json}");
+    } else {
+        println!("{json}");
+    }
 }
 
 fn parse_weights(text: &str) -> Result<Weights, String> {
@@ -270,7 +282,7 @@ fn same_as_input(
     what: &str,
     reporter: &Reporter,
 ) -> Option<u8> {
-    let out = out?;
+    let out = out.filter(|p| !program_on_stdout(Some(p)))?;
     let same = match (std::fs::canonicalize(out), std::fs::canonicalize(input)) {
         (Ok(a), Ok(b)) => a == b,
         _ => false,
@@ -312,7 +324,7 @@ fn write_program(
     summary: &str,
     reporter: &Reporter,
 ) -> u8 {
-    match out {
+    match out.filter(|p| !program_on_stdout(Some(p))) {
         Some(out) => {
             if let Err(e) = source::write_atomic(out, text.as_bytes()) {
                 reporter.error(&format!("cannot write `{}`: {e}", out.display()), None);

@@ -4,6 +4,7 @@
 //! error) and where output goes: results on stdout, diagnostics on stderr.
 
 mod check;
+mod docs;
 mod edit;
 mod fmt;
 mod infer;
@@ -19,6 +20,9 @@ Examples:
   lsyc run lang-examples/koch-island.lsy -o koch.svg
   lsyc run lang-examples/plant-e.lsy -o plant.png --stats
   lsyc run lang-examples/palm.lsy -o palm.svg --guides
+  lsyc run lang-examples/plant-e.lsy -o - | gzip > plant.svgz   # -o -: stdout
+  lsyc completions bash > ~/.local/share/bash-completion/completions/lsyc
+  lsyc man run | man -l -
   lsyc edit lang-examples/palm.lsy --by trunk3.v2=30,-5 --pin trunk2 --write
   lsyc infer art.svg -o art.lsy
   lsyc infer --skeleton sketch.svg -o tree.lsy
@@ -84,6 +88,16 @@ pub enum Command {
         after_help = "Examples:\n  lsyc edit palm.lsy --move frond4.v4=100,480 --pin trunk1\n  lsyc edit palm.lsy --by trunk3.v2=30,-5 --pin trunk2\n  lsyc edit palm.lsy --pin trunk1 --translate frond1=10,0 --rotate frond1=15 --write"
     )]
     Edit(edit::Args),
+    /// Print a shell completion script: bash, zsh, fish, elvish or powershell.
+    #[command(
+        after_help = "Examples:\n  lsyc completions bash > ~/.local/share/bash-completion/completions/lsyc\n  lsyc completions zsh > ~/.zfunc/_lsyc\n  lsyc completions fish > ~/.config/fish/completions/lsyc.fish"
+    )]
+    Completions(docs::CompletionsArgs),
+    /// Print a manual page (roff), generated from this command line's own help.
+    #[command(
+        after_help = "Examples:\n  lsyc man | man -l -\n  lsyc man run | man -l -\n  lsyc man > lsyc.1"
+    )]
+    Man(docs::ManArgs),
 }
 
 /// Where diagnostics go and how they look.
@@ -221,6 +235,8 @@ pub fn main() -> ExitCode {
         Command::Run(args) => run::run(args, &reporter),
         Command::Infer(args) => infer::run(args, &reporter),
         Command::Edit(args) => edit::run(args, &reporter),
+        Command::Completions(args) => docs::completions(args, &reporter),
+        Command::Man(args) => docs::man(args, &reporter),
     };
     ExitCode::from(status)
 }
@@ -246,4 +262,57 @@ pub fn summary(diags: &[Diagnostic]) -> String {
         (e, 0) => part(e, "error"),
         (e, w) => format!("{}, {}", part(e, "error"), part(w, "warning")),
     }
+}
+
+/// Reads a program for `run`, `check` and `fmt`, reporting why not (exit 1):
+/// a file that cannot be read, or a drawing given where a program belongs (one
+/// clear error pointing at `lsyc infer`, not a cascade of parse errors).
+pub fn read_program(path: &std::path::Path, reporter: &Reporter) -> Option<lsyc::source::Source> {
+    let name = path.display().to_string();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if matches!(ext.as_deref(), Some("svg" | "svgz")) {
+        refuse_drawing(&name, reporter);
+        return None;
+    }
+    let src = match lsyc::source::read(path) {
+        Ok(s) => s,
+        Err(d) => {
+            reporter.emit(&[d], &name, "");
+            return None;
+        }
+    };
+    if looks_like_svg(&src.text) {
+        refuse_drawing(&name, reporter);
+        return None;
+    }
+    Some(src)
+}
+
+/// Whether a text is an SVG document: it starts (after a byte-order mark and
+/// blank space) with an XML declaration, an SVG doctype or an `<svg` element.
+fn looks_like_svg(text: &str) -> bool {
+    let t = text.trim_start_matches('\u{feff}').trim_start();
+    t.starts_with("<?xml") || t.starts_with("<svg") || t.starts_with("<!DOCTYPE svg")
+}
+
+fn refuse_drawing(name: &str, reporter: &Reporter) {
+    let path = std::path::Path::new(name);
+    let stem = path
+        .file_stem()
+        .map_or("art".into(), |s| s.to_string_lossy());
+    // Never suggest writing over the drawing itself.
+    let out = if path.extension().is_some_and(|e| e == "lsy") {
+        format!("{stem}-inferred.lsy")
+    } else {
+        format!("{stem}.lsy")
+    };
+    reporter.error(
+        &format!("`{name}` is a drawing (SVG), not an .lsy program"),
+        Some(&format!(
+            "to turn a drawing into a program, run `lsyc infer {name} -o {out}`"
+        )),
+    );
 }

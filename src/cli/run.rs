@@ -14,15 +14,21 @@ pub struct Args {
     /// The .lsy program to run.
     pub file: PathBuf,
 
-    /// Derivation steps (default: the program's `derive`).
-    #[arg(short = 'n', long = "steps", value_name = "STEPS")]
+    /// Derivation steps, 0 to 1000000 (default: the program's `derive`).
+    #[arg(short = 'n', long = "steps", value_name = "STEPS", allow_negative_numbers = true, value_parser = parse_steps)]
     pub steps: Option<u32>,
 
-    /// Output file; its extension picks the format: .svg .png .obj .txt
+    /// Output file; its extension picks the format: .svg .png .obj .txt;
+    /// `-o -` writes to stdout (SVG unless --format says otherwise).
     #[arg(short = 'o', long = "output", value_name = "OUT")]
     pub output: Option<PathBuf>,
 
-    /// Print statistics as one JSON object on stdout.
+    /// The output format when the extension cannot say (`-o -`): svg, png, obj or txt.
+    #[arg(long, value_name = "FORMAT", requires = "output")]
+    pub format: Option<String>,
+
+    /// Print statistics as one JSON object on stdout (on stderr when the drawing
+    /// itself goes to stdout with `-o -`).
     #[arg(long)]
     pub stats: bool,
 
@@ -62,7 +68,8 @@ pub struct Args {
     #[arg(long)]
     pub disasm: bool,
 
-    /// For a scene: also draw the guides' outlines and the links.
+    /// For a scene: also draw the guides' outlines and the links (SVG and PNG;
+    /// OBJ and text hold only what the systems draw).
     #[arg(long)]
     pub guides: bool,
 
@@ -75,6 +82,18 @@ pub struct Args {
     /// to the element's size, in the drawing's colours); repeatable.
     #[arg(long = "element", value_name = "NAME=FILE.svg")]
     pub elements: Vec<String>,
+}
+
+/// `-n STEPS`: a whole number within derive's own limit, with derive's message.
+fn parse_steps(text: &str) -> Result<u32, String> {
+    let max = lsyc::derive::MAX_STEPS;
+    text.trim()
+        .parse::<u32>()
+        .ok()
+        .filter(|&n| n <= max)
+        .ok_or_else(|| {
+            format!("the number of derivation steps must be a whole number from 0 to {max}")
+        })
 }
 
 pub fn run(args: &Args, reporter: &Reporter) -> u8 {
@@ -135,11 +154,20 @@ fn run_inner(args: &Args, reporter: &Reporter) -> Result<(), u8> {
     run_system(args, reporter, &src, &fe, &opts, format, background)
 }
 
-/// The output format, from the output file's extension.
+/// Whether an output path means stdout (`-o -`).
+fn is_stdout(path: &std::path::Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// The output format, from the output file's extension (or `--format`, which
+/// `-o -` needs).
 fn output_format(args: &Args, reporter: &Reporter) -> Result<Option<Format>, u8> {
     let Some(p) = &args.output else {
         return Ok(None);
     };
+    if let Some(format) = requested_format(args, p, reporter)? {
+        return Ok(Some(format));
+    }
     Format::from_path(p).map(Some).ok_or_else(|| {
         reporter.error(
             &format!("cannot tell the output format of `{}`", p.display()),
@@ -147,6 +175,56 @@ fn output_format(args: &Args, reporter: &Reporter) -> Result<Option<Format>, u8>
         );
         2
     })
+}
+
+/// The format `--format` names, SVG for `-o -` without it, or `None` to go by
+/// the extension; a usage error if `--format` names no format, disagrees with
+/// the file's extension, or asks for a PNG on a terminal.
+fn requested_format(
+    args: &Args,
+    p: &std::path::Path,
+    reporter: &Reporter,
+) -> Result<Option<Format>, u8> {
+    let named = match &args.format {
+        None => None,
+        Some(f) => {
+            // The format of a file with that extension.
+            let format = Format::from_path(std::path::Path::new(&format!("out.{f}")));
+            if format.is_none() {
+                reporter.error(
+                    &format!("`--format {f}` is not an output format"),
+                    Some("the formats are svg, png, obj and txt"),
+                );
+                return Err(2);
+            }
+            format
+        }
+    };
+    if is_stdout(p) {
+        let format = named.unwrap_or(Format::Svg);
+        if format == Format::Png && std::io::stdout().is_terminal() {
+            reporter.error(
+                "a PNG is not written to a terminal",
+                Some("redirect it (`-o - --format png > out.png`) or name a file: -o out.png"),
+            );
+            return Err(2);
+        }
+        return Ok(Some(format));
+    }
+    if let (Some(named), Some(by_name)) = (named, Format::from_path(p))
+        && named != by_name
+    {
+        reporter.error(
+            &format!(
+                "`--format {}` disagrees with the extension of `{}`",
+                args.format.as_deref().unwrap_or_default(),
+                p.display()
+            ),
+            Some("leave out --format, or give the file the format's extension"),
+        );
+        return Err(2);
+    }
+    Ok(named)
 }
 
 /// The PNG background as RGBA.
@@ -173,10 +251,7 @@ fn load(
     ovr: &[lsyc::check::Override],
     reporter: &Reporter,
 ) -> Result<(source::Source, frontend::Frontend), u8> {
-    let src = source::read(&args.file).map_err(|d| {
-        reporter.emit(&[d], &args.file.display().to_string(), "");
-        1u8
-    })?;
+    let src = super::read_program(&args.file, reporter).ok_or(1u8)?;
     if let Some(out) = &args.output
         && same_file(out, &args.file)
     {
@@ -255,12 +330,13 @@ fn run_system(
     let stats = Stats::new(&derived, &drawn, start.elapsed().as_secs_f64() * 1000.0);
     let wrote = report_stats(args, &stats);
     reporter.info(&format!(
-        "{}: {} modules, {} segments, {} elements after {} steps (derive {:.0} ms, draw {:.0} ms){wrote}",
+        "{}: {}, {}, {}, {} after {} (derive {:.0} ms, draw {:.0} ms){wrote}",
         stats.system,
-        stats.modules,
-        stats.segments,
-        stats.elements,
-        stats.steps,
+        count(stats.modules, "module"),
+        count(stats.segments, "segment"),
+        count(stats.elements, "element"),
+        count(stats.polygons, "polygon"),
+        count(stats.steps, "step"),
         stats.derive_ms,
         stats.interpret_ms
     ));
@@ -279,7 +355,7 @@ fn write_file<T>(
 ) -> Option<T> {
     let mut result = None;
     let mut failed = None;
-    let written = source::write_atomic_with(path, |w| match fill(w) {
+    let fill_or_fail = |w: &mut dyn Write| match fill(w) {
         Ok(v) => {
             result = Some(v);
             Ok(())
@@ -289,7 +365,17 @@ fn write_file<T>(
             failed = Some(d);
             Err(std::io::Error::other("stopped by an error"))
         }
-    });
+    };
+    let written = if is_stdout(path) {
+        // All or nothing on stdout too: the bytes go out once the drawing is complete.
+        let mut bytes = Vec::new();
+        fill_or_fail(&mut bytes).and_then(|()| {
+            let mut out = std::io::stdout().lock();
+            out.write_all(&bytes).and_then(|()| out.flush())
+        })
+    } else {
+        source::write_atomic_with(path, fill_or_fail)
+    };
     if let Some(d) = failed {
         reporter.emit(&[d], &src.name, &src.text);
         return None;
@@ -298,7 +384,7 @@ fn write_file<T>(
         reporter.emit(
             &[Diagnostic::error(
                 Code::WriteOutput,
-                format!("cannot write `{}`: {e}", path.display()),
+                format!("cannot write `{}`: {e}", output_name(path)),
             )],
             &src.name,
             &src.text,
@@ -308,17 +394,50 @@ fn write_file<T>(
     result
 }
 
-/// Prints `--stats` as one JSON object on stdout; returns the ", wrote OUT" part
-/// of the summary line.
+/// Prints `--stats` as one JSON object: on stdout, or on stderr when stdout
+/// carries the drawing (`-o -`). Returns the end of the summary line: where
+/// the output went, or how to write one.
 fn report_stats(args: &Args, stats: &impl serde::Serialize) -> String {
+    let on_stdout = args.output.as_deref().is_some_and(is_stdout);
     if args.stats
         && let Ok(s) = serde_json::to_string(stats)
     {
-        println!("{s}");
+        if on_stdout {
+            eprintln!("{s}");
+        } else {
+            println!("{s}");
+        }
     }
-    args.output
-        .as_ref()
-        .map_or(String::new(), |p| format!(", wrote {}", p.display()))
+    match &args.output {
+        Some(p) if is_stdout(p) => ", wrote it to stdout".to_string(),
+        Some(p) => format!(", wrote {}", p.display()),
+        None => {
+            let stem = args
+                .file
+                .file_stem()
+                .map_or("out".into(), |s| s.to_string_lossy());
+            format!("; no output written, add -o {stem}.svg to draw it")
+        }
+    }
+}
+
+/// "1 polygon", "2 polygons", "3 queries".
+fn count(n: impl std::fmt::Display, what: &str) -> String {
+    let n = n.to_string();
+    match (n.as_str(), what.strip_suffix('y')) {
+        ("1", _) => format!("1 {what}"),
+        (_, Some(stem)) => format!("{n} {stem}ies"),
+        _ => format!("{n} {what}s"),
+    }
+}
+
+/// How the summary names an output: `stdout` for `-o -`.
+fn output_name(p: &std::path::Path) -> String {
+    if is_stdout(p) {
+        "stdout".to_string()
+    } else {
+        p.display().to_string()
+    }
 }
 
 fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
@@ -386,15 +505,16 @@ fn run_scene(
     };
     let wrote = report_stats(args, &stats);
     reporter.info(&format!(
-        "scene {}: {} systems, {} modules, {} segments, {} elements, {} queries, {} messages after {} steps{wrote}",
+        "scene {}: {}, {}, {}, {}, {}, {}, {} after {}{wrote}",
         stats.scene,
-        stats.systems,
-        stats.modules,
-        stats.segments,
-        stats.elements,
-        stats.queries,
-        stats.messages,
-        stats.steps
+        count(stats.systems, "system"),
+        count(stats.modules, "module"),
+        count(stats.segments, "segment"),
+        count(stats.elements, "element"),
+        count(stats.polygons, "polygon"),
+        count(stats.queries, "query"),
+        count(stats.messages, "message"),
+        count(stats.steps, "step")
     ));
     0
 }

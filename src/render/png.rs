@@ -12,8 +12,10 @@ use tiny_skia::{
 /// Segments batched into one path before it is stroked.
 const BATCH: usize = 4096;
 
-/// An element ready to paint: its outline, fill and optional stroke colour.
-type Painted = (tiny_skia::Path, [u8; 3], Option<[u8; 3]>);
+/// An element ready to paint: its outline, fill, and optional stroke colour
+/// with the stroke's width in pixels (the element's `width`, as SVG draws it).
+/// (`fill "none"`: no fill, as in SVG).
+type Painted = (tiny_skia::Path, Option<[u8; 3]>, Option<([u8; 3], f32)>);
 
 pub struct PngWriter {
     pixmap: Pixmap,
@@ -90,12 +92,17 @@ impl PngWriter {
         let elements = elements
             .iter()
             .map(|e| {
-                let fill = e
-                    .fill
+                let fill = match e.fill.as_deref() {
+                    Some("none") => None,
+                    f => Some(f.and_then(parse_color).unwrap_or([63, 127, 58])),
+                };
+                let width = e.width.unwrap_or(1.0) as f32;
+                let stroke = e
+                    .stroke
                     .as_deref()
                     .and_then(parse_color)
-                    .unwrap_or([63, 127, 58]);
-                let stroke = e.stroke.as_deref().and_then(parse_color);
+                    .filter(|_| width > 0.0)
+                    .map(|c| (c, width));
                 element_path(&e.path).map(|p| (p, fill, stroke))
             })
             .collect();
@@ -218,19 +225,23 @@ impl Sink for PngWriter {
             ((o.x - self.min.x) * k + self.off.x) as f32,
             ((self.max.y - o.y) * k + self.off.y) as f32,
         );
-        let mut paint = Paint::default();
-        paint.set_color_rgba8(fill[0], fill[1], fill[2], 255);
-        paint.anti_alias = true;
+        let mut paint = Paint {
+            anti_alias: true,
+            ..Paint::default()
+        };
         let path = path.clone();
-        self.pixmap
-            .fill_path(&path, &paint, FillRule::Winding, t, None);
-        if let Some(s) = stroke {
+        if let Some(fill) = fill {
+            paint.set_color_rgba8(fill[0], fill[1], fill[2], 255);
+            self.pixmap
+                .fill_path(&path, &paint, FillRule::Winding, t, None);
+        }
+        if let Some((s, width)) = *stroke {
             paint.set_color_rgba8(s[0], s[1], s[2], 255);
             let stroke = Stroke {
-                width: 1.0,
+                width,
                 ..Stroke::default()
             };
-            // A hairline in pixels: stroke the transformed path.
+            // A width in pixels: stroke the transformed path.
             if let Some(p) = path.transform(t) {
                 self.pixmap
                     .stroke_path(&p, &paint, &stroke, Transform::identity(), None);

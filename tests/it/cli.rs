@@ -350,3 +350,301 @@ fn json_mode_writes_only_json_lines() {
         }
     }
 }
+
+/// Runs lsyc in `dir`, so that messages name files as given (relative) and
+/// snapshots hold no machine paths.
+fn run_in(dir: &Path, args: &[&str]) -> Run {
+    let out = Command::new(env!("CARGO_BIN_EXE_lsyc"))
+        .args(args)
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("the lsyc binary runs");
+    Run {
+        status: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// The raw stdout of a run in `dir` (for binary formats).
+fn stdout_bytes_in(dir: &Path, args: &[&str]) -> Vec<u8> {
+    let out = Command::new(env!("CARGO_BIN_EXE_lsyc"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the lsyc binary runs");
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out.stdout
+}
+
+/// Summary lines carry timings; a snapshot shows them as `N ms`.
+fn scrub_ms(text: &str) -> String {
+    let mut out = String::new();
+    for line in text.lines() {
+        let words: Vec<&str> = line.split(' ').collect();
+        let mut kept = Vec::new();
+        for (i, w) in words.iter().enumerate() {
+            let next_is_ms = words.get(i + 1).is_some_and(|n| n.starts_with("ms"));
+            if next_is_ms && w.chars().all(|c| c.is_ascii_digit()) {
+                kept.push("N");
+            } else {
+                kept.push(w);
+            }
+        }
+        out.push_str(&kept.join(" "));
+        out.push('\n');
+    }
+    out
+}
+
+const DEPTH_PROGRAM: &str = "const DEPTH = 4;\nconst turn = 90;\nlsystem A {\n    angle turn;\n    derive DEPTH;\n    axiom F;\n    F -> F+F;\n}\n";
+
+/// `-D depth=3` when the constant is `DEPTH`: a difference of case alone gets a
+/// "did you mean", however long the name; `-D DEPTH=3.5` for a constant used as
+/// a count is an error whose note names the `-D`.
+#[test]
+fn overrides_suggest_by_case_and_name_their_source() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    write(dir.path(), "depth.lsy", DEPTH_PROGRAM);
+    let case = run_in(dir.path(), &["check", "depth.lsy", "-D", "depth=3"]);
+    assert_eq!(case.status, 1, "{}", case.stderr);
+    let fraction = run_in(dir.path(), &["check", "depth.lsy", "-D", "DEPTH=3.5"]);
+    assert_eq!(fraction.status, 1, "{}", fraction.stderr);
+    // A fraction is fine where any number is.
+    let angle = run_in(dir.path(), &["check", "depth.lsy", "-D", "turn=22.5"]);
+    assert_eq!(angle.status, 0, "{}", angle.stderr);
+    insta::assert_snapshot!(
+        "override_case_and_fraction",
+        format!(
+            "$ lsyc check depth.lsy -D depth=3\n{}\n$ lsyc check depth.lsy -D DEPTH=3.5\n{}",
+            case.stderr, fraction.stderr
+        )
+    );
+}
+
+/// `-n` takes a whole number within derive's own limit, with derive's message
+/// (not clap's tip about `-- -1`), as a usage error.
+#[test]
+fn steps_out_of_range_get_derives_message() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    write(dir.path(), "depth.lsy", DEPTH_PROGRAM);
+    let mut shown = String::new();
+    for n in ["-1", "2.5", "1000001", "4000000000"] {
+        let r = run_in(dir.path(), &["run", "depth.lsy", "-n", n]);
+        assert_eq!(r.status, 2, "-n {n}: {}", r.stderr);
+        assert!(!r.stderr.contains("-- "), "-n {n}: {}", r.stderr);
+        shown.push_str(&format!("$ lsyc run depth.lsy -n {n}\n{}\n", r.stderr));
+    }
+    insta::assert_snapshot!("steps_out_of_range", shown);
+    let r = run_in(dir.path(), &["run", "depth.lsy", "-n", "0"]);
+    assert_eq!(r.status, 0, "{}", r.stderr);
+}
+
+/// A drawing given to `run`, `check` or `fmt` (by its extension, or by its
+/// first bytes) is one clear error pointing at `lsyc infer`, not a cascade of
+/// parse errors.
+#[test]
+fn a_drawing_given_as_a_program() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let svg = "<?xml version=\"1.0\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 10 10\">\n  <path d=\"M0 0 L5 5\"/>\n</svg>\n";
+    write(dir.path(), "leaf.svg", svg);
+    write(dir.path(), "named.lsy", svg);
+    write(
+        dir.path(),
+        "bare.lsy",
+        "\u{feff}  <svg viewBox=\"0 0 1 1\"></svg>\n",
+    );
+    let mut shown = String::new();
+    for args in [
+        ["run", "leaf.svg"],
+        ["check", "leaf.svg"],
+        ["fmt", "leaf.svg"],
+        ["check", "named.lsy"],
+        ["fmt", "bare.lsy"],
+    ] {
+        let r = run_in(dir.path(), &args);
+        assert_eq!(r.status, 1, "{args:?}: {}", r.stderr);
+        assert!(!r.stderr.contains("E0"), "{args:?}: {}", r.stderr);
+        assert_eq!(r.stderr.lines().count(), 2, "{args:?}: {}", r.stderr);
+        shown.push_str(&format!("$ lsyc {}\n{}\n", args.join(" "), r.stderr));
+    }
+    insta::assert_snapshot!("drawing_as_program", shown);
+}
+
+/// `-o -` writes every format to stdout, byte for byte what `-o FILE` writes:
+/// SVG by default, the others by `--format`; `infer -o -` is the program.
+#[test]
+fn dash_o_writes_to_stdout() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    write(
+        d,
+        "plant.lsy",
+        "lsystem P {\n    angle 25;\n    derive 3;\n    axiom X;\n    X -> F[+X][-X]{.+F.-F.F.}FX;\n    F -> FF;\n}\n",
+    );
+    for (format, ext) in [
+        (None, "svg"),
+        (Some("svg"), "svg"),
+        (Some("txt"), "txt"),
+        (Some("obj"), "obj"),
+        (Some("png"), "png"),
+    ] {
+        let file = format!("plant.{ext}");
+        let r = run_in(d, &["run", "plant.lsy", "-o", &file]);
+        assert_eq!(r.status, 0, "{}", r.stderr);
+        let mut args = vec!["run", "plant.lsy", "-o", "-"];
+        if let Some(f) = format {
+            args.extend(["--format", f]);
+        }
+        let piped = stdout_bytes_in(d, &args);
+        let written = std::fs::read(d.join(&file)).expect("the file");
+        assert!(!written.is_empty(), "{file}");
+        assert_eq!(piped, written, "{args:?} differs from -o {file}");
+    }
+    // `--format` that disagrees with the file, or names no format: usage errors.
+    let r = run_in(d, &["run", "plant.lsy", "-o", "x.svg", "--format", "png"]);
+    assert_eq!(r.status, 2, "{}", r.stderr);
+    let r = run_in(d, &["run", "plant.lsy", "-o", "-", "--format", "jpeg"]);
+    assert_eq!(r.status, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("svg, png, obj and txt"), "{}", r.stderr);
+    // infer: `-o -` is stdout, as without -o.
+    let art = crate::support::root().join("tests/data/infer/grid.svg");
+    let art = art.to_str().expect("utf-8");
+    let dash = stdout_bytes_in(d, &["infer", art, "-o", "-"]);
+    let plain = stdout_bytes_in(d, &["infer", art]);
+    assert!(String::from_utf8_lossy(&dash).contains("lsystem"));
+    assert_eq!(dash, plain);
+}
+
+/// `--stats` follows one rule: its JSON goes to stdout, unless stdout carries
+/// the result itself (`run -o -`, `infer` without `-o`), then to stderr.
+#[test]
+fn stats_go_to_stdout_unless_the_result_is_there() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    write(d, "depth.lsy", DEPTH_PROGRAM);
+    let json_line = |text: &str| -> serde_json::Value {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with('{'))
+            .unwrap_or_else(|| panic!("no JSON line in:\n{text}"));
+        serde_json::from_str(line).expect("JSON")
+    };
+    let r = run_in(d, &["run", "depth.lsy", "--stats"]);
+    assert_eq!(json_line(&r.stdout)["segments"], 16);
+    assert!(!r.stderr.contains('{'), "{}", r.stderr);
+    let r = run_in(d, &["run", "depth.lsy", "-o", "out.svg", "--stats"]);
+    assert_eq!(json_line(&r.stdout)["segments"], 16);
+    let r = run_in(d, &["run", "depth.lsy", "-o", "-", "--stats"]);
+    assert!(r.stdout.starts_with("<?xml"), "{}", r.stdout);
+    assert_eq!(json_line(&r.stderr)["segments"], 16);
+    let art = crate::support::root().join("tests/data/infer/grid.svg");
+    let art = art.to_str().expect("utf-8");
+    let r = run_in(d, &["infer", art, "-o", "grid.lsy", "--stats"]);
+    assert_eq!(r.status, 0, "{}", r.stderr);
+    assert!(json_line(&r.stdout)["elements"].as_u64() > Some(1));
+    let r = run_in(d, &["infer", art, "--stats"]);
+    assert!(r.stdout.contains("lsystem") && !r.stdout.contains("\"elements\""));
+    assert!(json_line(&r.stderr)["elements"].as_u64() > Some(1));
+}
+
+/// The summary line counts polygons, and without `-o` says that nothing was
+/// written and how to write a file.
+#[test]
+fn summary_line_counts_polygons_and_says_how_to_write() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    write(
+        d,
+        "leaf.lsy",
+        "lsystem Leaf {\n    angle 60;\n    axiom {.F.+F.+F.};\n}\n",
+    );
+    let mut shown = String::new();
+    for args in [
+        vec!["run", "leaf.lsy"],
+        vec!["run", "leaf.lsy", "-o", "leaf.svg"],
+        vec!["run", "leaf.lsy", "-o", "-", "--format", "txt"],
+    ] {
+        let r = run_in(d, &args);
+        assert_eq!(r.status, 0, "{}", r.stderr);
+        shown.push_str(&format!(
+            "$ lsyc {}\n{}",
+            args.join(" "),
+            scrub_ms(&r.stderr)
+        ));
+    }
+    insta::assert_snapshot!("summary_lines", shown);
+}
+
+/// `lsyc completions SHELL` and `lsyc man [COMMAND]` come from the same clap
+/// definition as `--help`: every command is in them.
+#[test]
+fn completions_and_manual_pages() {
+    let commands = ["run", "check", "fmt", "infer", "edit", "completions", "man"];
+    for shell in ["bash", "zsh", "fish", "elvish", "powershell"] {
+        let r = run(&["completions", shell]);
+        assert_eq!(r.status, 0, "{shell}: {}", r.stderr);
+        for c in commands {
+            assert!(r.stdout.contains(c), "{shell}: no `{c}`");
+        }
+    }
+    assert!(
+        run(&["completions", "bash"])
+            .stdout
+            .contains("--max-modules")
+    );
+    assert_eq!(run(&["completions", "tcsh"]).status, 2);
+    let r = run(&["man"]);
+    assert_eq!(r.status, 0, "{}", r.stderr);
+    assert!(
+        r.stdout.starts_with(".ie") || r.stdout.contains(".TH lsyc 1"),
+        "{}",
+        r.stdout
+    );
+    for c in commands {
+        assert!(
+            r.stdout.contains(&format!("lsyc\\-{c}")),
+            "lsyc(1) lists no `{c}`"
+        );
+    }
+    let r = run(&["man", "run"]);
+    assert_eq!(r.status, 0, "{}", r.stderr);
+    assert!(r.stdout.contains(".TH lsyc-run 1"), "{}", r.stdout);
+    for option in ["\\-\\-seed", "\\-\\-stats", "\\-\\-format", "\\-\\-guides"] {
+        assert!(r.stdout.contains(option), "lsyc-run(1) has no {option}");
+    }
+    let r = run(&["man", "frobnicate"]);
+    assert_eq!(r.status, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("run, fmt"), "{}", r.stderr);
+}
+
+/// The README's "A taste of the language" shows programs of the gallery:
+/// every code block there is text of a file in lang-examples/.
+#[test]
+fn readme_taste_is_gallery_text() {
+    let root = crate::support::root();
+    let readme = std::fs::read_to_string(root.join("README.md")).expect("README");
+    let start = readme
+        .find("## A taste of the language")
+        .expect("the section");
+    let rest = &readme[start + 3..];
+    let section = &rest[..rest.find("\n## ").unwrap_or(rest.len())];
+    let gallery: Vec<String> = crate::support::lsy_files(&["lang-examples"])
+        .iter()
+        .map(|p| crate::support::read_text(p))
+        .collect();
+    let blocks: Vec<&str> = section.split("```").skip(1).step_by(2).collect();
+    assert!(blocks.len() >= 2, "{section}");
+    for block in blocks {
+        let code = block.strip_prefix('\n').unwrap_or(block);
+        assert!(
+            gallery.iter().any(|g| g.contains(code)),
+            "not text of a gallery program:\n{code}"
+        );
+    }
+}
