@@ -31,11 +31,11 @@
 //! when none of its systems derives and no message is still to come.
 
 use super::index::{Grid, Layers};
-use super::query::{Answer, Probe, collide, query};
+use super::query::{Answer, Probe, collide, edge_meet, inward, query};
 use super::scene::{Link, Scene, seed_state};
 use crate::derive::{self, Limits, ModString};
 use crate::diagnostic::Diagnostic;
-use crate::geometry::{closest_on_segment, crossing};
+use crate::geometry::closest_on_segment;
 use crate::query::{QUERIES, QueryKind};
 use crate::turtle;
 use crate::turtle::State;
@@ -667,7 +667,7 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
         let link = &scene.links[r.link];
         let poly = &scene.guides[l.guide].polygon;
         let e = link.from.1 % poly.len();
-        let (a, b) = (poly[e], poly[(e + 1) % poly.len()]);
+        let inward = inward(poly);
         let tol = 1e-6 * (1.0 + r.from.abs().max_element());
         // Of the segments drawn from where the ?X stood across the edge, the one
         // closest to its heading (the first of equals): several branches may
@@ -677,7 +677,7 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
             if (s0 - r.from).length() > tol {
                 continue;
             }
-            if let Some(c) = crossing(s0, s1, a, b).filter(|&c| c > 1e-6) {
+            if let Some(c) = edge_meet(poly, inward, e, s0, s1) {
                 let along = (s1 - s0).normalize_or_zero().dot(r.dir);
                 if hit.is_none_or(|(best, _)| along > best) {
                     hit = Some((along, s0 + (s1 - s0) * c));

@@ -478,3 +478,80 @@ scene S {
     assert_eq!((stats.segments, stats.elements), (1, 1));
     assert_eq!(stats.bbox, Some([5.0, 2.0, 5.0, 6.0]));
 }
+
+/// The outputs of module `n` of system `k`, after the run.
+fn outputs(scene: &Scene, out: &Outcome, k: usize, n: usize) -> Vec<f64> {
+    let inst = &out.instances[k];
+    let prog = &scene.programs[scene.guides[inst.guide].program];
+    let at: usize = inst.string.syms[..n]
+        .iter()
+        .map(|&s| prog.symbols.arity(s))
+        .sum();
+    inst.string.params[at..at + prog.symbols.arity(inst.string.syms[n])].to_vec()
+}
+
+/// A stem growing straight up through the apex (5, 10) of a roof-shaped guide:
+/// its last segment meets both roof edges at the apex. The crossing is credited
+/// to the edge that starts a link (edge 3, not the lower-numbered edge 2), the
+/// token is used, and nothing is drawn beyond the apex (no stem leaving and
+/// coming back, no fork).
+#[test]
+fn a_stem_through_a_vertex_crosses_the_linked_edge() {
+    let text = "
+lsystem Up {
+    derive 20;
+    axiom ?X(3);
+    ?X(found, _, d) : found -> F(d) cut;
+    ?X(_, _, d) -> F(d) ?X(d);
+}
+lsystem Side(d) { derive 0; axiom F(d); }
+scene S {
+    guide a { polygon (0, 0) (10, 0) (10, 8) (5, 10) (0, 8); system Up; seed (5, 0) heading 0; }
+    guide b { polygon (0, 8) (5, 10) (5, 20) (0, 20); system Side; }
+    link a.edge(3) -> b.edge(0) { tokens 1; heading 0; }
+}";
+    let (scene, out) = run(text);
+    assert_eq!(out.messages, 1);
+    assert_eq!(scene.links[0].used, 1);
+    assert_eq!(out.guides[0].sent[0].at, DVec2::new(5.0, 10.0));
+    // Four segments up to y = 12 and nothing after them (the cut removed the
+    // rest): one F per ?X, no fork.
+    let inst = &out.instances[0];
+    assert_eq!(inst.string.params, vec![3.0; 4]);
+}
+
+/// A segment drawn on the very line of a later ?X is seen: the ?X answers it
+/// (id 4, the first drawn segment after the 4 guide edges) and not the guide's
+/// top edge beyond it.
+#[test]
+fn x_sees_a_collinear_segment() {
+    let text = "
+lsystem Probe { derive 0; axiom [f(6) F(2)] ?X(10); }
+scene S {
+    guide g { polygon (0, 0) (10, 0) (10, 10) (0, 10); system Probe; seed (5, 1) heading 0; }
+}";
+    let (scene, out) = run(text);
+    assert_eq!(outputs(&scene, &out, 0, 4), vec![1.0, 4.0, 10.0]);
+}
+
+/// A drawn segment nearer along the way than the guide's edge is what ?X
+/// reports, and the linked edge behind it reserves no token.
+#[test]
+fn x_reports_the_nearest_hit_whether_edge_or_drawn_segment() {
+    let text = "
+lsystem Probe { derive 1; axiom [f(7) +(90) f(1) +(180) F(2)] ?X(12); }
+lsystem Side { derive 0; axiom F; }
+scene S {
+    guide g { polygon (0, 0) (10, 0) (10, 10) (0, 10); system Probe; seed (5, 1) heading 0; }
+    guide h { polygon (0, 10) (10, 10) (10, 20) (0, 20); system Side; }
+    link g.edge(2) -> h.edge(0) { tokens 1; }
+}";
+    let (scene, out) = run(text);
+    // The cross bar at y = 8 is nearer than the top edge at y = 10.
+    assert_eq!(outputs(&scene, &out, 0, 7), vec![1.0, 4.0, 12.0]);
+    assert_eq!(events(&out, 0), vec![]);
+    // Without the bar, the top edge is hit and its token reserved.
+    let (scene, out) = run(&text.replace("F(2)]", "f(2)]"));
+    assert_eq!(outputs(&scene, &out, 0, 7), vec![1.0, 2.0, 12.0]);
+    assert_eq!(events(&out, 0)[0].2, Token::Reserved);
+}
