@@ -113,6 +113,9 @@ codes! {
     AlwaysFalse = "W0203", "a rule whose condition is always false";
     SplitWord = "W0301", "a word read as a run of single-letter modules";
     ArityNeverRewritten = "W0302", "a turtle symbol whose parameter count no rule matches";
+    NeverSeeded = "W0801", "a guide never seeded while a link to it kept its tokens";
+    DeriveRanOut = "W0802", "a system stopped by `derive` with query modules still to answer";
+    LeavesAndComesBack = "W0803", "growth that leaves its guide and comes back in";
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]

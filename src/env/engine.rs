@@ -11,7 +11,7 @@
 //! links, and its incoming messages), so that `Runner::run` after an edit
 //! recomputes only the changed guides and those downstream of them whose
 //! incoming messages changed. Must not build scenes (`scene`), compute a query
-//! answer itself (`query`) or clip drawings (`clip`); nothing else in `env`
+//! answer itself (`query`) or clip drawings (`clip`); in `env` only `explain`
 //! imports it.
 //!
 //! One step of a unit, for step t ≥ 1:
@@ -53,6 +53,12 @@ pub struct Instance {
     pub start: State,
     pub string: ModString,
     pub steps: u32,
+    /// The scene step at which it was seeded (0 for explicit seeds).
+    pub seeded: u32,
+    /// The link whose message seeded it (`None` for an explicit seed).
+    pub via: Option<usize>,
+    /// The scene step at which its string last changed.
+    pub changed: u32,
 }
 
 /// What a scene run produced.
@@ -75,11 +81,7 @@ pub fn run(
     limits: Limits,
     max_steps: Option<u32>,
 ) -> Result<Outcome, Diagnostic> {
-    let cfg = Config {
-        seed,
-        limits,
-        cap: max_steps.unwrap_or(MAX_SCENE_STEPS).min(MAX_SCENE_STEPS),
-    };
+    let cfg = Config::new(seed, limits, max_steps);
     let (out, _) = execute(scene, cfg, &[], &mut Cache::default())?;
     out.count_used(&mut scene.links);
     Ok(out)
@@ -160,6 +162,17 @@ pub struct Config {
     pub limits: Limits,
     /// The most steps (`MAX_SCENE_STEPS` at most).
     pub cap: u32,
+}
+
+impl Config {
+    /// The configuration of `run`: at most `max_steps` (and `MAX_SCENE_STEPS`).
+    pub fn new(seed: u64, limits: Limits, max_steps: Option<u32>) -> Config {
+        Config {
+            seed,
+            limits,
+            cap: max_steps.unwrap_or(MAX_SCENE_STEPS).min(MAX_SCENE_STEPS),
+        }
+    }
 }
 
 /// Unit results by their guides, with the key they were computed from.
@@ -504,6 +517,9 @@ fn start(scene: &Scene, cfg: Config, unit: &[usize]) -> Result<Vec<Live>, Diagno
                 start: seed_state(s.at, s.heading),
                 string,
                 steps: 0,
+                seeded: 0,
+                via: None,
+                changed: 0,
             });
         }
         live.push(l);
@@ -608,6 +624,7 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
             // An unchanged string draws the same: keep its drawing.
             if string != inst.string {
                 inst.string = string;
+                inst.changed = t;
                 *probe = None;
             }
             *fresh = true;
@@ -738,6 +755,9 @@ fn deliver(
         start: seed_state(at, link.heading),
         string,
         steps: 0,
+        seeded: m.step,
+        via: Some(m.link),
+        changed: m.step,
     });
     Ok(())
 }

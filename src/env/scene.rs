@@ -10,12 +10,16 @@ use crate::ast::{self, File, GuideStmt, Item, LinkStmt, SceneStmt};
 use crate::check::Checked;
 use crate::compile::{self, CompileError, Program};
 use crate::diagnostic::{Code, Diagnostic};
+use crate::span::Span;
 use crate::turtle::State;
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
 
+#[derive(Clone)]
 pub struct Guide {
     pub name: String,
+    /// Where the guide's name is written (for diagnostics about it).
+    pub span: Span,
     pub polygon: Vec<DVec2>,
     /// Index into `Scene::programs`.
     pub program: usize,
@@ -30,7 +34,10 @@ pub struct Seed {
     pub args: Vec<f64>,
 }
 
+#[derive(Clone)]
 pub struct Link {
+    /// From `link` to the end of its far edge reference (for diagnostics).
+    pub span: Span,
     pub from: (usize, usize),
     pub to: (usize, usize),
     pub tokens: u32,
@@ -38,6 +45,7 @@ pub struct Link {
     pub heading: f64,
 }
 
+#[derive(Clone)]
 pub struct Scene {
     pub name: String,
     pub guides: Vec<Guide>,
@@ -139,6 +147,7 @@ fn guides(file: &File, checked: &Checked, scene: &ast::Scene) -> Result<Guides, 
         index.insert(g.name.name.clone(), guides.len());
         guides.push(Guide {
             name: g.name.name.clone(),
+            span: g.name.span,
             polygon,
             program,
             seeds,
@@ -198,6 +207,10 @@ fn links(
             }
         }
         links.push(Link {
+            span: Span {
+                start: st.span.start,
+                end: l.to.span.end,
+            },
             from: end(&l.from)?,
             to: end(&l.to)?,
             tokens,

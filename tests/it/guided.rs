@@ -555,3 +555,67 @@ scene S {
     assert_eq!(outputs(&scene, &out, 0, 7), vec![1.0, 2.0, 12.0]);
     assert_eq!(events(&out, 0)[0].2, Token::Reserved);
 }
+
+/// The warnings of a scene run, rendered as `lsyc run` prints them, and the
+/// per-guide explanation.
+fn warnings_of(text: &str) -> (String, String) {
+    let mut scene = build(text);
+    let out = lsyc::env::run(&mut scene, 0, Default::default(), None).expect("runs");
+    let cfg = Config::new(0, Default::default(), None);
+    let diags = lsyc::env::explain::warnings(&scene, &out, cfg);
+    let reports = lsyc::env::explain::explain(&scene, &out, cfg).expect("explains");
+    (
+        crate::support::render_plain(&diags, "scene.lsy", text),
+        lsyc::env::explain::render(&scene, &reports),
+    )
+}
+
+/// A stem that needs 21 steps (a query, then a segment, ten times, and the
+/// last query) under `derive 10`: it stops half-way, the crown is never seeded,
+/// and the run says both, with the steps it would need.
+const SHORT: &str = "lsystem Stem {
+    derive 10;
+    axiom ?D_L(10);
+    ?D_L(found, _, beta, _, D) : found -> +(beta * 0.5) ?X(D);
+    ?D_L(_, _, _, _, _) -> ;
+    ?X(found, _, D) : found -> F(D) cut;
+    ?X(_, _, D) -> F(D) ?D_L(D);
+}
+lsystem Crown(D) { derive 1; axiom F(D); }
+scene S {
+    guide stem { polygon (-10, 0) (10, 0) (10, 100) (-10, 100); system Stem; seed (0, 0) heading 0; }
+    guide crown { polygon (-10, 100) (10, 100) (30, 150) (-30, 150); system Crown; }
+    link stem.edge(2) -> crown.edge(0) { tokens 1; heading 0; }
+}
+";
+
+#[test]
+fn a_run_cut_short_says_why_the_far_guide_stayed_empty() {
+    let (warnings, explained) = warnings_of(SHORT);
+    insta::assert_snapshot!("warnings_cut_short", warnings);
+    insta::assert_snapshot!("explain_cut_short", explained);
+    // With the steps the warning names, the crown grows and nothing warns.
+    let need = warnings
+        .split("write `derive ")
+        .nth(1)
+        .and_then(|s| s.split(';').next())
+        .expect("a step count");
+    let fixed = SHORT.replace("derive 10;", &format!("derive {need};"));
+    let (warnings, explained) = warnings_of(&fixed);
+    assert_eq!(warnings, "", "{warnings}");
+    assert!(
+        explained.contains("guide crown (lsystem Crown):\n  seeded at step"),
+        "{explained}"
+    );
+}
+
+#[test]
+fn growth_that_leaves_its_guide_and_comes_back_is_reported() {
+    let text = "lsystem Out { derive 0; axiom F(5) -(90) F(20) +(180) F(20) F(2); }
+scene S {
+    guide g { polygon (0, 0) (10, 0) (10, 10) (0, 10); system Out; seed (5, 1) heading 0; }
+}
+";
+    let (warnings, _) = warnings_of(text);
+    insta::assert_snapshot!("warnings_comes_back", warnings);
+}
