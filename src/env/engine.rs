@@ -113,6 +113,8 @@ pub struct Message {
     pub seq: usize,
     /// Where the crossing segment met the start edge.
     pub at: DVec2,
+    /// The direction of the crossing segment (for `heading continue`).
+    pub dir: DVec2,
     /// The pass-through parameters of the `?X` that reserved the token (Δ first).
     pub pass: Vec<f64>,
 }
@@ -439,6 +441,9 @@ fn unit_key(
                 l.to.1 as u64,
                 u64::from(l.tokens),
                 l.heading.to_bits(),
+                u64::from(l.continues),
+                u64::from(l.aim_middle),
+                l.take.map_or(u64::MAX, f64::to_bits),
             ]);
         }
     }
@@ -450,6 +455,7 @@ fn unit_key(
             m.seq as u64,
         ]);
         pt(&mut k, m.at);
+        pt(&mut k, m.dir);
         k.push(m.pass.len() as u64);
         k.extend(m.pass.iter().map(|a| a.to_bits()));
     }
@@ -689,19 +695,19 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
         // Of the segments drawn from where the ?X stood across the edge, the one
         // closest to its heading (the first of equals): several branches may
         // start at one point.
-        let mut hit: Option<(f64, DVec2)> = None;
+        let mut hit: Option<(f64, DVec2, DVec2)> = None;
         for &(s0, s1) in l.probes[r.instance].iter().flat_map(|p| p.grid.segs()) {
             if (s0 - r.from).length() > tol {
                 continue;
             }
             if let Some(c) = edge_meet(poly, inward, e, s0, s1) {
                 let along = (s1 - s0).normalize_or_zero().dot(r.dir);
-                if hit.is_none_or(|(best, _)| along > best) {
-                    hit = Some((along, s0 + (s1 - s0) * c));
+                if hit.is_none_or(|(best, _, _)| along > best) {
+                    hit = Some((along, s0 + (s1 - s0) * c, s1 - s0));
                 }
             }
         }
-        let hit = hit.map(|h| h.1);
+        let hit = hit.map(|h| (h.1, h.2));
         let token = if hit.is_some() {
             Token::Used
         } else {
@@ -714,7 +720,7 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
             instance: r.instance,
             module: r.module,
         });
-        if let Some(at) = hit {
+        if let Some((at, dir)) = hit {
             used[r.link] += 1;
             let m = Message {
                 step: t,
@@ -722,6 +728,7 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
                 from_guide: l.guide,
                 seq: l.run.sent.len(),
                 at,
+                dir,
                 pass: r.pass,
             };
             l.run.sent.push(m.clone());
@@ -746,13 +753,20 @@ fn deliver(
     let poly = &scene.guides[tg].polygon;
     let (a, b) = (poly[te % poly.len()], poly[(te + 1) % poly.len()]);
     let at = closest_on_segment(m.at, a, b);
+    // `heading continue`: the heading of the crossing segment (0 = +y,
+    // counter-clockwise positive).
+    let heading = if link.continues && m.dir.length_squared() > 0.0 {
+        (-m.dir.x).atan2(m.dir.y).to_degrees()
+    } else {
+        link.heading
+    };
     let prog = &scene.programs[scene.guides[tg].program];
     let mut args = m.pass.clone();
     args.resize(prog.params.len(), 0.0);
     let string = derive::axiom(prog, &args, cfg.seed).map_err(|e| e.diagnostic(prog))?;
     live[k].add(Instance {
         guide: tg,
-        start: seed_state(at, link.heading),
+        start: seed_state(at, heading),
         string,
         steps: 0,
         seeded: m.step,
@@ -914,6 +928,7 @@ fn reserve(scene: &Scene, l: &mut Live, k: usize, crossings: Vec<Crossing>, used
             .filter(|&i| {
                 let link = &scene.links[i];
                 link.from == (l.guide, c.edge)
+                    && link.take.is_none_or(|v| c.pass.get(1) == Some(&v))
                     && used[i] as usize + l.reserved.iter().filter(|r| r.link == i).count()
                         < link.tokens as usize
             })

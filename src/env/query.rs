@@ -86,7 +86,8 @@ pub(crate) fn query(
         DVec2::Y
     };
     let poly = &scene.guides[gi].polygon;
-    let link_edges = || -> Vec<(usize, DVec2, DVec2)> {
+    // A link that aims at its middle is the point in the middle of its edge.
+    let link_edges = |aim: bool| -> Vec<(usize, DVec2, DVec2)> {
         scene
             .links
             .iter()
@@ -94,7 +95,13 @@ pub(crate) fn query(
             .filter(|(_, l)| l.from.0 == gi)
             .map(|(i, l)| {
                 let e = l.from.1 % poly.len().max(1);
-                (i, poly[e], poly[(e + 1) % poly.len()])
+                let (a, b) = (poly[e], poly[(e + 1) % poly.len()]);
+                if aim && l.aim_middle {
+                    let m = (a + b) * 0.5;
+                    (i, m, m)
+                } else {
+                    (i, a, b)
+                }
             })
             .collect()
     };
@@ -134,14 +141,14 @@ pub(crate) fn query(
     match kind {
         QueryKind::Position => Answer::new(&[st.pos.x, st.pos.y, st.pos.z]),
         QueryKind::Heading => Answer::new(&[st.h.x, st.h.y, st.h.z]),
-        QueryKind::DistanceLink => nearest(&link_edges()),
+        QueryKind::DistanceLink => nearest(&link_edges(true)),
         QueryKind::DistanceGuide => nearest(&guide_edges()),
         // Drawn segments have ids after the guide's edges, as for ?N_A and ?X.
         QueryKind::DistanceElement => match grid.and_then(|g| g.nearest(p)) {
             Some((d, c, i)) => closest(d, c, poly.len() + i),
             None => Answer::new(&[0.0; 4]),
         },
-        QueryKind::AheadLink => ahead(first_ahead(&link_edges())),
+        QueryKind::AheadLink => ahead(first_ahead(&link_edges(false))),
         QueryKind::AheadGuide => ahead(first_ahead(&guide_edges())),
         QueryKind::AheadElement => {
             // Guide edges come first (ids 0..n), so they win ties.

@@ -43,6 +43,15 @@ pub struct Link {
     pub tokens: u32,
     pub used: u32,
     pub heading: f64,
+    /// `heading continue;`: the seeded system keeps the heading of the segment
+    /// that crossed (`heading` is then unused).
+    pub continues: bool,
+    /// `aim middle;`: `?D_L` in the start guide measures to the middle of this
+    /// link's edge, not to its closest point.
+    pub aim_middle: bool,
+    /// `take v;`: only a `?X` whose second parameter (the first after Δ) is `v`
+    /// takes this link's tokens.
+    pub take: Option<f64>,
 }
 
 #[derive(Clone)]
@@ -199,10 +208,17 @@ fn links(
             Ok((g, value(&r.index, checked) as usize))
         };
         let (mut tokens, mut heading) = (0u32, 0.0);
+        let (mut continues, mut aim_middle, mut take) = (false, false, None);
         for ls in &l.body.stmts {
             match &ls.node {
                 LinkStmt::Tokens(e) => tokens = value(e, checked) as u32,
+                LinkStmt::Heading(e) if link_word(e) == Some("continue") => continues = true,
                 LinkStmt::Heading(e) => heading = value(e, checked),
+                LinkStmt::Setting(k, e) => match k.name.as_str() {
+                    "aim" => aim_middle = link_word(e) == Some("middle"),
+                    "take" => take = Some(value(e, checked)),
+                    _ => {}
+                },
                 LinkStmt::Error => {}
             }
         }
@@ -216,6 +232,9 @@ fn links(
             tokens,
             used: 0,
             heading,
+            continues,
+            aim_middle,
+            take,
         });
     }
     Ok(links)
@@ -231,5 +250,14 @@ pub fn seed_state(at: DVec2, deg: f64) -> State {
         l: DVec3::Z.cross(h),
         u: DVec3::Z,
         ..State::default()
+    }
+}
+
+/// A link setting's value written as a bare word (`heading continue;`, `aim
+/// middle;`), as the checker reads it.
+fn link_word(e: &ast::Expr) -> Option<&str> {
+    match &e.kind {
+        ast::ExprKind::Var(n) => Some(n.as_str()),
+        _ => None,
     }
 }

@@ -619,3 +619,50 @@ scene S {
     let (warnings, _) = warnings_of(text);
     insta::assert_snapshot!("warnings_comes_back", warnings);
 }
+
+/// A stem whose every segment also starts a stray shoot at 60°: the link's
+/// `take 1` lets only the stem's `?X(D, 1)` use the token (the shoots pass 0),
+/// `aim middle` steers the stem to the middle of the top edge, and `heading
+/// continue` seeds the crown with the heading of the segment that crossed.
+const AIMED: &str = "lsystem Stem {
+    derive 60;
+    axiom ?D_L(10, 1);
+    ?D_L(found, _, beta, _, D, k) : found -> +(beta * 0.5) ?X(D, k);
+    ?D_L(_, _, _, _, _, _) -> ;
+    ?X(found, _, D, _) : found -> F(D) cut;
+    ?X(_, _, D, k) -> F(D) [+(60) ?X(D, 0)] ?D_L(D, k);
+}
+lsystem Crown(D, _) { derive 0; axiom F(D); }
+scene S {
+    guide stem { polygon (-10, 0) (10, 0) (10, 100) (-10, 100); system Stem; seed (-5, 0) heading 0; }
+    guide crown { polygon (-10, 100) (10, 100) (30, 150) (-30, 150); system Crown; }
+    link stem.edge(2) -> crown.edge(0) { tokens 1; heading continue; aim middle; take 1; }
+}
+";
+
+#[test]
+fn links_aim_take_and_continue() {
+    let (scene, out) = run(AIMED);
+    assert_eq!(out.messages, 1);
+    // The stem (k = 1) took the token: the message carries (D, 1).
+    let m = &out.guides[0].sent[0];
+    assert_eq!(m.pass, vec![10.0, 1.0]);
+    // Aiming at the middle (0, 100), it crossed near it.
+    assert!(m.at.x.abs() < 2.0, "{}", m.at);
+    // The crown starts with the crossing segment's heading.
+    let crown = out.instances.iter().find(|i| i.guide == 1).expect("seeded");
+    let h = crown.start.h.truncate();
+    assert!((h - m.dir.normalize()).length() < 1e-9, "{h} {}", m.dir);
+    assert!(scene.links[0].continues && scene.links[0].aim_middle);
+    // Without `take 1`, a stray shoot (k = 0) reaches the edge first and
+    // takes the token; without `aim middle`, the stem goes for the closest
+    // point of the edge (straight up from where it stands, x = -5).
+    let (_, out) = run(&AIMED.replace(" take 1;", ""));
+    assert_eq!(out.guides[0].sent[0].pass, vec![10.0, 0.0]);
+    let (_, out) = run(&AIMED.replace(" aim middle;", ""));
+    assert!(
+        out.guides[0].sent[0].at.x < -3.0,
+        "{}",
+        out.guides[0].sent[0].at
+    );
+}
