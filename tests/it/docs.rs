@@ -85,7 +85,9 @@ fn every_block_of_the_reference_is_what_it_says() {
                 assert!(!errors(&body).is_empty(), "{at}: no error");
             }
             "sh" | "text" => {}
-            other => panic!("{at}: a code block needs an info string (lsy, lsy rules, lsy fragment, lsy error, sh, text), not `{other}`"),
+            other => panic!(
+                "{at}: a code block needs an info string (lsy, lsy rules, lsy fragment, lsy error, sh, text), not `{other}`"
+            ),
         }
     }
     // The reference has whole programs, scenes among them, and rules.

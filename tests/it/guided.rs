@@ -674,17 +674,27 @@ fn links_aim_take_and_continue() {
 #[test]
 fn the_references_stem_and_crown_work_as_printed() {
     let md = crate::support::read_text(&crate::support::root().join("docs/language.md"));
-    let start = md.find("scene StemAndCrown").expect("the scene is in the reference");
+    let start = md
+        .find("scene StemAndCrown")
+        .expect("the scene is in the reference");
     let open = md[..start].rfind("```lsy\n").expect("its block") + "```lsy\n".len();
     let close = start + md[start..].find("```").expect("closed");
     let text = &md[open..close];
     let (scene, out) = run(text);
     assert_eq!(out.messages, 1);
     assert_eq!(scene.links[0].used, 1);
-    let crown = out.instances.iter().find(|i| i.guide == 1).expect("crown seeded");
+    let crown = out
+        .instances
+        .iter()
+        .find(|i| i.guide == 1)
+        .expect("crown seeded");
     assert_eq!(crown.via, Some(0));
     // The message crossed near the middle of the top edge, and the crown grew.
-    assert!(out.guides[0].sent[0].at.x.abs() < 3.0, "{}", out.guides[0].sent[0].at);
+    assert!(
+        out.guides[0].sent[0].at.x.abs() < 3.0,
+        "{}",
+        out.guides[0].sent[0].at
+    );
     assert_eq!(out.guides[0].sent[0].pass, vec![10.0]);
     assert!(crown.string.len() > 100, "{}", crown.string.len());
     let (warnings, _) = warnings_of(text);
