@@ -700,3 +700,27 @@ fn the_references_stem_and_crown_work_as_printed() {
     let (warnings, _) = warnings_of(text);
     assert_eq!(warnings, "");
 }
+
+/// `lsyc run --explain` prints the explanation after the run's warnings, on
+/// stderr, and the run still succeeds.
+#[test]
+fn run_explain_on_the_command_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let file = dir.path().join("short.lsy");
+    std::fs::write(&file, SHORT).expect("written");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_lsyc"))
+        .arg("run")
+        .arg(&file)
+        .arg("--explain")
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let (w, x) = (
+        err.find("warning[W0801]").expect("the warning"),
+        err.find("guide crown (lsystem Crown):\n  never seeded")
+            .expect("the explanation"),
+    );
+    assert!(w < x, "{err}");
+    assert!(err.contains("write `derive 20;`"), "{err}");
+}
