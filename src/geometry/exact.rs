@@ -121,6 +121,14 @@ fn param(p: DVec2, q: DVec2, c: DVec2) -> f64 {
 /// the parameter is rounded (and for a proper crossing computed from the
 /// lines, clamped to [0, 1]).
 pub fn segment_hit(p: DVec2, q: DVec2, a: DVec2, b: DVec2) -> Option<f64> {
+    // Boxes apart: they cannot meet (exact comparisons, the cheap filter).
+    if p.x.max(q.x) < a.x.min(b.x)
+        || a.x.max(b.x) < p.x.min(q.x)
+        || p.y.max(q.y) < a.y.min(b.y)
+        || a.y.max(b.y) < p.y.min(q.y)
+    {
+        return None;
+    }
     let o1 = orient(p, q, a);
     let o2 = orient(p, q, b);
     if o1 == o2 && o1 != Ordering::Equal {
