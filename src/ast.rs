@@ -369,6 +369,9 @@ pub struct EdgeRef {
 #[derive(Clone, Debug, PartialEq)]
 pub enum LinkStmt {
     Tokens(Expr),
+    /// `heading a;`, or `heading continue;` (the name `continue`).
     Heading(Expr),
+    /// `aim middle;`, `take 1;`: a named setting (the checker knows the names).
+    Setting(Ident, Expr),
     Error,
 }

@@ -97,6 +97,7 @@ codes! {
     EdgeOutOfRange = "E0802", "an edge index beyond the polygon's edges";
     GuideIncomplete = "E0803", "a guide without a polygon or without a system";
     SeedArguments = "E0804", "a seed passing a different number of arguments than its lsystem takes";
+    LinkSetting = "E0805", "a link setting lsyc does not know, or a value it does not take";
     DivisionByZero = "E0901", "a division by zero while running";
     NotFinite = "E0902", "an expression whose value is not a finite number while running";
     TooManyModules = "E0903", "a derivation step that would exceed the module limit";
@@ -113,6 +114,9 @@ codes! {
     AlwaysFalse = "W0203", "a rule whose condition is always false";
     SplitWord = "W0301", "a word read as a run of single-letter modules";
     ArityNeverRewritten = "W0302", "a turtle symbol whose parameter count no rule matches";
+    NeverSeeded = "W0801", "a guide never seeded while a link to it kept its tokens";
+    DeriveRanOut = "W0802", "a system stopped by `derive` with query modules still to answer";
+    LeavesAndComesBack = "W0803", "growth that leaves its guide and comes back in";
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]

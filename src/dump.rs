@@ -224,6 +224,7 @@ impl Dumper {
                     let t = match l {
                         LinkStmt::Tokens(e) => format!("tokens {}", d.expr(e)),
                         LinkStmt::Heading(e) => format!("heading {}", d.expr(e)),
+                        LinkStmt::Setting(k, e) => format!("{} {}", k.name, d.expr(e)),
                         LinkStmt::Error => "error".to_string(),
                     };
                     d.line(&t);

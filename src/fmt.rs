@@ -422,6 +422,7 @@ fn link_stmt(s: &LinkStmt) -> String {
     match s {
         LinkStmt::Tokens(e) => format!("tokens {};", format_expr(e)),
         LinkStmt::Heading(e) => format!("heading {};", format_expr(e)),
+        LinkStmt::Setting(k, e) => format!("{} {};", k.name, format_expr(e)),
         LinkStmt::Error => String::new(),
     }
 }

@@ -2,23 +2,23 @@
 //! segment crossing, ray hit, point in polygon, signed area, centroid, signed
 //! angle, and the affine maps of the plane (`DAffine2`).
 //!
-//! Owns: the tolerances of these predicates, each stated once here ([`PARALLEL`],
-//! [`ON_BOUNDARY`], [`RAY_START`]), and the spatial index of points
-//! ([`index`]). Every function is deterministic: the same input gives the same
-//! bits. Must not know guides, elements, SVG or the language.
+//! Owns: the exact predicates ([`exact`]: orientation, where segments meet),
+//! the tolerances that remain, each stated once here ([`ON_BOUNDARY`],
+//! [`RAY_START`]), and the spatial indexes ([`index`]). Every function is
+//! deterministic: the same input gives the same bits. Must not know guides,
+//! elements, SVG or the language.
 //!
-//! The predicates are floating point with explicit tolerances, not exact
-//! (adaptive) orientation tests: the scene's centre rule counts a point within
-//! [`ON_BOUNDARY`] of an edge as inside and a crossing with a nearly parallel
-//! segment as none, and the snapshots pin those answers down. An exact
-//! predicate would answer differently exactly at those boundaries.
+//! Whether two segments meet, and whether a ray meets a segment, is decided
+//! exactly (robust orientation tests with an exact fallback): segments that
+//! cross at a vertex, touch, or overlap on one line meet; only the place where
+//! they meet is rounded. The centre rule's point-in-polygon test keeps its
+//! tolerance: a point within [`ON_BOUNDARY`] of an edge counts as inside.
 
+pub mod exact;
 pub mod index;
 
 use glam::{DAffine2, DMat2, DVec2};
 
-/// Two directions whose cross product is below this are parallel (no crossing).
-pub const PARALLEL: f64 = 1e-12;
 /// A point whose squared distance to a polygon edge is below this lies on the
 /// boundary, which counts as inside.
 pub const ON_BOUNDARY: f64 = 1e-18;
@@ -36,27 +36,19 @@ pub fn closest_on_segment(p: DVec2, a: DVec2, b: DVec2) -> DVec2 {
     a + ab * t
 }
 
-/// Where the line through `p` along `r` meets the line through `a` along `s`:
-/// the parameters (t along `r`, u along `s`), unless they are parallel.
-fn meet(p: DVec2, r: DVec2, a: DVec2, s: DVec2) -> Option<(f64, f64)> {
-    let denom = r.perp_dot(s);
-    if denom.abs() < PARALLEL {
-        return None;
-    }
-    Some(((a - p).perp_dot(s) / denom, (a - p).perp_dot(r) / denom))
-}
-
-/// Where segment `p`–`q` crosses segment `a`–`b`: the parameter along `p`–`q`
-/// (0 at p, 1 at q), if they cross.
+/// Where the closed segment `p`–`q` first meets segment `a`–`b`: the
+/// parameter along `p`–`q` (0 at p, 1 at q). Crossings, touches (also at
+/// vertices) and collinear overlaps meet; the decision is exact
+/// ([`exact::segment_hit`]).
 pub fn crossing(p: DVec2, q: DVec2, a: DVec2, b: DVec2) -> Option<f64> {
-    let (t, u) = meet(p, q - p, a, b - a)?;
-    ((0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)).then_some(t)
+    exact::segment_hit(p, q, a, b)
 }
 
-/// Distance along the ray from `p` in unit direction `dir` to segment `a`–`b`.
+/// Distance along the ray from `p` in unit direction `dir` to segment `a`–`b`,
+/// when it is beyond [`RAY_START`] (what the ray starts on does not count).
+/// The decision is exact ([`exact::ray_segment_hit`]).
 pub fn ray_hit(p: DVec2, dir: DVec2, a: DVec2, b: DVec2) -> Option<f64> {
-    let (t, u) = meet(p, dir, a, b - a)?;
-    (t > RAY_START && (0.0..=1.0).contains(&u)).then_some(t)
+    exact::ray_segment_hit(p, dir, a, b).filter(|&t| t > RAY_START)
 }
 
 /// Whether `p` lies inside the polygon (even–odd rule; the boundary, within

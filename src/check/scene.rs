@@ -285,17 +285,46 @@ impl<'a> Checker<'a> {
             let (key, e) = match &ls.node {
                 LinkStmt::Tokens(e) => ("tokens", e),
                 LinkStmt::Heading(e) => ("heading", e),
+                LinkStmt::Setting(k, e) => (k.name.as_str(), e),
                 LinkStmt::Error => continue,
             };
+            if let LinkStmt::Setting(k, _) = &ls.node
+                && !LINK_SETTINGS.contains(&key)
+            {
+                self.diags.push(
+                    Diagnostic::error(Code::LinkSetting, format!("a link has no setting `{key}`"))
+                        .primary(k.span, "not a link setting")
+                        .help("a link takes `tokens n;`, `heading a;` or `heading continue;`, `aim middle;` and `take v;`"),
+                );
+                continue;
+            }
             if let Some(first) = seen.get(key) {
                 self.setting_twice(key, ls.span, *first);
                 continue;
             }
             seen.insert(key, ls.span);
-            if key == "tokens" {
-                self.const_int(e, "a token count", 0.0, 1e9);
-            } else {
-                self.const_num(e, "a link heading");
+            match key {
+                "tokens" => {
+                    self.const_int(e, "a token count", 0.0, 1e9);
+                }
+                "heading" if link_word(e) == Some("continue") => {}
+                "aim" => {
+                    if !matches!(link_word(e), Some("middle" | "closest")) {
+                        self.diags.push(
+                            Diagnostic::error(
+                                Code::LinkSetting,
+                                "`aim` takes `middle` or `closest`",
+                            )
+                            .primary(e.span, "not `middle` or `closest`"),
+                        );
+                    }
+                }
+                "take" => {
+                    self.const_num(e, "a link's `take` value");
+                }
+                _ => {
+                    self.const_num(e, "a link heading");
+                }
             }
         }
     }
@@ -344,5 +373,17 @@ impl<'a> Checker<'a> {
                 .note("edge i joins vertex i to vertex i + 1; the last edge closes the polygon"),
             );
         }
+    }
+}
+
+/// The named settings a link takes besides `tokens` and `heading`.
+const LINK_SETTINGS: &[&str] = &["aim", "take"];
+
+/// A link setting's value written as a bare word (`continue`, `middle`); in
+/// these places a word is never read as a constant.
+fn link_word(e: &crate::ast::Expr) -> Option<&str> {
+    match &e.kind {
+        crate::ast::ExprKind::Var(n) => Some(n.as_str()),
+        _ => None,
     }
 }

@@ -73,6 +73,10 @@ pub struct Args {
     #[arg(long)]
     pub guides: bool,
 
+    /// For a scene: say per guide how it was seeded, its steps, what was kept and clipped, and its links' tokens.
+    #[arg(long)]
+    pub explain: bool,
+
     /// Which scene of the file to run (default: the first); `--system` runs one
     /// lsystem on its own instead.
     #[arg(long, value_name = "NAME")]
@@ -478,6 +482,18 @@ fn run_scene(
             return 1;
         }
     };
+    let cfg = lsyc::env::Config::new(opts.seed, opts.limits, opts.steps);
+    reporter.emit(
+        &lsyc::env::explain::warnings(&r.scene, &r.outcome, cfg),
+        &src.name,
+        &src.text,
+    );
+    if args.explain {
+        match lsyc::env::explain::explain(&r.scene, &r.outcome, cfg) {
+            Ok(rep) => eprint!("{}", lsyc::env::explain::render(&r.scene, &rep)),
+            Err(d) => reporter.emit(&[d], &src.name, &src.text),
+        }
+    }
     let picture = Picture {
         size: args.size,
         background,

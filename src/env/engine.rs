@@ -11,7 +11,7 @@
 //! links, and its incoming messages), so that `Runner::run` after an edit
 //! recomputes only the changed guides and those downstream of them whose
 //! incoming messages changed. Must not build scenes (`scene`), compute a query
-//! answer itself (`query`) or clip drawings (`clip`); nothing else in `env`
+//! answer itself (`query`) or clip drawings (`clip`); in `env` only `explain`
 //! imports it.
 //!
 //! One step of a unit, for step t ≥ 1:
@@ -31,11 +31,11 @@
 //! when none of its systems derives and no message is still to come.
 
 use super::index::{Grid, Layers};
-use super::query::{Answer, Probe, collide, query};
+use super::query::{Answer, Probe, collide, edge_meet, inward, query};
 use super::scene::{Link, Scene, seed_state};
 use crate::derive::{self, Limits, ModString};
 use crate::diagnostic::Diagnostic;
-use crate::geometry::{closest_on_segment, crossing};
+use crate::geometry::closest_on_segment;
 use crate::query::{QUERIES, QueryKind};
 use crate::turtle;
 use crate::turtle::State;
@@ -53,6 +53,12 @@ pub struct Instance {
     pub start: State,
     pub string: ModString,
     pub steps: u32,
+    /// The scene step at which it was seeded (0 for explicit seeds).
+    pub seeded: u32,
+    /// The link whose message seeded it (`None` for an explicit seed).
+    pub via: Option<usize>,
+    /// The scene step at which its string last changed.
+    pub changed: u32,
 }
 
 /// What a scene run produced.
@@ -75,11 +81,7 @@ pub fn run(
     limits: Limits,
     max_steps: Option<u32>,
 ) -> Result<Outcome, Diagnostic> {
-    let cfg = Config {
-        seed,
-        limits,
-        cap: max_steps.unwrap_or(MAX_SCENE_STEPS).min(MAX_SCENE_STEPS),
-    };
+    let cfg = Config::new(seed, limits, max_steps);
     let (out, _) = execute(scene, cfg, &[], &mut Cache::default())?;
     out.count_used(&mut scene.links);
     Ok(out)
@@ -111,6 +113,8 @@ pub struct Message {
     pub seq: usize,
     /// Where the crossing segment met the start edge.
     pub at: DVec2,
+    /// The direction of the crossing segment (for `heading continue`).
+    pub dir: DVec2,
     /// The pass-through parameters of the `?X` that reserved the token (Δ first).
     pub pass: Vec<f64>,
 }
@@ -160,6 +164,17 @@ pub struct Config {
     pub limits: Limits,
     /// The most steps (`MAX_SCENE_STEPS` at most).
     pub cap: u32,
+}
+
+impl Config {
+    /// The configuration of `run`: at most `max_steps` (and `MAX_SCENE_STEPS`).
+    pub fn new(seed: u64, limits: Limits, max_steps: Option<u32>) -> Config {
+        Config {
+            seed,
+            limits,
+            cap: max_steps.unwrap_or(MAX_SCENE_STEPS).min(MAX_SCENE_STEPS),
+        }
+    }
 }
 
 /// Unit results by their guides, with the key they were computed from.
@@ -426,6 +441,9 @@ fn unit_key(
                 l.to.1 as u64,
                 u64::from(l.tokens),
                 l.heading.to_bits(),
+                u64::from(l.continues),
+                u64::from(l.aim_middle),
+                l.take.map_or(u64::MAX, f64::to_bits),
             ]);
         }
     }
@@ -437,6 +455,7 @@ fn unit_key(
             m.seq as u64,
         ]);
         pt(&mut k, m.at);
+        pt(&mut k, m.dir);
         k.push(m.pass.len() as u64);
         k.extend(m.pass.iter().map(|a| a.to_bits()));
     }
@@ -504,6 +523,9 @@ fn start(scene: &Scene, cfg: Config, unit: &[usize]) -> Result<Vec<Live>, Diagno
                 start: seed_state(s.at, s.heading),
                 string,
                 steps: 0,
+                seeded: 0,
+                via: None,
+                changed: 0,
             });
         }
         live.push(l);
@@ -608,6 +630,7 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
             // An unchanged string draws the same: keep its drawing.
             if string != inst.string {
                 inst.string = string;
+                inst.changed = t;
                 *probe = None;
             }
             *fresh = true;
@@ -667,24 +690,24 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
         let link = &scene.links[r.link];
         let poly = &scene.guides[l.guide].polygon;
         let e = link.from.1 % poly.len();
-        let (a, b) = (poly[e], poly[(e + 1) % poly.len()]);
+        let inward = inward(poly);
         let tol = 1e-6 * (1.0 + r.from.abs().max_element());
         // Of the segments drawn from where the ?X stood across the edge, the one
         // closest to its heading (the first of equals): several branches may
         // start at one point.
-        let mut hit: Option<(f64, DVec2)> = None;
+        let mut hit: Option<(f64, DVec2, DVec2)> = None;
         for &(s0, s1) in l.probes[r.instance].iter().flat_map(|p| p.grid.segs()) {
             if (s0 - r.from).length() > tol {
                 continue;
             }
-            if let Some(c) = crossing(s0, s1, a, b).filter(|&c| c > 1e-6) {
+            if let Some(c) = edge_meet(poly, inward, e, s0, s1) {
                 let along = (s1 - s0).normalize_or_zero().dot(r.dir);
-                if hit.is_none_or(|(best, _)| along > best) {
-                    hit = Some((along, s0 + (s1 - s0) * c));
+                if hit.is_none_or(|(best, _, _)| along > best) {
+                    hit = Some((along, s0 + (s1 - s0) * c, s1 - s0));
                 }
             }
         }
-        let hit = hit.map(|h| h.1);
+        let hit = hit.map(|h| (h.1, h.2));
         let token = if hit.is_some() {
             Token::Used
         } else {
@@ -697,7 +720,7 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
             instance: r.instance,
             module: r.module,
         });
-        if let Some(at) = hit {
+        if let Some((at, dir)) = hit {
             used[r.link] += 1;
             let m = Message {
                 step: t,
@@ -705,6 +728,7 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
                 from_guide: l.guide,
                 seq: l.run.sent.len(),
                 at,
+                dir,
                 pass: r.pass,
             };
             l.run.sent.push(m.clone());
@@ -729,15 +753,25 @@ fn deliver(
     let poly = &scene.guides[tg].polygon;
     let (a, b) = (poly[te % poly.len()], poly[(te + 1) % poly.len()]);
     let at = closest_on_segment(m.at, a, b);
+    // `heading continue`: the heading of the crossing segment (0 = +y,
+    // counter-clockwise positive).
+    let heading = if link.continues && m.dir.length_squared() > 0.0 {
+        (-m.dir.x).atan2(m.dir.y).to_degrees()
+    } else {
+        link.heading
+    };
     let prog = &scene.programs[scene.guides[tg].program];
     let mut args = m.pass.clone();
     args.resize(prog.params.len(), 0.0);
     let string = derive::axiom(prog, &args, cfg.seed).map_err(|e| e.diagnostic(prog))?;
     live[k].add(Instance {
         guide: tg,
-        start: seed_state(at, link.heading),
+        start: seed_state(at, heading),
         string,
         steps: 0,
+        seeded: m.step,
+        via: Some(m.link),
+        changed: m.step,
     });
     Ok(())
 }
@@ -894,6 +928,7 @@ fn reserve(scene: &Scene, l: &mut Live, k: usize, crossings: Vec<Crossing>, used
             .filter(|&i| {
                 let link = &scene.links[i];
                 link.from == (l.guide, c.edge)
+                    && link.take.is_none_or(|v| c.pass.get(1) == Some(&v))
                     && used[i] as usize + l.reserved.iter().filter(|r| r.link == i).count()
                         < link.tokens as usize
             })

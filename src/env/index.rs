@@ -17,11 +17,18 @@ pub struct Layers<'a> {
 }
 
 impl Layers<'_> {
-    /// `Grid::first_crossing` over all parts: the lowest id.
-    pub fn first_crossing(&self, p: DVec2, q: DVec2) -> Option<usize> {
-        self.parts
-            .iter()
-            .find_map(|(off, g)| g.first_crossing(p, q).map(|i| off + i))
+    /// `Grid::first_crossing` over all parts: the nearest along `p`–`q`,
+    /// then the lowest id.
+    pub fn first_crossing(&self, p: DVec2, q: DVec2) -> Option<(f64, usize)> {
+        let mut best: Option<(f64, usize)> = None;
+        for (off, g) in &self.parts {
+            if let Some((t, i)) = g.first_crossing(p, q)
+                && best.is_none_or(|b| t.total_cmp(&b.0).then((off + i).cmp(&b.1)).is_lt())
+            {
+                best = Some((t, off + i));
+            }
+        }
+        best
     }
 
     /// `Grid::nearest` over all parts: the closest, then the lowest id.
@@ -72,10 +79,16 @@ mod tests {
         }
     }
 
-    fn scan_crossing(segs: &[(DVec2, DVec2)], p: DVec2, q: DVec2) -> Option<usize> {
-        segs.iter().enumerate().find_map(|(i, s)| {
-            (!touches(s, p) && crossing(p, q, s.0, s.1).is_some_and(|t| t > 1e-6)).then_some(i)
-        })
+    fn scan_crossing(segs: &[(DVec2, DVec2)], p: DVec2, q: DVec2) -> Option<(f64, usize)> {
+        segs.iter()
+            .enumerate()
+            .filter(|(_, s)| !touches(s, p))
+            .filter_map(|(i, s)| {
+                crossing(p, q, s.0, s.1)
+                    .filter(|&t| t > 0.0)
+                    .map(|t| (t, i))
+            })
+            .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
     }
 
     fn scan_nearest(segs: &[(DVec2, DVec2)], p: DVec2) -> Option<(f64, usize)> {
@@ -196,7 +209,10 @@ mod tests {
             let segs = &segs[40 - (n - 2)..];
             assert_eq!(grid.cells() > 1, n == 42);
             let first = segs.len() - 2;
-            assert_eq!(grid.first_crossing(p, DVec2::new(5.0, 10.0)), Some(first));
+            assert_eq!(
+                grid.first_crossing(p, DVec2::new(5.0, 10.0)),
+                Some((0.5, first))
+            );
             assert_eq!(grid.nearest(p).map(|x| x.2), Some(first));
             assert_eq!(grid.ray(p, DVec2::Y, f64::INFINITY), Some((5.0, first)));
             assert_eq!(grid.ray(p, DVec2::Y, 4.0), None, "beyond the limit");
@@ -221,7 +237,8 @@ mod tests {
         ];
         let g = Grid::new(wild);
         assert_eq!(
-            g.first_crossing(DVec2::new(0.0, -1.0), DVec2::new(0.0, 2.0)),
+            g.first_crossing(DVec2::new(0.0, -1.0), DVec2::new(0.0, 2.0))
+                .map(|x| x.1),
             Some(1)
         );
     }

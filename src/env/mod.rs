@@ -10,18 +10,21 @@
 //! - `query` — the answers to query modules (`Probe`, `Answer`, `query`,
 //!   `collide`);
 //! - `clip` — the centre rule (`Clip`, `element_centres`, `outline_centre`);
+//! - `explain` — what each guide did in a run and the warnings a run
+//!   deserves (`explain`, `warnings`);
 //! - `engine` — the derive–interpret–answer loop of Měch & Prusinkiewicz
 //!   (1996) over all active L-systems with token states, messages and
 //!   incremental reruns (`execute`, `Runner`), and the entry `run`.
 //!
-//! Who may call whom (a DAG; an arrow reads "imports"): `engine` → `query`,
-//! `scene`, `index`; `query` → `scene`, `index`. `scene`, `index` and `clip`
+//! Who may call whom (a DAG; an arrow reads "imports"): `explain` → `engine`,
+//! `scene`, `clip`; `engine` → `query`, `scene`, `index`; `query` → `scene`, `index`. `scene`, `index` and `clip`
 //! import nothing from `env`. Plane geometry comes from `crate::geometry`.
 //!
 //! Must not parse or print programs.
 
 pub mod clip;
 pub mod engine;
+pub mod explain;
 pub mod index;
 pub mod query;
 pub mod scene;

@@ -9,10 +9,12 @@
 
 use super::index::Layers;
 use super::scene::Scene;
-use crate::geometry::{closest_on_segment, crossing, ray_hit, signed_angle};
+use crate::geometry::exact::orient;
+use crate::geometry::{closest_on_segment, crossing, ray_hit, signed_angle, signed_area};
 use crate::query::QueryKind;
 use crate::turtle::{Sink, State};
 use glam::{DVec2, DVec3};
+use std::cmp::Ordering;
 
 /// Collects one instance's segments and query requests.
 #[derive(Default)]
@@ -84,7 +86,8 @@ pub(crate) fn query(
         DVec2::Y
     };
     let poly = &scene.guides[gi].polygon;
-    let link_edges = || -> Vec<(usize, DVec2, DVec2)> {
+    // A link that aims at its middle is the point in the middle of its edge.
+    let link_edges = |aim: bool| -> Vec<(usize, DVec2, DVec2)> {
         scene
             .links
             .iter()
@@ -92,7 +95,13 @@ pub(crate) fn query(
             .filter(|(_, l)| l.from.0 == gi)
             .map(|(i, l)| {
                 let e = l.from.1 % poly.len().max(1);
-                (i, poly[e], poly[(e + 1) % poly.len()])
+                let (a, b) = (poly[e], poly[(e + 1) % poly.len()]);
+                if aim && l.aim_middle {
+                    let m = (a + b) * 0.5;
+                    (i, m, m)
+                } else {
+                    (i, a, b)
+                }
             })
             .collect()
     };
@@ -132,14 +141,14 @@ pub(crate) fn query(
     match kind {
         QueryKind::Position => Answer::new(&[st.pos.x, st.pos.y, st.pos.z]),
         QueryKind::Heading => Answer::new(&[st.h.x, st.h.y, st.h.z]),
-        QueryKind::DistanceLink => nearest(&link_edges()),
+        QueryKind::DistanceLink => nearest(&link_edges(true)),
         QueryKind::DistanceGuide => nearest(&guide_edges()),
         // Drawn segments have ids after the guide's edges, as for ?N_A and ?X.
         QueryKind::DistanceElement => match grid.and_then(|g| g.nearest(p)) {
             Some((d, c, i)) => closest(d, c, poly.len() + i),
             None => Answer::new(&[0.0; 4]),
         },
-        QueryKind::AheadLink => ahead(first_ahead(&link_edges())),
+        QueryKind::AheadLink => ahead(first_ahead(&link_edges(false))),
         QueryKind::AheadGuide => ahead(first_ahead(&guide_edges())),
         QueryKind::AheadElement => {
             // Guide edges come first (ids 0..n), so they win ties.
@@ -162,6 +171,15 @@ pub(crate) fn query(
 /// ?X: does the next element of length `delta` leave the guide or hit an
 /// element? Returns the answer (found, id) and the guide edge it would cross
 /// (where a link may hold a token to reserve).
+///
+/// The answer is the *nearest* hit along the segment, guide edge or drawn
+/// segment (an edge wins a tie). Whether something is hit is exact
+/// (`geometry::exact`): a segment through a vertex, touching an edge or lying
+/// along a drawn segment hits it. A guide edge counts where the segment leaves
+/// the guide or touches the edge from inside, not where it enters (a system
+/// seeded on an edge does not hit it going in). A segment through a corner
+/// meets both edges there at once: the hit is credited to the edge that starts
+/// a link if only one of them does, else to the lower edge index.
 pub(crate) fn collide(
     scene: &Scene,
     grid: Option<&Layers>,
@@ -171,21 +189,60 @@ pub(crate) fn collide(
 ) -> (Answer, Option<usize>) {
     let p = st.pos.truncate();
     let q = (st.pos + st.h * delta * st.scale).truncate();
+    let edge = edge_hit(scene, gi, p, q);
     let poly = &scene.guides[gi].polygon;
+    let drawn = grid
+        .and_then(|g| g.first_crossing(p, q))
+        .filter(|&(t, _)| edge.is_none_or(|(te, _)| t < te));
+    match (edge, drawn) {
+        (_, Some((_, i))) => (Answer::new(&[1.0, (poly.len() + i) as f64]), None),
+        (Some((_, e)), None) => (Answer::new(&[1.0, e as f64]), Some(e)),
+        (None, None) => (Answer::new(&[0.0, 0.0]), None),
+    }
+}
+
+/// The guide edge that segment `p`–`q` of a system in guide `gi` meets first
+/// (see `collide`): (parameter along `p`–`q`, edge).
+pub(crate) fn edge_hit(scene: &Scene, gi: usize, p: DVec2, q: DVec2) -> Option<(f64, usize)> {
+    let poly = &scene.guides[gi].polygon;
+    let inward = inward(poly);
+    let linked = |e: usize| scene.links.iter().any(|l| l.from == (gi, e));
     let mut best: Option<(f64, usize)> = None;
-    for (i, a, b) in edges(poly) {
-        if let Some(t) = crossing(p, q, a, b)
-            && t > 1e-6
-            && best.is_none_or(|(bt, _)| t < bt)
-        {
+    for i in 0..poly.len() {
+        let Some(t) = edge_meet(poly, inward, i, p, q) else {
+            continue;
+        };
+        let better = match best {
+            None => true,
+            Some((bt, bi)) => t < bt || (t == bt && linked(i) && !linked(bi)),
+        };
+        if better {
             best = Some((t, i));
         }
     }
-    if let Some((_, edge)) = best {
-        return (Answer::new(&[1.0, edge as f64]), Some(edge));
+    best
+}
+
+/// The side of its edges (as `orient(a, b, ·)`) on which a polygon lies.
+pub(crate) fn inward(poly: &[DVec2]) -> Ordering {
+    if signed_area(poly) >= 0.0 {
+        Ordering::Greater
+    } else {
+        Ordering::Less
     }
-    if let Some(i) = grid.and_then(|g| g.first_crossing(p, q)) {
-        return (Answer::new(&[1.0, (poly.len() + i) as f64]), None);
-    }
-    (Answer::new(&[0.0, 0.0]), None)
+}
+
+/// Where segment `p`–`q` meets edge `e` of `poly` as a guide edge counts
+/// (see `collide`): not when it ends strictly on the inner side (entering, or
+/// starting on the edge and going in). `inward` is `inward(poly)`.
+pub(crate) fn edge_meet(
+    poly: &[DVec2],
+    inward: Ordering,
+    e: usize,
+    p: DVec2,
+    q: DVec2,
+) -> Option<f64> {
+    let n = poly.len();
+    let (a, b) = (poly[e % n], poly[(e + 1) % n]);
+    crossing(p, q, a, b).filter(|_| orient(a, b, q) != inward)
 }

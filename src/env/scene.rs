@@ -10,12 +10,16 @@ use crate::ast::{self, File, GuideStmt, Item, LinkStmt, SceneStmt};
 use crate::check::Checked;
 use crate::compile::{self, CompileError, Program};
 use crate::diagnostic::{Code, Diagnostic};
+use crate::span::Span;
 use crate::turtle::State;
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
 
+#[derive(Clone)]
 pub struct Guide {
     pub name: String,
+    /// Where the guide's name is written (for diagnostics about it).
+    pub span: Span,
     pub polygon: Vec<DVec2>,
     /// Index into `Scene::programs`.
     pub program: usize,
@@ -30,14 +34,27 @@ pub struct Seed {
     pub args: Vec<f64>,
 }
 
+#[derive(Clone)]
 pub struct Link {
+    /// From `link` to the end of its far edge reference (for diagnostics).
+    pub span: Span,
     pub from: (usize, usize),
     pub to: (usize, usize),
     pub tokens: u32,
     pub used: u32,
     pub heading: f64,
+    /// `heading continue;`: the seeded system keeps the heading of the segment
+    /// that crossed (`heading` is then unused).
+    pub continues: bool,
+    /// `aim middle;`: `?D_L` in the start guide measures to the middle of this
+    /// link's edge, not to its closest point.
+    pub aim_middle: bool,
+    /// `take v;`: only a `?X` whose second parameter (the first after Δ) is `v`
+    /// takes this link's tokens.
+    pub take: Option<f64>,
 }
 
+#[derive(Clone)]
 pub struct Scene {
     pub name: String,
     pub guides: Vec<Guide>,
@@ -139,6 +156,7 @@ fn guides(file: &File, checked: &Checked, scene: &ast::Scene) -> Result<Guides, 
         index.insert(g.name.name.clone(), guides.len());
         guides.push(Guide {
             name: g.name.name.clone(),
+            span: g.name.span,
             polygon,
             program,
             seeds,
@@ -190,19 +208,33 @@ fn links(
             Ok((g, value(&r.index, checked) as usize))
         };
         let (mut tokens, mut heading) = (0u32, 0.0);
+        let (mut continues, mut aim_middle, mut take) = (false, false, None);
         for ls in &l.body.stmts {
             match &ls.node {
                 LinkStmt::Tokens(e) => tokens = value(e, checked) as u32,
+                LinkStmt::Heading(e) if link_word(e) == Some("continue") => continues = true,
                 LinkStmt::Heading(e) => heading = value(e, checked),
+                LinkStmt::Setting(k, e) => match k.name.as_str() {
+                    "aim" => aim_middle = link_word(e) == Some("middle"),
+                    "take" => take = Some(value(e, checked)),
+                    _ => {}
+                },
                 LinkStmt::Error => {}
             }
         }
         links.push(Link {
+            span: Span {
+                start: st.span.start,
+                end: l.to.span.end,
+            },
             from: end(&l.from)?,
             to: end(&l.to)?,
             tokens,
             used: 0,
             heading,
+            continues,
+            aim_middle,
+            take,
         });
     }
     Ok(links)
@@ -218,5 +250,14 @@ pub fn seed_state(at: DVec2, deg: f64) -> State {
         l: DVec3::Z.cross(h),
         u: DVec3::Z,
         ..State::default()
+    }
+}
+
+/// A link setting's value written as a bare word (`heading continue;`, `aim
+/// middle;`), as the checker reads it.
+fn link_word(e: &ast::Expr) -> Option<&str> {
+    match &e.kind {
+        ast::ExprKind::Var(n) => Some(n.as_str()),
+        _ => None,
     }
 }

@@ -25,6 +25,10 @@ const CLI_ONLY: &[Code] = &[
     Code::DrawingTooLarge,
     // Only `lsyc run` needs an lsystem: tests/it/hostile.rs.
     Code::NoLsystem,
+    // Warnings of a scene's run: tests/it/guided.rs.
+    Code::NeverSeeded,
+    Code::DeriveRanOut,
+    Code::LeavesAndComesBack,
 ];
 
 fn expected_codes(text: &str) -> Vec<String> {

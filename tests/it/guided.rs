@@ -478,3 +478,249 @@ scene S {
     assert_eq!((stats.segments, stats.elements), (1, 1));
     assert_eq!(stats.bbox, Some([5.0, 2.0, 5.0, 6.0]));
 }
+
+/// The outputs of module `n` of system `k`, after the run.
+fn outputs(scene: &Scene, out: &Outcome, k: usize, n: usize) -> Vec<f64> {
+    let inst = &out.instances[k];
+    let prog = &scene.programs[scene.guides[inst.guide].program];
+    let at: usize = inst.string.syms[..n]
+        .iter()
+        .map(|&s| prog.symbols.arity(s))
+        .sum();
+    inst.string.params[at..at + prog.symbols.arity(inst.string.syms[n])].to_vec()
+}
+
+/// A stem growing straight up through the apex (5, 10) of a roof-shaped guide:
+/// its last segment meets both roof edges at the apex. The crossing is credited
+/// to the edge that starts a link (edge 3, not the lower-numbered edge 2), the
+/// token is used, and nothing is drawn beyond the apex (no stem leaving and
+/// coming back, no fork).
+#[test]
+fn a_stem_through_a_vertex_crosses_the_linked_edge() {
+    let text = "
+lsystem Up {
+    derive 20;
+    axiom ?X(3);
+    ?X(found, _, d) : found -> F(d) cut;
+    ?X(_, _, d) -> F(d) ?X(d);
+}
+lsystem Side(d) { derive 0; axiom F(d); }
+scene S {
+    guide a { polygon (0, 0) (10, 0) (10, 8) (5, 10) (0, 8); system Up; seed (5, 0) heading 0; }
+    guide b { polygon (0, 8) (5, 10) (5, 20) (0, 20); system Side; }
+    link a.edge(3) -> b.edge(0) { tokens 1; heading 0; }
+}";
+    let (scene, out) = run(text);
+    assert_eq!(out.messages, 1);
+    assert_eq!(scene.links[0].used, 1);
+    assert_eq!(out.guides[0].sent[0].at, DVec2::new(5.0, 10.0));
+    // Four segments up to y = 12 and nothing after them (the cut removed the
+    // rest): one F per ?X, no fork.
+    let inst = &out.instances[0];
+    assert_eq!(inst.string.params, vec![3.0; 4]);
+}
+
+/// A segment drawn on the very line of a later ?X is seen: the ?X answers it
+/// (id 4, the first drawn segment after the 4 guide edges) and not the guide's
+/// top edge beyond it.
+#[test]
+fn x_sees_a_collinear_segment() {
+    let text = "
+lsystem Probe { derive 0; axiom [f(6) F(2)] ?X(10); }
+scene S {
+    guide g { polygon (0, 0) (10, 0) (10, 10) (0, 10); system Probe; seed (5, 1) heading 0; }
+}";
+    let (scene, out) = run(text);
+    assert_eq!(outputs(&scene, &out, 0, 4), vec![1.0, 4.0, 10.0]);
+}
+
+/// A drawn segment nearer along the way than the guide's edge is what ?X
+/// reports, and the linked edge behind it reserves no token.
+#[test]
+fn x_reports_the_nearest_hit_whether_edge_or_drawn_segment() {
+    let text = "
+lsystem Probe { derive 1; axiom [f(7) +(90) f(1) +(180) F(2)] ?X(12); }
+lsystem Side { derive 0; axiom F; }
+scene S {
+    guide g { polygon (0, 0) (10, 0) (10, 10) (0, 10); system Probe; seed (5, 1) heading 0; }
+    guide h { polygon (0, 10) (10, 10) (10, 20) (0, 20); system Side; }
+    link g.edge(2) -> h.edge(0) { tokens 1; }
+}";
+    let (scene, out) = run(text);
+    // The cross bar at y = 8 is nearer than the top edge at y = 10.
+    assert_eq!(outputs(&scene, &out, 0, 7), vec![1.0, 4.0, 12.0]);
+    assert_eq!(events(&out, 0), vec![]);
+    // Without the bar, the top edge is hit and its token reserved.
+    let (scene, out) = run(&text.replace("F(2)]", "f(2)]"));
+    assert_eq!(outputs(&scene, &out, 0, 7), vec![1.0, 2.0, 12.0]);
+    assert_eq!(events(&out, 0)[0].2, Token::Reserved);
+}
+
+/// The warnings of a scene run, rendered as `lsyc run` prints them, and the
+/// per-guide explanation.
+fn warnings_of(text: &str) -> (String, String) {
+    let mut scene = build(text);
+    let out = lsyc::env::run(&mut scene, 0, Default::default(), None).expect("runs");
+    let cfg = Config::new(0, Default::default(), None);
+    let diags = lsyc::env::explain::warnings(&scene, &out, cfg);
+    let reports = lsyc::env::explain::explain(&scene, &out, cfg).expect("explains");
+    (
+        crate::support::render_plain(&diags, "scene.lsy", text),
+        lsyc::env::explain::render(&scene, &reports),
+    )
+}
+
+/// A stem that needs 21 steps (a query, then a segment, ten times, and the
+/// last query) under `derive 10`: it stops half-way, the crown is never seeded,
+/// and the run says both, with the steps it would need.
+const SHORT: &str = "lsystem Stem {
+    derive 10;
+    axiom ?D_L(10);
+    ?D_L(found, _, beta, _, D) : found -> +(beta * 0.5) ?X(D);
+    ?D_L(_, _, _, _, _) -> ;
+    ?X(found, _, D) : found -> F(D) cut;
+    ?X(_, _, D) -> F(D) ?D_L(D);
+}
+lsystem Crown(D) { derive 1; axiom F(D); }
+scene S {
+    guide stem { polygon (-10, 0) (10, 0) (10, 100) (-10, 100); system Stem; seed (0, 0) heading 0; }
+    guide crown { polygon (-10, 100) (10, 100) (30, 150) (-30, 150); system Crown; }
+    link stem.edge(2) -> crown.edge(0) { tokens 1; heading 0; }
+}
+";
+
+#[test]
+fn a_run_cut_short_says_why_the_far_guide_stayed_empty() {
+    let (warnings, explained) = warnings_of(SHORT);
+    insta::assert_snapshot!("warnings_cut_short", warnings);
+    insta::assert_snapshot!("explain_cut_short", explained);
+    // With the steps the warning names, the crown grows and nothing warns.
+    let need = warnings
+        .split("write `derive ")
+        .nth(1)
+        .and_then(|s| s.split(';').next())
+        .expect("a step count");
+    let fixed = SHORT.replace("derive 10;", &format!("derive {need};"));
+    let (warnings, explained) = warnings_of(&fixed);
+    assert_eq!(warnings, "", "{warnings}");
+    assert!(
+        explained.contains("guide crown (lsystem Crown):\n  seeded at step"),
+        "{explained}"
+    );
+}
+
+#[test]
+fn growth_that_leaves_its_guide_and_comes_back_is_reported() {
+    let text = "lsystem Out { derive 0; axiom F(5) -(90) F(20) +(180) F(20) F(2); }
+scene S {
+    guide g { polygon (0, 0) (10, 0) (10, 10) (0, 10); system Out; seed (5, 1) heading 0; }
+}
+";
+    let (warnings, _) = warnings_of(text);
+    insta::assert_snapshot!("warnings_comes_back", warnings);
+}
+
+/// A stem whose every segment also starts a stray shoot at 60°: the link's
+/// `take 1` lets only the stem's `?X(D, 1)` use the token (the shoots pass 0),
+/// `aim middle` steers the stem to the middle of the top edge, and `heading
+/// continue` seeds the crown with the heading of the segment that crossed.
+const AIMED: &str = "lsystem Stem {
+    derive 60;
+    axiom ?D_L(10, 1);
+    ?D_L(found, _, beta, _, D, k) : found -> +(beta * 0.5) ?X(D, k);
+    ?D_L(_, _, _, _, _, _) -> ;
+    ?X(found, _, D, _) : found -> F(D) cut;
+    ?X(_, _, D, k) -> F(D) [+(60) ?X(D, 0)] ?D_L(D, k);
+}
+lsystem Crown(D, _) { derive 0; axiom F(D); }
+scene S {
+    guide stem { polygon (-10, 0) (10, 0) (10, 100) (-10, 100); system Stem; seed (-5, 0) heading 0; }
+    guide crown { polygon (-10, 100) (10, 100) (30, 150) (-30, 150); system Crown; }
+    link stem.edge(2) -> crown.edge(0) { tokens 1; heading continue; aim middle; take 1; }
+}
+";
+
+#[test]
+fn links_aim_take_and_continue() {
+    let (scene, out) = run(AIMED);
+    assert_eq!(out.messages, 1);
+    // The stem (k = 1) took the token: the message carries (D, 1).
+    let m = &out.guides[0].sent[0];
+    assert_eq!(m.pass, vec![10.0, 1.0]);
+    // Aiming at the middle (0, 100), it crossed near it.
+    assert!(m.at.x.abs() < 2.0, "{}", m.at);
+    // The crown starts with the crossing segment's heading.
+    let crown = out.instances.iter().find(|i| i.guide == 1).expect("seeded");
+    let h = crown.start.h.truncate();
+    assert!((h - m.dir.normalize()).length() < 1e-9, "{h} {}", m.dir);
+    assert!(scene.links[0].continues && scene.links[0].aim_middle);
+    // Without `take 1`, a stray shoot (k = 0) reaches the edge first and
+    // takes the token; without `aim middle`, the stem goes for the closest
+    // point of the edge (straight up from where it stands, x = -5).
+    let (_, out) = run(&AIMED.replace(" take 1;", ""));
+    assert_eq!(out.guides[0].sent[0].pass, vec![10.0, 0.0]);
+    let (_, out) = run(&AIMED.replace(" aim middle;", ""));
+    assert!(
+        out.guides[0].sent[0].at.x < -3.0,
+        "{}",
+        out.guides[0].sent[0].at
+    );
+}
+
+/// The newcomer's scene: the stem-and-crown program of the reference's
+/// "Scenes, guides and links", run as printed. The stem reaches the link at
+/// the top of its guide, its crossing seeds the crown (which receives the
+/// stem's Δ), the crown grows, and the run has nothing to warn about.
+#[test]
+fn the_references_stem_and_crown_work_as_printed() {
+    let md = crate::support::read_text(&crate::support::root().join("docs/language.md"));
+    let start = md
+        .find("scene StemAndCrown")
+        .expect("the scene is in the reference");
+    let open = md[..start].rfind("```lsy\n").expect("its block") + "```lsy\n".len();
+    let close = start + md[start..].find("```").expect("closed");
+    let text = &md[open..close];
+    let (scene, out) = run(text);
+    assert_eq!(out.messages, 1);
+    assert_eq!(scene.links[0].used, 1);
+    let crown = out
+        .instances
+        .iter()
+        .find(|i| i.guide == 1)
+        .expect("crown seeded");
+    assert_eq!(crown.via, Some(0));
+    // The message crossed near the middle of the top edge, and the crown grew.
+    assert!(
+        out.guides[0].sent[0].at.x.abs() < 3.0,
+        "{}",
+        out.guides[0].sent[0].at
+    );
+    assert_eq!(out.guides[0].sent[0].pass, vec![10.0]);
+    assert!(crown.string.len() > 100, "{}", crown.string.len());
+    let (warnings, _) = warnings_of(text);
+    assert_eq!(warnings, "");
+}
+
+/// `lsyc run --explain` prints the explanation after the run's warnings, on
+/// stderr, and the run still succeeds.
+#[test]
+fn run_explain_on_the_command_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let file = dir.path().join("short.lsy");
+    std::fs::write(&file, SHORT).expect("written");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_lsyc"))
+        .arg("run")
+        .arg(&file)
+        .arg("--explain")
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let (w, x) = (
+        err.find("warning[W0801]").expect("the warning"),
+        err.find("guide crown (lsystem Crown):\n  never seeded")
+            .expect("the explanation"),
+    );
+    assert!(w < x, "{err}");
+    assert!(err.contains("write `derive 20;`"), "{err}");
+}

@@ -5,6 +5,7 @@ mod bridge;
 mod cli;
 mod corpus;
 mod diagnostics;
+mod docs;
 mod edit;
 mod evaluator;
 mod geometry;

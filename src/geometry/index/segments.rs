@@ -262,17 +262,34 @@ impl SegmentGrid {
         &self.items[self.start[c] as usize..self.start[c + 1] as usize]
     }
 
-    /// The lowest-indexed segment that `p`–`q` crosses (beyond its very start),
-    /// not counting segments touching `p`.
-    pub fn first_crossing(&self, p: DVec2, q: DVec2) -> Option<usize> {
+    /// The segment that `p`–`q` meets first going from `p` (crossing,
+    /// touching or overlapping on one line; [`crossing`]): (parameter along
+    /// `p`–`q`, index), the lowest index among equally near ones. Segments
+    /// touching `p` (the asker's own) and segments that `p` lies on (what the
+    /// turtle stands on) are skipped.
+    pub fn first_crossing(&self, p: DVec2, q: DVec2) -> Option<(f64, usize)> {
         if self.nx == 0 || !(p.is_finite() && q.is_finite()) {
             return None;
         }
+        let hit = |i: usize| -> Option<(f64, usize)> {
+            let s = &self.segs[i];
+            if touches(s, p) {
+                return None;
+            }
+            crossing(p, q, s.0, s.1)
+                .filter(|&t| t > 0.0)
+                .map(|t| (t, i))
+        };
+        let nearer = |best: Option<(f64, usize)>, x: (f64, usize)| match best {
+            Some(b) if b.0.total_cmp(&x.0).then(b.1.cmp(&x.1)).is_le() => Some(b),
+            _ => Some(x),
+        };
         if self.nx * self.ny == 1 {
-            return self.items.iter().map(|&i| i as usize).find(|&i| {
-                let s = &self.segs[i];
-                !touches(s, p) && crossing(p, q, s.0, s.1).is_some_and(|t| t > 1e-6)
-            });
+            return self
+                .items
+                .iter()
+                .filter_map(|&i| hit(i as usize))
+                .fold(None, nearer);
         }
         let mut cells = Vec::new();
         self.walk(p, q, &mut cells);
@@ -282,10 +299,10 @@ impl SegmentGrid {
             .collect();
         cands.sort_unstable();
         cands.dedup();
-        cands.into_iter().map(|i| i as usize).find(|&i| {
-            let s = &self.segs[i];
-            !touches(s, p) && crossing(p, q, s.0, s.1).is_some_and(|t| t > 1e-6)
-        })
+        cands
+            .into_iter()
+            .filter_map(|i| hit(i as usize))
+            .fold(None, nearer)
     }
 
     /// The closest segment to `p` not touching it: (distance, closest point,
