@@ -1,10 +1,13 @@
 //! `lsyc run FILE`: derive, draw, and write SVG, PNG, OBJ or text.
 
 use super::{Reporter, check::overrides};
+
+mod outputs;
 use lsyc::derive::Limits;
 use lsyc::diagnostic::{Code, Diagnostic};
-use lsyc::run::{self, Format, Options, OutputError, Picture, Stats};
+use lsyc::run::{self, Format, Options, OutputError, Stats};
 use lsyc::{frontend, source};
+use outputs::{parse_view, picture};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -18,9 +21,19 @@ pub struct Args {
     #[arg(short = 'n', long = "steps", value_name = "STEPS")]
     pub steps: Option<u32>,
 
-    /// Output file; its extension picks the format: .svg .png .obj .txt
+    /// Output file; its extension picks the format: .svg .png .obj (+ .mtl) .glb
+    /// .txt, or .apng (every step, animated)
     #[arg(short = 'o', long = "output", value_name = "OUT")]
     pub output: Option<PathBuf>,
+
+    /// Camera of 3D programs in SVG and PNG, in degrees (default 30,20).
+    #[arg(long, value_name = "AZIMUTH,ELEVATION", value_parser = parse_view, allow_hyphen_values = true)]
+    pub view: Option<[f64; 2]>,
+
+    /// Write every derivation step: -o DIR/NAME.EXT gives DIR/NAME-000.EXT (the
+    /// axiom) to NAME-NNN.EXT, all in the final step's view box.
+    #[arg(long)]
+    pub frames: bool,
 
     /// Print statistics as one JSON object on stdout.
     #[arg(long)]
@@ -237,18 +250,12 @@ fn run_system(
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let derived = derived.map_err(fail)?;
+    let mut derived = derived.map_err(fail)?;
     let start = Instant::now();
     let drawn = match (format, &args.output) {
         (Some(format), Some(path)) => {
-            let picture = Picture {
-                size: args.size,
-                background,
-            };
-            write_file(path, reporter, src, |w| {
-                run::write_output(&derived, format, picture, args.seed, w)
-            })
-            .ok_or(1u8)?
+            let picture = picture(args, background);
+            outputs::write(args, reporter, src, &mut derived, format, path, &picture)?
         }
         _ => run::measure(&derived, args.seed).map_err(fail)?.0,
     };
@@ -359,19 +366,18 @@ fn run_scene(
             return 1;
         }
     };
-    let picture = Picture {
-        size: args.size,
-        background,
-    };
+    let picture = picture(args, background);
     let stats = match &args.output {
-        Some(path) => {
-            match write_file(path, reporter, src, |w| {
-                run::write_scene(&r, format, picture, args.seed, args.guides, w)
-            }) {
-                Some(s) => s,
-                None => return 1,
+        Some(path) => match outputs::write_scene(args, reporter, src, &r, format, path, picture) {
+            Some(s) => s,
+            None => {
+                return if args.frames || format == Some(Format::Apng) {
+                    2
+                } else {
+                    1
+                };
             }
-        }
+        },
         None => match run::write_scene(&r, None, picture, args.seed, false, &mut std::io::sink()) {
             Ok(s) => s,
             Err(OutputError::Diagnostic(d)) => {
