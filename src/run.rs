@@ -365,7 +365,7 @@ pub fn each_step(
     let args = vec![0.0; d.prog.params.len()];
     let axiom = derive::axiom(&d.prog, &args, seed).map_err(|e| e.diagnostic(&d.prog));
     let mut s = axiom.map_err(OutputError::Diagnostic)?;
-    let final_string = std::mem::replace(&mut d.string, ModString::default());
+    let final_string = std::mem::take(&mut d.string);
     let mut result = Ok(());
     for k in 0..=last {
         if k > 0 {
