@@ -323,9 +323,11 @@ fn report_stats(args: &Args, stats: &impl serde::Serialize) -> String {
     {
         println!("{s}");
     }
-    args.output
-        .as_ref()
-        .map_or(String::new(), |p| format!(", wrote {}", p.display()))
+    match &args.output {
+        Some(_) if args.frames => ", wrote its frames".to_string(),
+        Some(p) => format!(", wrote {}", p.display()),
+        None => String::new(),
+    }
 }
 
 fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
