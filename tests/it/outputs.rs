@@ -74,7 +74,10 @@ fn gallery_3d() -> Vec<PathBuf> {
         .filter(|p| !has_scene(p) && derive_file(p, Some(0)).prog.is_3d)
         .collect();
     assert!(found.len() >= 3, "3D gallery programs: {found:?}");
-    eprintln!("3D gallery: {:?}", found.iter().map(|p| rel(p)).collect::<Vec<_>>());
+    eprintln!(
+        "3D gallery: {:?}",
+        found.iter().map(|p| rel(p)).collect::<Vec<_>>()
+    );
     found
 }
 

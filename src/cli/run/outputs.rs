@@ -2,7 +2,8 @@
 //! frames (`--frames`), an animated PNG, and the `--view` camera.
 //!
 //! Owns: file names beside the output (`X.mtl`, `NAME-000.EXT`), writing each
-//! atomically, and the frames' progress bar. Drawing is the library's
+//! atomically, and the progress shown while writing (a bar of frames, a
+//! spinner for one big file; neither when stderr is not a terminal). Drawing is the library's
 //! (`lsyc::run`).
 
 use super::{Args, Reporter, write_file};
@@ -98,6 +99,22 @@ fn frames_bar(len: u32) -> Option<indicatif::ProgressBar> {
     Some(bar)
 }
 
+/// A spinner with the elapsed time while `path` is written (big drawings
+/// take seconds); none when stderr is not a terminal.
+fn writing_spinner(path: &Path) -> Option<indicatif::ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new_spinner();
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} writing {msg} {elapsed}")
+    {
+        bar.set_style(style);
+    }
+    bar.set_message(path.display().to_string());
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    Some(bar)
+}
+
 /// Writes one lsystem's output(s) to `path`; reports failures and returns
 /// the exit status (1 an error in the input or the file, 2 a usage error).
 pub fn write(
@@ -132,8 +149,12 @@ pub fn write(
         return written.map(|w| w.drawn).ok_or(1);
     }
     if !args.frames {
-        let written = write_one(reporter, src, derived, format, path, picture, args.seed)?;
-        return Ok(written.drawn);
+        let spinner = writing_spinner(path);
+        let written = write_one(reporter, src, derived, format, path, picture, args.seed);
+        if let Some(s) = spinner {
+            s.finish_and_clear();
+        }
+        return written.map(|w| w.drawn);
     }
     let last = derived.steps;
     let bar = frames_bar(last + 1);
@@ -223,9 +244,14 @@ pub fn write_scene(
         );
         return None;
     }
+    let spinner = writing_spinner(path);
     let stats = write_file(path, reporter, src, |w| {
         run::write_scene(r, format, picture, args.seed, args.guides, w)
-    })?;
+    });
+    if let Some(s) = spinner {
+        s.finish_and_clear();
+    }
+    let stats = stats?;
     if format == Some(Format::Obj) && !write_mtl(path, &stats.materials, reporter, src) {
         return None;
     }
