@@ -301,7 +301,8 @@ pub fn write_output_full(
         }
         Format::Glb => {
             let options = render::obj::ObjOptions::for_program(&d.prog);
-            let mut w = render::obj::MeshBuilder::with_target(render::glb::GlbMesh::new(), options);
+            let glb = render::glb::GlbMesh::with_budget(d.limits.max_bytes);
+            let mut w = render::obj::MeshBuilder::with_target(glb, options);
             w.object(&d.prog.name);
             let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
             if let Some(b) = drawn.bbox {
@@ -653,7 +654,7 @@ pub fn write_scene(
             w.finish()?;
         }
         Some(Format::Glb) => {
-            let glb = render::glb::GlbMesh::new();
+            let glb = render::glb::GlbMesh::with_budget(r.limits.max_bytes);
             let mut w = render::obj::MeshBuilder::with_target(glb, scene_mesh_options(r));
             scene_mesh(r, seed, &mut w)?;
             materials = w.colors();

@@ -44,11 +44,40 @@ pub struct GlbMesh {
     color: u32,
     /// Too many vertices for 32-bit indices: writing fails.
     overflow: bool,
+    /// Bytes the mesh may hold in memory (0: no bound), and about how many
+    /// it holds; past the bound nothing more is kept and writing fails.
+    budget: usize,
+    held: usize,
+    over_budget: bool,
 }
+
+/// About how many bytes of memory a position or normal, a distinct corner
+/// (its map entry and list item) and a triangle take.
+const VECTOR_BYTES: usize = 24;
+const CORNER_BYTES: usize = 56;
+const TRIANGLE_BYTES: usize = 12;
 
 impl GlbMesh {
     pub fn new() -> GlbMesh {
         GlbMesh::default()
+    }
+
+    /// A mesh that holds at most about `max_bytes` in memory (the run's
+    /// `--max-memory`): glTF is written at the end, not streamed like OBJ.
+    pub fn with_budget(max_bytes: usize) -> GlbMesh {
+        GlbMesh {
+            budget: max_bytes,
+            ..GlbMesh::default()
+        }
+    }
+
+    /// Counts `bytes` more; false (and nothing more is kept) past the budget.
+    fn hold(&mut self, bytes: usize) -> bool {
+        self.held = self.held.saturating_add(bytes);
+        if self.budget > 0 && self.held > self.budget {
+            self.over_budget = true;
+        }
+        !self.over_budget
     }
 
     fn corner(&mut self, c: (u64, u64)) -> Option<u32> {
@@ -61,12 +90,16 @@ impl GlbMesh {
         if let Some(&i) = prim.index.get(&c) {
             return Some(i);
         }
+        if self.over_budget {
+            return None;
+        }
         let Ok(i) = u32::try_from(prim.corners.len()) else {
             self.overflow = true;
             return None;
         };
         prim.index.insert(c, i);
         prim.corners.push(c);
+        self.hold(CORNER_BYTES);
         Some(i)
     }
 
@@ -74,6 +107,9 @@ impl GlbMesh {
         let (Some(a), Some(b), Some(c)) = (self.corner(a), self.corner(b), self.corner(c)) else {
             return;
         };
+        if !self.hold(TRIANGLE_BYTES) {
+            return;
+        }
         if let Some(prim) = self
             .objects
             .last_mut()
@@ -92,6 +128,13 @@ impl GlbMesh {
 
     /// Writes the GLB file.
     pub fn write(self, out: &mut dyn Write) -> io::Result<()> {
+        if self.over_budget {
+            return Err(io::Error::other(format!(
+                "the glTF mesh needs more than {} MiB of memory (--max-memory); \
+                 write OBJ, which streams, or draw fewer steps",
+                self.budget >> 20
+            )));
+        }
         if self.overflow {
             return Err(io::Error::other(
                 "the mesh has more vertices of one colour than glTF's 32-bit indices can number",
@@ -219,11 +262,17 @@ impl GlbMesh {
 
 impl MeshTarget for GlbMesh {
     fn vertex(&mut self, p: DVec3) {
-        self.positions.push(p);
+        // Vertices keep their numbers even past the budget (faces refer to
+        // them); only their values are dropped.
+        if self.hold(VECTOR_BYTES) {
+            self.positions.push(p);
+        }
     }
 
     fn normal(&mut self, n: DVec3) {
-        self.normals.push(n);
+        if self.hold(VECTOR_BYTES) {
+            self.normals.push(n);
+        }
     }
 
     fn face(&mut self, corners: &[(u64, u64)]) {

@@ -622,3 +622,23 @@ fn frames_and_animations_of_scenes_are_usage_errors() {
         assert!(String::from_utf8_lossy(&r.stderr).contains("not yet for a scene"));
     }
 }
+
+#[test]
+fn glb_beyond_the_memory_limit_is_a_clear_error() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("bush.glb");
+    let r = lsyc(&[
+        "run",
+        s(&example("bush-3d.lsy")),
+        "-n",
+        "5",
+        "--max-memory",
+        "1",
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(r.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(err.contains("--max-memory"), "{err}");
+    assert!(!out.exists(), "nothing is written");
+}
