@@ -642,3 +642,29 @@ fn glb_beyond_the_memory_limit_is_a_clear_error() {
     assert!(err.contains("--max-memory"), "{err}");
     assert!(!out.exists(), "nothing is written");
 }
+
+/// Stepping from the axiom gives each step's string exactly as `-n k` does,
+/// random draws included, and leaves the final string in place.
+#[test]
+fn each_step_replays_stochastic_growth() {
+    let path = example("stochastic-plant.lsy");
+    let mut last = derive_file(&path, Some(5));
+    let final_string = format!("{:?}", txt_of(&last));
+    let mut seen = Vec::new();
+    let r = run::each_step(&mut last, &Picture::default(), 0, &mut |d, framed| {
+        assert!(framed.bounds.is_some(), "frames share a view box");
+        seen.push((d.steps, txt_of(d)));
+        Ok(())
+    });
+    assert!(r.is_ok());
+    assert_eq!(seen.len(), 6);
+    for (k, text) in &seen {
+        assert_eq!(text, &txt_of(&derive_file(&path, Some(*k))), "step {k}");
+    }
+    assert_eq!(format!("{:?}", txt_of(&last)), final_string);
+}
+
+fn txt_of(d: &Derived) -> String {
+    let (bytes, _) = output(d, Format::Txt, &Picture::default());
+    String::from_utf8(bytes).expect("utf-8")
+}
