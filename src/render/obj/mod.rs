@@ -1,5 +1,7 @@
-//! Wavefront OBJ output: a streaming `turtle::Sink` that writes segments as
-//! closed tubes, polygons `{ . }` as faces and elements as flat outlines.
+//! The 3D mesh of a drawing, written as Wavefront OBJ (and, through
+//! `crate::render::glb`, as glTF): a streaming `turtle::Sink` that builds
+//! segments as closed tubes, polygons `{ . }` as faces and elements as flat
+//! outlines.
 //!
 //! Owns: the 3D mesh form of a drawing. Segments become generalized cylinders
 //! (the sources' "generalized cylinders with spherical joints"): a chain of
