@@ -80,8 +80,14 @@ pub fn derive(
 pub enum Format {
     Svg,
     Png,
+    /// Wavefront OBJ; its material library (`.mtl`) is written beside it from
+    /// [`Written::materials`].
     Obj,
+    /// Binary glTF 2.0.
+    Glb,
     Txt,
+    /// An animated PNG of every derivation step (one lsystem).
+    Apng,
 }
 
 impl Format {
@@ -91,17 +97,29 @@ impl Format {
             "svg" => Format::Svg,
             "png" => Format::Png,
             "obj" => Format::Obj,
+            "glb" => Format::Glb,
             "txt" => Format::Txt,
+            "apng" => Format::Apng,
             _ => return None,
         })
     }
 }
 
-/// Settings of the picture formats.
-#[derive(Clone, Copy, Debug)]
+/// Settings of the output formats.
+#[derive(Clone, Debug)]
 pub struct Picture {
     pub size: u32,
     pub background: [u8; 4],
+    /// The camera of 3D programs in SVG and PNG: azimuth and elevation in
+    /// degrees (`None`: the default view, 30, 20).
+    pub view: Option<[f64; 2]>,
+    /// Draw into this view box instead of fitting the drawing (growth frames
+    /// all use the final step's).
+    pub bounds: Option<Bounds>,
+    /// The material library an OBJ names in its `mtllib` line.
+    pub mtllib: Option<String>,
+    /// Time each frame of an animation is shown, in milliseconds.
+    pub frame_ms: u16,
 }
 
 impl Default for Picture {
@@ -109,8 +127,30 @@ impl Default for Picture {
         Picture {
             size: 1024,
             background: [255, 255, 255, 255],
+            view: None,
+            bounds: None,
+            mtllib: None,
+            frame_ms: 400,
         }
     }
+}
+
+impl Picture {
+    /// The view of a program (3D or not) under these settings.
+    pub fn view(&self, is_3d: bool) -> View {
+        match self.view {
+            Some([azimuth, elevation]) if is_3d => View::oblique(azimuth, elevation),
+            _ => View::new(is_3d),
+        }
+    }
+}
+
+/// What writing an output gives back.
+#[derive(Clone, Debug, Default)]
+pub struct Written {
+    pub drawn: Drawn,
+    /// The colours the mesh used (OBJ: the materials its `.mtl` must define).
+    pub materials: Vec<u32>,
 }
 
 /// Local bounding boxes of the program's elements (for fitting the view).
@@ -121,11 +161,16 @@ fn element_boxes(prog: &Program) -> Vec<[f64; 4]> {
         .collect()
 }
 
-/// Draws without output: the counts and bounding box.
+/// Draws without output: the counts and bounding box (in the default view).
 pub fn measure(d: &Derived, seed: u64) -> Result<(Drawn, Bounds), Diagnostic> {
+    measure_in(d, seed, View::new(d.prog.is_3d))
+}
+
+/// Draws without output: the counts and bounding box as `view` sees them.
+pub fn measure_in(d: &Derived, seed: u64, view: View) -> Result<(Drawn, Bounds), Diagnostic> {
     let boxes = element_boxes(&d.prog);
     let mut sink = BoundsSink {
-        view: View::new(d.prog.is_3d),
+        view,
         bounds: Bounds::default(),
         element_boxes: &boxes,
     };
@@ -186,14 +231,37 @@ pub fn write_output(
     seed: u64,
     out: &mut dyn Write,
 ) -> Result<Drawn, OutputError> {
-    match format {
+    write_output_full(d, format, &picture, seed, out).map(|w| w.drawn)
+}
+
+/// The view box of a picture: the one given, or the drawing's own.
+fn picture_bounds(
+    d: &Derived,
+    picture: &Picture,
+    seed: u64,
+    view: View,
+) -> Result<Bounds, OutputError> {
+    let (_, own) = measure_in(d, seed, view).map_err(OutputError::Diagnostic)?;
+    Ok(picture.bounds.unwrap_or(own))
+}
+
+/// Writes `d` in `format` to `out`; returns what was drawn and the materials used.
+pub fn write_output_full(
+    d: &Derived,
+    format: Format,
+    picture: &Picture,
+    seed: u64,
+    out: &mut dyn Write,
+) -> Result<Written, OutputError> {
+    let view = picture.view(d.prog.is_3d);
+    let drawn = match format {
         Format::Txt => {
             render::txt::write(out, &d.prog, &d.string)?;
             let (drawn, _) = measure(d, seed).map_err(OutputError::Diagnostic)?;
-            Ok(drawn)
+            drawn
         }
         Format::Svg => {
-            let (_, bounds) = measure(d, seed).map_err(OutputError::Diagnostic)?;
+            let bounds = picture_bounds(d, picture, seed, view)?;
             let used: Vec<bool> = (0..d.prog.elements.len())
                 .map(|i| {
                     d.prog
@@ -203,41 +271,181 @@ pub fn write_output(
                         .any(|s| s.action == Action::Element(i as u16))
                 })
                 .collect();
-            let view = View::new(d.prog.is_3d);
             let mut w = render::svg::SvgWriter::new(out, view, &bounds, &d.prog.elements, &used)?;
             let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
             w.finish()?;
-            Ok(drawn)
+            drawn
         }
         Format::Png => {
-            let (_, bounds) = measure(d, seed).map_err(OutputError::Diagnostic)?;
-            let view = View::new(d.prog.is_3d);
-            let mut w = render::png::PngWriter::new(
-                picture.size,
-                picture.background,
-                view,
-                &bounds,
-                &d.prog.elements,
-            )
-            .ok_or_else(|| std::io::Error::other("the image size is not possible"))?;
-            let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
+            let (drawn, w) = draw_png(d, picture, seed, view)?;
             let bytes = w.finish().map_err(std::io::Error::other)?;
             out.write_all(&bytes)?;
-            Ok(drawn)
+            drawn
         }
         Format::Obj => {
             // One pass: the extent comes from what was drawn, checked before the
             // mesh is finished (the file is written only if this succeeds).
             let options = render::obj::ObjOptions::for_program(&d.prog);
-            let mut w = render::obj::ObjWriter::new(out, options);
+            let mut w = match &picture.mtllib {
+                Some(lib) => render::obj::ObjWriter::with_mtllib(out, options, lib),
+                None => render::obj::ObjWriter::new(out, options),
+            };
+            w.object(&d.prog.name);
             let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
             if let Some(b) = drawn.bbox {
                 check_corners(b, &d.prog).map_err(OutputError::Diagnostic)?;
             }
+            let materials = w.colors();
             w.finish()?;
-            Ok(drawn)
+            return Ok(Written { drawn, materials });
+        }
+        Format::Glb => {
+            let options = render::obj::ObjOptions::for_program(&d.prog);
+            let glb = render::glb::GlbMesh::with_budget(d.limits.max_bytes);
+            let mut w = render::obj::MeshBuilder::with_target(glb, options);
+            w.object(&d.prog.name);
+            let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
+            if let Some(b) = drawn.bbox {
+                check_corners(b, &d.prog).map_err(OutputError::Diagnostic)?;
+            }
+            let materials = w.colors();
+            w.into_target().write(out)?;
+            return Ok(Written { drawn, materials });
+        }
+        Format::Apng => {
+            return Err(OutputError::Io(std::io::Error::other(
+                "an animated PNG is written from the derivation's steps (write_animation)",
+            )));
+        }
+    };
+    Ok(Written {
+        drawn,
+        materials: Vec::new(),
+    })
+}
+
+/// Draws `d` into a PNG canvas (not yet encoded).
+fn draw_png(
+    d: &Derived,
+    picture: &Picture,
+    seed: u64,
+    view: View,
+) -> Result<(Drawn, render::png::PngWriter), OutputError> {
+    let bounds = picture_bounds(d, picture, seed, view)?;
+    let mut w = render::png::PngWriter::new(
+        picture.size,
+        picture.background,
+        view,
+        &bounds,
+        &d.prog.elements,
+    )
+    .ok_or_else(|| std::io::Error::other("the image size is not possible"))?;
+    let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
+    Ok((drawn, w))
+}
+
+/// Growth, step by step: `d` (derived to its final step) is taken back to
+/// its axiom, then derived again one step at a time; `frame` sees step 0 (the
+/// axiom), 1, … up to `d.steps`, each in the final step's view box (returned
+/// by the first call's `Picture::bounds`). Afterwards `d` holds its final
+/// string again. Step `k` equals a run of `-n k`: the same steps, seeds and
+/// limits.
+pub fn each_step(
+    d: &mut Derived,
+    picture: &Picture,
+    seed: u64,
+    frame: &mut dyn FnMut(&Derived, &Picture) -> Result<(), OutputError>,
+) -> Result<(), OutputError> {
+    let view = picture.view(d.prog.is_3d);
+    let (_, bounds) = measure_in(d, seed, view).map_err(OutputError::Diagnostic)?;
+    let framed = Picture {
+        bounds: Some(picture.bounds.unwrap_or(bounds)),
+        ..picture.clone()
+    };
+    let last = d.steps;
+    let args = vec![0.0; d.prog.params.len()];
+    let axiom = derive::axiom(&d.prog, &args, seed).map_err(|e| e.diagnostic(&d.prog));
+    let mut s = axiom.map_err(OutputError::Diagnostic)?;
+    let final_string = std::mem::take(&mut d.string);
+    let mut result = Ok(());
+    for k in 0..=last {
+        if k > 0 {
+            match derive::step(&d.prog, &s, k, seed, d.limits) {
+                Ok(next) => s = next,
+                Err(e) => {
+                    result = Err(OutputError::Diagnostic(e.diagnostic(&d.prog)));
+                    break;
+                }
+            }
+        }
+        d.string = std::mem::take(&mut s);
+        d.steps = k;
+        let r = frame(d, &framed);
+        s = std::mem::take(&mut d.string);
+        if r.is_err() {
+            result = r;
+            break;
         }
     }
+    d.string = final_string;
+    d.steps = last;
+    result
+}
+
+/// An animated PNG of every step of `d`'s growth (`each_step`), each frame
+/// shown `picture.frame_ms`, the last one twice as long; it plays forever.
+pub fn write_animation(
+    d: &mut Derived,
+    picture: &Picture,
+    seed: u64,
+    progress: &dyn Fn(u32),
+    out: &mut dyn Write,
+) -> Result<Written, OutputError> {
+    let frames = d.steps + 1;
+    let mut encoder: Option<png::Writer<&mut dyn Write>> = None;
+    let mut size = (0, 0);
+    let mut out = Some(out);
+    let mut drawn = Drawn::default();
+    let png_error = |e: png::EncodingError| OutputError::Io(std::io::Error::other(e.to_string()));
+    let last = d.steps;
+    each_step(d, picture, seed, &mut |step, framed| {
+        let view = framed.view(step.prog.is_3d);
+        let (frame_drawn, w) = draw_png(step, framed, seed, view)?;
+        drawn = frame_drawn;
+        let (width, height, rgba) = w.finish_rgba();
+        if encoder.is_none() {
+            size = (width, height);
+            let Some(out) = out.take() else {
+                return Err(std::io::Error::other("the output is gone").into());
+            };
+            let mut e = png::Encoder::new(out, width, height);
+            e.set_color(png::ColorType::Rgba);
+            e.set_depth(png::BitDepth::Eight);
+            e.set_animated(frames, 0).map_err(png_error)?;
+            encoder = Some(e.write_header().map_err(png_error)?);
+        }
+        if (width, height) != size {
+            return Err(std::io::Error::other("frames of different sizes").into());
+        }
+        if let Some(wr) = encoder.as_mut() {
+            let ms = if step.steps == last {
+                picture.frame_ms.saturating_mul(2)
+            } else {
+                picture.frame_ms
+            };
+            wr.set_frame_delay(ms, 1000).map_err(png_error)?;
+            wr.write_image_data(&rgba).map_err(png_error)?;
+        }
+        progress(step.steps);
+        Ok(())
+    })?;
+    if let Some(wr) = encoder {
+        wr.finish().map_err(png_error)?;
+    }
+    Ok(Written {
+        drawn,
+        materials: Vec::new(),
+    })
 }
 
 /// The `--stats` object of the contract.
@@ -371,6 +579,9 @@ pub struct SceneStats {
     pub messages: u64,
     pub derive_ms: f64,
     pub interpret_ms: f64,
+    /// The colours the mesh used (OBJ: the materials of its `.mtl`).
+    #[serde(skip)]
+    pub materials: Vec<u32>,
 }
 
 /// What the scene writers share: the view, the elements and the bounds of
@@ -403,7 +614,7 @@ pub fn write_scene(
     out: &mut dyn Write,
 ) -> Result<SceneStats, OutputError> {
     let start = Instant::now();
-    let view = View::new(r.scene.programs.iter().any(|p| p.is_3d));
+    let view = picture.view(r.scene.programs.iter().any(|p| p.is_3d));
     // Elements are items of the file, the same for every system of the scene.
     let elements: &[crate::compile::ElementDef] =
         r.scene.programs.first().map_or(&[], |p| &p.elements);
@@ -428,11 +639,33 @@ pub fn write_scene(
         elements,
         bounds,
     };
+    let mut materials = Vec::new();
     match format {
         Some(Format::Svg) => scene_svg(r, &frame, seed, guides, out)?,
         Some(Format::Png) => scene_png(r, &frame, picture, seed, guides, out)?,
-        Some(Format::Obj) => scene_obj(r, seed, out)?,
+        Some(Format::Obj) => {
+            let options = scene_mesh_options(r);
+            let mut w = match &picture.mtllib {
+                Some(lib) => render::obj::ObjWriter::with_mtllib(out, options, lib),
+                None => render::obj::ObjWriter::new(out, options),
+            };
+            scene_mesh(r, seed, &mut w)?;
+            materials = w.colors();
+            w.finish()?;
+        }
+        Some(Format::Glb) => {
+            let glb = render::glb::GlbMesh::with_budget(r.limits.max_bytes);
+            let mut w = render::obj::MeshBuilder::with_target(glb, scene_mesh_options(r));
+            scene_mesh(r, seed, &mut w)?;
+            materials = w.colors();
+            w.into_target().write(out)?;
+        }
         Some(Format::Txt) => scene_txt(r, out)?,
+        Some(Format::Apng) => {
+            return Err(OutputError::Io(std::io::Error::other(
+                "a scene has no animated output yet: write its steps with `-n`",
+            )));
+        }
         None => {}
     }
     let round = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
@@ -449,6 +682,7 @@ pub fn write_scene(
         messages: r.outcome.messages,
         derive_ms: round(r.derive_ms),
         interpret_ms: round(start.elapsed().as_secs_f64() * 1000.0),
+        materials,
     })
 }
 
@@ -529,19 +763,31 @@ fn scene_png(
     Ok(())
 }
 
-/// A scene as one OBJ mesh.
-fn scene_obj(r: &SceneRun, seed: u64, out: &mut dyn Write) -> Result<(), OutputError> {
-    // One mesh for the whole scene: every guide's systems through the
-    // centre rule (tubes sized by the first system's step).
-    let options = r
-        .scene
+/// How a scene's mesh is built: tubes sized by the first system's step.
+fn scene_mesh_options(r: &SceneRun) -> render::obj::ObjOptions {
+    r.scene
         .programs
         .first()
         .map(render::obj::ObjOptions::for_program)
-        .unwrap_or_default();
-    let mut w = render::obj::ObjWriter::new(out, options);
-    draw_scene(r, seed, &mut w).map_err(OutputError::Diagnostic)?;
-    w.finish()?;
+        .unwrap_or_default()
+}
+
+/// A scene as one mesh (OBJ or glTF): one object per guide, named for it,
+/// holding that guide's systems through the centre rule.
+fn scene_mesh<T: render::obj::MeshTarget>(
+    r: &SceneRun,
+    seed: u64,
+    w: &mut render::obj::MeshBuilder<T>,
+) -> Result<(), OutputError> {
+    let centres = program_centres(&r.scene);
+    for (gi, g) in r.scene.guides.iter().enumerate() {
+        w.object(&g.name);
+        for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
+            let mut clip = crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut *w);
+            r.interpret(inst, seed, &mut clip)
+                .map_err(OutputError::Diagnostic)?;
+        }
+    }
     Ok(())
 }
 

@@ -35,3 +35,15 @@ edited tree --pin trunk --scale clusterR2=1.3 --scale clusterL2=1.3 --by top.v4=
 # Fig. 9b: two cable vertices dragged down, the deck and the towers held; the hangers
 # regrow at the same spacing.
 edited bridge --by main1.v2=0,-30 --by main8.v3=0,-30 --pin deck --pin towerL --pin towerR
+
+# 3D and growth outputs (README "3D and growth outputs"): the bush from two
+# cameras, its growth as frames (--frames) and as one animated PNG (.apng, kept
+# under a .png name so that every viewer shows it).
+"$lsyc" run lang-examples/bush-3d.lsy -n 5 --size 400 -o docs/gallery/bush-3d-view-30-20.png
+"$lsyc" run lang-examples/bush-3d.lsy -n 5 --size 400 --view 75,60 -o docs/gallery/bush-3d-view-75-60.png
+"$lsyc" run lang-examples/bush-3d.lsy -n 6 --size 200 --frames -o "$tmp/bush-3d-step.png"
+for k in 002 003 004 005 006; do
+    cp "$tmp/bush-3d-step-$k.png" "docs/gallery/bush-3d-step-$k.png"
+done
+"$lsyc" run lang-examples/bush-3d.lsy -n 6 --size 320 -o "$tmp/bush-3d-growth.apng"
+cp "$tmp/bush-3d-growth.apng" docs/gallery/bush-3d-growth.png

@@ -1,10 +1,13 @@
 //! `lsyc run FILE`: derive, draw, and write SVG, PNG, OBJ or text.
 
 use super::{Reporter, check::overrides};
+
+mod outputs;
 use lsyc::derive::Limits;
 use lsyc::diagnostic::{Code, Diagnostic};
-use lsyc::run::{self, Format, Options, OutputError, Picture, Stats};
+use lsyc::run::{self, Format, Options, OutputError, Stats};
 use lsyc::{frontend, source};
+use outputs::{parse_view, picture};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -18,14 +21,24 @@ pub struct Args {
     #[arg(short = 'n', long = "steps", value_name = "STEPS", allow_negative_numbers = true, value_parser = parse_steps)]
     pub steps: Option<u32>,
 
-    /// Output file; its extension picks the format: .svg .png .obj .txt;
-    /// `-o -` writes to stdout (SVG unless --format says otherwise).
+    /// Output file; its extension picks the format: .svg .png .obj (+ .mtl) .glb
+    /// .txt, or .apng (every step, animated); `-o -` writes to stdout (SVG
+    /// unless --format says otherwise).
     #[arg(short = 'o', long = "output", value_name = "OUT")]
     pub output: Option<PathBuf>,
 
     /// The output format when the extension cannot say (`-o -`): svg, png, obj or txt.
     #[arg(long, value_name = "FORMAT", requires = "output")]
     pub format: Option<String>,
+
+    /// Camera of 3D programs in SVG and PNG, in degrees (default 30,20).
+    #[arg(long, value_name = "AZIMUTH,ELEVATION", value_parser = parse_view, allow_hyphen_values = true)]
+    pub view: Option<[f64; 2]>,
+
+    /// Write every derivation step: -o DIR/NAME.EXT gives DIR/NAME-000.EXT (the
+    /// axiom) to NAME-NNN.EXT, all in the final step's view box.
+    #[arg(long)]
+    pub frames: bool,
 
     /// Print statistics as one JSON object on stdout (on stderr when the drawing
     /// itself goes to stdout with `-o -`).
@@ -316,18 +329,12 @@ fn run_system(
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let derived = derived.map_err(fail)?;
+    let mut derived = derived.map_err(fail)?;
     let start = Instant::now();
     let drawn = match (format, &args.output) {
         (Some(format), Some(path)) => {
-            let picture = Picture {
-                size: args.size,
-                background,
-            };
-            write_file(path, reporter, src, |w| {
-                run::write_output(&derived, format, picture, args.seed, w)
-            })
-            .ok_or(1u8)?
+            let picture = picture(args, background);
+            outputs::write(args, reporter, src, &mut derived, format, path, &picture)?
         }
         _ => run::measure(&derived, args.seed).map_err(fail)?.0,
     };
@@ -413,6 +420,7 @@ fn report_stats(args: &Args, stats: &impl serde::Serialize) -> String {
         }
     }
     match &args.output {
+        Some(_) if args.frames => ", wrote its frames".to_string(),
         Some(p) if is_stdout(p) => ", wrote it to stdout".to_string(),
         Some(p) => format!(", wrote {}", p.display()),
         None => {
@@ -494,19 +502,18 @@ fn run_scene(
             Err(d) => reporter.emit(&[d], &src.name, &src.text),
         }
     }
-    let picture = Picture {
-        size: args.size,
-        background,
-    };
+    let picture = picture(args, background);
     let stats = match &args.output {
-        Some(path) => {
-            match write_file(path, reporter, src, |w| {
-                run::write_scene(&r, format, picture, args.seed, args.guides, w)
-            }) {
-                Some(s) => s,
-                None => return 1,
+        Some(path) => match outputs::write_scene(args, reporter, src, &r, format, path, picture) {
+            Some(s) => s,
+            None => {
+                return if args.frames || format == Some(Format::Apng) {
+                    2
+                } else {
+                    1
+                };
             }
-        }
+        },
         None => match run::write_scene(&r, None, picture, args.seed, false, &mut std::io::sink()) {
             Ok(s) => s,
             Err(OutputError::Diagnostic(d)) => {

@@ -1,10 +1,11 @@
-//! Output formats, chosen by the file extension: SVG, PNG, OBJ and text.
+//! Output formats, chosen by the file extension: SVG, PNG, OBJ (with MTL), glTF binary and text.
 //!
 //! Owns: the view (2D programs are drawn in the x–y plane; 3D programs are
-//! projected from a fixed oblique view), the colour palette of `'(c)`, and the
+//! projected from an oblique camera, `--view`), the colour palette of `'(c)`, and the
 //! fitting of drawings into a viewport. Each format is a `turtle::Sink` or a
 //! writer of the module string; none of them derives.
 
+pub mod glb;
 pub mod obj;
 pub mod png;
 pub mod svg;
@@ -30,6 +31,19 @@ pub fn palette_rgb(i: u32) -> [u8; 3] {
     parse_hex(palette(i)).unwrap_or([0, 0, 0])
 }
 
+/// A palette entry in linear RGB, 0–1 (what glTF's base colour and the MTL
+/// `Kd` hold): the sRGB transfer function undone.
+pub fn palette_linear(i: u32) -> [f64; 3] {
+    palette_rgb(i).map(|c| {
+        let s = f64::from(c) / 255.0;
+        if s <= 0.04045 {
+            s / 12.92
+        } else {
+            ((s + 0.055) / 1.055).powf(2.4)
+        }
+    })
+}
+
 /// `#rrggbb` to RGB.
 pub fn parse_hex(s: &str) -> Option<[u8; 3]> {
     let h = s.strip_prefix('#')?;
@@ -39,6 +53,9 @@ pub fn parse_hex(s: &str) -> Option<[u8; 3]> {
     let v = u32::from_str_radix(h, 16).ok()?;
     Some([(v >> 16) as u8, (v >> 8) as u8, v as u8])
 }
+
+/// The default camera of 3D programs: azimuth and elevation in degrees.
+pub const DEFAULT_VIEW: [f64; 2] = [30.0, 20.0];
 
 /// How 3D points become 2D drawing coordinates (+y up).
 #[derive(Clone, Copy, Debug)]
@@ -51,12 +68,19 @@ impl View {
     /// 30° about the vertical, tilted 20°) so that depth shows.
     pub fn new(is_3d: bool) -> View {
         if is_3d {
-            let yaw = DMat3::from_rotation_y(30f64.to_radians());
-            let tilt = DMat3::from_rotation_x(20f64.to_radians());
-            View { m: tilt * yaw }
+            View::oblique(DEFAULT_VIEW[0], DEFAULT_VIEW[1])
         } else {
             View { m: DMat3::IDENTITY }
         }
+    }
+
+    /// A 3D program seen from `azimuth` degrees about the vertical (+y) axis
+    /// and `elevation` degrees above the horizon: the camera of `--view`.
+    /// `new(true)` is `oblique(30, 20)`.
+    pub fn oblique(azimuth: f64, elevation: f64) -> View {
+        let yaw = DMat3::from_rotation_y(azimuth.to_radians());
+        let tilt = DMat3::from_rotation_x(elevation.to_radians());
+        View { m: tilt * yaw }
     }
 
     pub fn project(&self, p: DVec3) -> DVec2 {

@@ -161,6 +161,14 @@ impl PngWriter {
         self.flush();
         self.pixmap.encode_png().map_err(|e| e.to_string())
     }
+
+    /// The picture's width, height and RGBA pixels (not premultiplied), for
+    /// an animation's frame.
+    pub fn finish_rgba(mut self) -> (u32, u32, Vec<u8>) {
+        self.flush();
+        let (w, h) = (self.pixmap.width(), self.pixmap.height());
+        (w, h, self.pixmap.take_demultiplied())
+    }
 }
 
 impl Sink for PngWriter {

@@ -1,5 +1,7 @@
-//! Wavefront OBJ output: a streaming `turtle::Sink` that writes segments as
-//! closed tubes, polygons `{ . }` as faces and elements as flat outlines.
+//! The 3D mesh of a drawing, written as Wavefront OBJ (and, through
+//! `crate::render::glb`, as glTF): a streaming `turtle::Sink` that builds
+//! segments as closed tubes, polygons `{ . }` as faces and elements as flat
+//! outlines.
 //!
 //! Owns: the 3D mesh form of a drawing. Segments become generalized cylinders
 //! (the sources' "generalized cylinders with spherical joints"): a chain of
@@ -11,27 +13,52 @@
 //! continuations after `]`). Polygons and elements are single n-gon faces with
 //! one normal. Output is streamed: only the open chains (at most
 //! `MAX_OPEN_CHAINS`) and a bounded memory of joint positions are kept.
-//! Colours `'(c)` become `usemtl lsyc_color<c>` switches (no `.mtl` is written).
+//! Colours `'(c)` become materials named `lsyc_color<c>` (`usemtl` switches,
+//! and the `.mtl` library of [`write_mtl`]).
+//!
+//! The mesh is built once, by [`MeshBuilder`], and sent to a [`MeshTarget`]:
+//! [`ObjText`] prints it as OBJ text; `crate::render::glb` keeps it in buffers
+//! for binary glTF. Anything the builder makes reaches both formats.
 //! Must not know the turtle's rules or any other output format.
 //!
-//! Parts: this file (options, the writer's buffer and faces), `tube` (tubes,
-//! caps, mitres and spherical joints), `outline` (element outlines, read through
-//! `crate::path`); numbers are printed by `crate::number`.
+//! Parts: this file (options, the builder and its faces), `text` (OBJ and MTL
+//! text), `tube` (tubes, caps, mitres and spherical joints), `outline` (element
+//! outlines, read through `crate::path`); numbers are printed by `crate::number`.
 
 mod outline;
 #[cfg(test)]
 mod tests;
+mod text;
 mod tube;
 
 pub use outline::{ElementOutline, outline_from_path};
+pub use text::{MATERIAL_PREFIX, ObjText, material_name, write_mtl};
 
 use crate::compile::Program;
-use crate::number::{write_significant, write_uint};
 use crate::turtle::Sink;
 use glam::DVec3;
-use std::collections::{HashMap, VecDeque};
+use std::collections::{BTreeSet, HashMap, VecDeque};
 use std::io::{self, Write};
 use tube::{Chain, Joint};
+
+/// Where the built mesh goes. Vertices and normals are numbered from 1, each
+/// in the order they arrive; faces refer to them by these numbers.
+pub trait MeshTarget {
+    fn vertex(&mut self, p: DVec3);
+    /// A unit normal.
+    fn normal(&mut self, n: DVec3);
+    /// A face of (vertex, normal) corners, counter-clockwise seen from outside.
+    /// Tube faces are convex; polygon and element faces are simple polygons,
+    /// possibly concave.
+    fn face(&mut self, corners: &[(u64, u64)]);
+    /// The colour of the faces that follow.
+    fn material(&mut self, color: u32);
+    /// Faces that follow belong to a new object called `name` (an lsystem, a
+    /// scene's guide).
+    fn object(&mut self, name: &str);
+    /// A remark for a reader of the file (OBJ comments; ignored elsewhere).
+    fn comment(&mut self, _text: &str) {}
+}
 
 /// Chains whose end may still be continued (after a `]`); older ones are closed.
 pub const MAX_OPEN_CHAINS: usize = 64;
@@ -47,8 +74,6 @@ pub const MAX_SIDES: usize = 256;
 /// Relative resolution of written coordinates (7 significant digits), with
 /// a margin: shorter segments and thinner tubes would collapse.
 const RESOLUTION: f64 = 1e-5;
-/// Output is assembled in a buffer of this size before it is written.
-const BUFFER: usize = 1 << 16;
 
 /// How the mesh is built.
 #[derive(Clone, Debug)]
@@ -103,14 +128,11 @@ struct Counts {
     faces: u64,
 }
 
-/// A streaming OBJ writer. Call [`ObjWriter::finish`] to close the open tubes
-/// and flush; dropping it without `finish` leaves the output incomplete.
-pub struct ObjWriter<W: Write> {
-    out: W,
-    /// Text not yet written to `out`.
-    buf: Vec<u8>,
-    /// The first write error; nothing is written after it.
-    error: Option<io::Error>,
+/// Builds the mesh of a drawing into a [`MeshTarget`], streaming. Call
+/// [`MeshBuilder::into_target`] (or `finish` on an [`ObjWriter`]) to close
+/// the open tubes; without it the mesh is incomplete.
+pub struct MeshBuilder<T: MeshTarget> {
+    out: T,
     sides: usize,
     /// cos, sin of the ring angles.
     ring_angles: Vec<(f64, f64)>,
@@ -124,12 +146,39 @@ pub struct ObjWriter<W: Write> {
     /// Vertices and normals written so far (the last index).
     v: u64,
     vn: u64,
-    material: u32,
+    /// The current colour (`None` before the first face).
+    material: Option<u32>,
+    /// Every colour a face used.
+    used: BTreeSet<u32>,
     counts: Counts,
 }
 
-impl<W: Write> ObjWriter<W> {
+/// A streaming OBJ writer: the mesh builder printing OBJ text.
+pub type ObjWriter<W> = MeshBuilder<ObjText<W>>;
+
+impl<W: Write> MeshBuilder<ObjText<W>> {
+    /// An OBJ writer to `out`.
     pub fn new(out: W, options: ObjOptions) -> Self {
+        Self::with_target(ObjText::new(out), options)
+    }
+
+    /// Like `new`, with a `mtllib` line naming the material library (written
+    /// by [`write_mtl`] from [`MeshBuilder::colors`]).
+    pub fn with_mtllib(out: W, options: ObjOptions, mtllib: &str) -> Self {
+        let mut text = ObjText::new(out);
+        text.mtllib(mtllib);
+        Self::with_target(text, options)
+    }
+
+    /// Closes the open tubes, writes a closing comment with counts and flushes.
+    /// Reports the first IO error of any earlier write.
+    pub fn finish(self) -> io::Result<W> {
+        self.into_target().finish()
+    }
+}
+
+impl<T: MeshTarget> MeshBuilder<T> {
+    pub fn with_target(out: T, options: ObjOptions) -> Self {
         let sides = options.sides.clamp(3, MAX_SIDES);
         let ring_angles = (0..sides)
             .map(|i| {
@@ -147,10 +196,8 @@ impl<W: Write> ObjWriter<W> {
             .into_iter()
             .map(ElementOutline::oriented)
             .collect();
-        let mut w = ObjWriter {
+        let mut w = MeshBuilder {
             out,
-            buf: Vec::with_capacity(BUFFER + 256),
-            error: None,
             sides,
             ring_angles,
             default_radius,
@@ -160,107 +207,74 @@ impl<W: Write> ObjWriter<W> {
             joint_order: VecDeque::new(),
             v: 0,
             vn: 0,
-            material: 0,
+            material: None,
+            used: BTreeSet::new(),
             counts: Counts::default(),
         };
-        w.text(&format!(
-            "# lsyc OBJ: segments as closed tubes ({sides} sides), polygons and elements as faces\n"
+        w.out.comment(&format!(
+            "lsyc OBJ: segments as closed tubes ({sides} sides), polygons and elements as faces"
         ));
         w
     }
 
-    /// Closes the open tubes, writes a closing comment with counts and flushes.
-    /// Reports the first IO error of any earlier write.
-    pub fn finish(mut self) -> io::Result<W> {
+    /// Closes the open tubes and writes a closing comment with counts; gives
+    /// back the target.
+    pub fn into_target(mut self) -> T {
+        self.close_open();
+        let (c, v) = (self.counts, self.v);
+        self.out.comment(&format!(
+            "{} tubes, {} spheres, {} polygons, {} elements; {v} vertices, {} faces",
+            c.tubes, c.spheres, c.polygons, c.elements, c.faces
+        ));
+        self.out
+    }
+
+    /// Every colour a face used so far, in order.
+    pub fn colors(&self) -> Vec<u32> {
+        self.used.iter().copied().collect()
+    }
+
+    /// Starts a new object called `name`: the open tubes are closed first, so
+    /// that everything drawn before belongs to the previous object.
+    pub fn object(&mut self, name: &str) {
+        self.close_open();
+        self.out.object(name);
+    }
+
+    fn close_open(&mut self) {
         for chain in std::mem::take(&mut self.open) {
             self.close(chain);
         }
-        let (c, v) = (self.counts, self.v);
-        self.text(&format!(
-            "# {} tubes, {} spheres, {} polygons, {} elements; {v} vertices, {} faces\n",
-            c.tubes, c.spheres, c.polygons, c.elements, c.faces
-        ));
-        self.drain();
-        if let Some(e) = self.error.take() {
-            return Err(e);
-        }
-        self.out.flush()?;
-        Ok(self.out)
-    }
-
-    /// Writes the buffer out (or drops it after an error).
-    fn drain(&mut self) {
-        if self.error.is_none()
-            && let Err(e) = self.out.write_all(&self.buf)
-        {
-            self.error = Some(e);
-        }
-        self.buf.clear();
-    }
-
-    /// Ends a line; writes the buffer out when it is full.
-    fn end_line(&mut self) {
-        self.buf.push(b'\n');
-        if self.buf.len() >= BUFFER {
-            self.drain();
-        }
-    }
-
-    fn text(&mut self, t: &str) {
-        self.buf.extend_from_slice(t.as_bytes());
-        if self.buf.len() >= BUFFER {
-            self.drain();
-        }
-    }
-
-    fn triple(&mut self, tag: &[u8], p: DVec3) {
-        self.buf.extend_from_slice(tag);
-        for x in [p.x, p.y, p.z] {
-            self.buf.push(b' ');
-            write_significant(&mut self.buf, x);
-        }
-        self.end_line();
     }
 
     fn vertex(&mut self, p: DVec3) -> u64 {
-        self.triple(b"v", p);
+        self.out.vertex(p);
         self.v += 1;
         self.v
     }
 
     fn normal(&mut self, n: DVec3) -> u64 {
-        self.triple(b"vn", n);
+        self.out.normal(n);
         self.vn += 1;
         self.vn
     }
 
-    /// A corner ` v//vn` of a face line.
-    fn corner(&mut self, (v, n): (u64, u64)) {
-        self.buf.push(b' ');
-        write_uint(&mut self.buf, v);
-        self.buf.extend_from_slice(b"//");
-        write_uint(&mut self.buf, n);
-    }
-
     /// A triangle of (vertex, normal) pairs, counter-clockwise seen from outside.
     fn tri(&mut self, a: (u64, u64), b: (u64, u64), c: (u64, u64)) {
-        self.buf.push(b'f');
-        self.corner(a);
-        self.corner(b);
-        self.corner(c);
-        self.end_line();
+        self.out.face(&[a, b, c]);
         self.counts.faces += 1;
     }
 
     fn material(&mut self, color: u32) {
-        if color != self.material {
-            self.material = color;
-            self.text(&format!("usemtl lsyc_color{color}\n"));
+        if self.material != Some(color) {
+            self.material = Some(color);
+            self.used.insert(color);
+            self.out.material(color);
         }
     }
 }
 
-impl<W: Write> Sink for ObjWriter<W> {
+impl<T: MeshTarget> Sink for MeshBuilder<T> {
     fn segment(&mut self, a: DVec3, b: DVec3, width: f64, color: u32) {
         if !(a.is_finite() && b.is_finite()) {
             return;
@@ -335,7 +349,7 @@ impl<W: Write> Sink for ObjWriter<W> {
     }
 }
 
-impl<W: Write> ObjWriter<W> {
+impl<T: MeshTarget> MeshBuilder<T> {
     /// One n-gon face with a single normal (by default the polygon's own, by
     /// Newell's method). Nothing is written for a face whose area the written
     /// digits would not resolve.
@@ -361,11 +375,8 @@ impl<W: Write> ObjWriter<W> {
             self.vertex(p);
         }
         let n = self.normal(normal);
-        self.buf.push(b'f');
-        for k in 0..pts.len() as u64 {
-            self.corner((first + k, n));
-        }
-        self.end_line();
+        let corners: Vec<(u64, u64)> = (0..pts.len() as u64).map(|k| (first + k, n)).collect();
+        self.out.face(&corners);
         self.counts.faces += 1;
         true
     }

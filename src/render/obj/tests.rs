@@ -50,7 +50,7 @@ fn parse(text: &str) -> Mesh {
                     m.spheres = words[3].parse().expect("count");
                 }
             }
-            Some("usemtl") | None => {}
+            Some("usemtl") | Some("o") | Some("mtllib") | None => {}
             Some(other) => panic!("unexpected line kind {other}"),
         }
     }

@@ -4,11 +4,10 @@
 //!
 //! Owns: the geometry of generalized cylinders and where joints are
 //! remembered. Must not know the turtle, element outlines or number printing
-//! (the writer's `vertex`, `normal` and `tri` write).
+//! (the builder's `vertex`, `normal` and `tri` send them on).
 
-use super::{MAX_JOINTS, MAX_OPEN_CHAINS, MITRE_MAX_REACH, MITRE_MIN_COS, ObjWriter};
+use super::{MAX_JOINTS, MAX_OPEN_CHAINS, MITRE_MAX_REACH, MITRE_MIN_COS, MeshBuilder, MeshTarget};
 use glam::{DQuat, DVec3};
-use std::io::Write;
 
 /// First vertex and first normal index (1-based) of a ring of `sides` vertices.
 #[derive(Clone, Copy, Debug)]
@@ -43,7 +42,7 @@ pub(super) struct Joint {
     pub(super) sphere: f64,
 }
 
-impl<W: Write> ObjWriter<W> {
+impl<T: MeshTarget> MeshBuilder<T> {
     pub(super) fn radius(&self, width: f64) -> f64 {
         let r = width * 0.5;
         if r.is_finite() && r > 0.0 {
@@ -85,12 +84,12 @@ impl<W: Write> ObjWriter<W> {
         let k = self.sides as u64;
         for i in 0..k {
             let j = (i + 1) % k;
-            self.buf.push(b'f');
-            self.corner((a.v + i, a.n + i));
-            self.corner((a.v + j, a.n + j));
-            self.corner((b.v + j, b.n + j));
-            self.corner((b.v + i, b.n + i));
-            self.end_line();
+            self.out.face(&[
+                (a.v + i, a.n + i),
+                (a.v + j, a.n + j),
+                (b.v + j, b.n + j),
+                (b.v + i, b.n + i),
+            ]);
             self.counts.faces += 1;
         }
     }
