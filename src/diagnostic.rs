@@ -89,6 +89,8 @@ codes! {
     MissingAxiom = "E0603", "an lsystem without an axiom";
     DuplicateSetting = "E0604", "a setting given twice";
     NoLsystem = "E0605", "a file with no lsystem to run";
+    IgnoreAndConsider = "E0606", "`ignore` and `consider` in one lsystem";
+    ContextNotAllowed = "E0607", "context on an `interpret` or `decompose` rule";
     InvalidPath = "E0701", "element path data that is not valid SVG";
     MissingPath = "E0702", "an element without a `path`";
     UnknownProperty = "E0703", "an element property lsyc does not know";
@@ -106,6 +108,7 @@ codes! {
     TooManySteps = "E0907", "more derivation steps than the limit";
     TooMuchDrawing = "E0908", "interpretation that would draw more than the module limit";
     DrawingTooLarge = "E0909", "a drawing with coordinates too large to write";
+    DecomposeTooDeep = "E0910", "decomposition rules that expand into each other too deeply";
     Unused = "W0101", "a declaration that nothing uses";
     UnusedParameter = "W0102", "a rule parameter that nothing uses";
     NeverProduced = "W0201", "a rule whose predecessor never appears";

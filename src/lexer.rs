@@ -68,6 +68,12 @@ pub enum Token {
     Interpret,
     #[token("cut")]
     Cut,
+    #[token("tropism")]
+    Tropism,
+    #[token("consider")]
+    Consider,
+    #[token("decompose")]
+    Decompose,
     #[token("true")]
     True,
     #[token("false")]
@@ -416,6 +422,9 @@ impl Token {
             Token::Ignore => "ignore",
             Token::Interpret => "interpret",
             Token::Cut => "cut",
+            Token::Tropism => "tropism",
+            Token::Consider => "consider",
+            Token::Decompose => "decompose",
             Token::True => "true",
             Token::False => "false",
             Token::Epsilon => "ε",

@@ -57,6 +57,11 @@ pub fn is_letter(name: &str) -> bool {
     matches!((cs.next(), cs.next()), (Some(c), None) if c.is_alphabetic())
 }
 
+/// Multi-letter modules the language itself defines (keywords in module strings).
+pub fn is_builtin(name: &str) -> bool {
+    name == "tropism"
+}
+
 /// Whether an undeclared name can be split into single letters.
 pub fn splits(name: &str) -> bool {
     name.chars().all(char::is_alphabetic)
@@ -76,7 +81,7 @@ pub fn resolve(file: &mut File, diags: &mut Vec<Diagnostic>) {
         };
         for stmt in &mut ls.body.stmts {
             match &mut stmt.node {
-                Stmt::Axiom(ms) | Stmt::Ignore(ms) => r.split_list(ms),
+                Stmt::Axiom(ms) | Stmt::Ignore(ms) | Stmt::Consider(ms) => r.split_list(ms),
                 Stmt::Rule(rule) => {
                     if let Some(l) = &mut rule.left {
                         r.split_list(l);
@@ -162,6 +167,7 @@ impl Resolver<'_> {
         if let ModName::Name(n) = &m.name
             && !self.scope.declares(n)
             && !is_letter(n)
+            && !is_builtin(n)
             && !splits(n)
             && self.reported.insert(n.clone())
         {
@@ -277,7 +283,7 @@ fn word_like(name: &str) -> bool {
 
 fn needs_split(m: &Module, scope: &Scope) -> bool {
     match &m.name {
-        ModName::Name(n) => !scope.declares(n) && !is_letter(n) && splits(n),
+        ModName::Name(n) => !scope.declares(n) && !is_letter(n) && !is_builtin(n) && splits(n),
         _ => false,
     }
 }

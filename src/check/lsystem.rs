@@ -45,6 +45,8 @@ struct Local {
     warned: HashSet<(ModName, usize)>,
     /// Queries whose pass-through mismatch is already reported.
     pass_reported: HashSet<&'static str>,
+    /// Whether a `consider` list was given.
+    considers: bool,
 }
 
 impl<'a> Checker<'a> {
@@ -59,6 +61,7 @@ impl<'a> Checker<'a> {
             query_pass: HashMap::new(),
             warned: HashSet::new(),
             pass_reported: HashSet::new(),
+            considers: false,
         };
         self.settings(ls, &mut local);
         let rules: Vec<&Rule> = ls
@@ -87,7 +90,9 @@ impl<'a> Checker<'a> {
                     }
                     self.brackets(ms);
                 }
-                Stmt::Ignore(ms) => self.module_list(ms, Role::Ignore, &mut local),
+                Stmt::Ignore(ms) | Stmt::Consider(ms) => {
+                    self.module_list(ms, Role::Ignore, &mut local)
+                }
                 Stmt::Rule(r) => {
                     for ctx in [&r.left, &r.right].into_iter().flatten() {
                         self.module_list(ctx, Role::Context, &mut local);
@@ -139,7 +144,7 @@ impl<'a> Checker<'a> {
                 match self.modules.get(n.as_str()) {
                     Some(info) if info.element => Kind::Element,
                     Some(info) => Kind::Declared(info.arity.unwrap_or(0)),
-                    None if n == "F" || n == "f" => Kind::Turtle,
+                    None if n == "F" || n == "f" || n == "tropism" => Kind::Turtle,
                     None if is_letter(n) => Kind::Letter,
                     None => Kind::Undeclared,
                 }
@@ -158,6 +163,8 @@ impl<'a> Checker<'a> {
                 Stmt::Derive(_) => "derive",
                 Stmt::Step(_) => "step",
                 Stmt::Axiom(_) => "axiom",
+                Stmt::Tropism(_) => "tropism",
+                Stmt::Ignore(_) | Stmt::Consider(_) => "ignore",
                 Stmt::Module(m) => {
                     if let Some((_, first)) = local.decls.get(&m.name.name) {
                         self.diags
@@ -175,7 +182,31 @@ impl<'a> Checker<'a> {
                 }
                 _ => continue,
             };
-            let span = Span::new(s.span.start as usize, s.span.start as usize + key.len());
+            let word = match &s.node {
+                Stmt::Consider(_) => "consider",
+                _ => key,
+            };
+            let span = Span::new(s.span.start as usize, s.span.start as usize + word.len());
+            if key == "ignore" {
+                // Several `ignore` lists add up; `consider` is the complement and
+                // cannot be mixed with them.
+                if let Some(first) = seen.get(key)
+                    && (matches!(s.node, Stmt::Consider(_)) || local.considers)
+                {
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::IgnoreAndConsider,
+                            "`ignore` and `consider` cannot both be given in one lsystem",
+                        )
+                        .primary(span, "given here")
+                        .secondary(*first, "the other list")
+                        .help("keep one: `consider` lists the modules context sees, `ignore` the modules it skips"),
+                    );
+                }
+                local.considers |= matches!(s.node, Stmt::Consider(_));
+                seen.entry(key).or_insert(span);
+                continue;
+            }
             if let Some(first) = seen.get(key) {
                 self.diags.push(
                     Diagnostic::error(Code::DuplicateSetting, format!("`{key}` is given twice"))
@@ -196,6 +227,16 @@ impl<'a> Checker<'a> {
                 Stmt::Derive(e) => {
                     self.const_int(e, "the number of derivation steps", 0.0, 1_000_000.0);
                 }
+                Stmt::Tropism(t) => {
+                    for (e, what) in t.dir.iter().zip([
+                        "the tropism vector's x",
+                        "the tropism vector's y",
+                        "the tropism vector's z",
+                    ]) {
+                        self.const_num(e, what);
+                    }
+                    self.const_num(&t.elasticity, "the elasticity");
+                }
                 _ => {}
             }
         }
@@ -214,6 +255,29 @@ impl<'a> Checker<'a> {
     /// Checks a rule's predecessor and context patterns and records arities.
     fn predecessor(&mut self, r: &Rule, local: &mut Local) {
         let m = &r.pred;
+        if r.interpret || r.decompose {
+            let kw = if r.interpret {
+                "interpret"
+            } else {
+                "decompose"
+            };
+            for ctx in [&r.left, &r.right].into_iter().flatten() {
+                let span = match (ctx.first(), ctx.last()) {
+                    (Some(a), Some(b)) => a.span.to(b.span),
+                    _ => m.span,
+                };
+                self.diags.push(
+                    Diagnostic::error(
+                        Code::ContextNotAllowed,
+                        format!("an `{kw}` rule cannot have context"),
+                    )
+                    .primary(span, "context here")
+                    .help(format!(
+                        "`{kw}` rules rewrite one module by itself (conditions and weights are allowed); match the context in a derivation rule"
+                    )),
+                );
+            }
+        }
         let arity = m.arity();
         match self.kind(m, local) {
             Kind::Structure => self.diags.push(
@@ -408,7 +472,7 @@ impl<'a> Checker<'a> {
                     self.diags.push(
                         Diagnostic::error(
                             Code::ArgsNotAllowed,
-                            "an ignore list names modules without parameters",
+                            "an `ignore` or `consider` list names modules without parameters",
                         )
                         .primary(m.span, "parameters here")
                         .help(format!("write just `{}`", m.name.text())),
@@ -626,11 +690,12 @@ impl<'a> Checker<'a> {
             match &s.node {
                 Stmt::Axiom(ms) => produced.extend(ms.iter().map(|m| &m.name)),
                 Stmt::Rule(r) if !r.interpret => produced.extend(r.succ.iter().map(|m| &m.name)),
+                Stmt::Tropism(_) => {}
                 _ => {}
             }
         }
         let mut reported: HashSet<&ModName> = HashSet::new();
-        let mut always: HashMap<(bool, &ModName, usize), Span> = HashMap::new();
+        let mut always: HashMap<(u8, &ModName, usize), Span> = HashMap::new();
         let mut prev: Option<&Rule> = None;
         for r in rules {
             let name = &r.pred.name;
@@ -672,10 +737,10 @@ impl<'a> Checker<'a> {
                 }
                 self.diags.push(d);
             }
-            let key = (r.interpret, name, r.pred.arity());
+            let key = (rule_kind(r), name, r.pred.arity());
             let same_group = r.weight.is_some()
                 && prev.is_some_and(|p| {
-                    p.weight.is_some() && p.pred.name == *name && p.interpret == r.interpret
+                    p.weight.is_some() && p.pred.name == *name && rule_kind(p) == rule_kind(r)
                 });
             if let Some(&earlier) = always.get(&key) {
                 if !same_group {
@@ -697,5 +762,16 @@ impl<'a> Checker<'a> {
             }
             prev = Some(r);
         }
+    }
+}
+
+/// 0 for a derivation rule, 1 for `interpret`, 2 for `decompose`.
+fn rule_kind(r: &Rule) -> u8 {
+    if r.interpret {
+        1
+    } else if r.decompose {
+        2
+    } else {
+        0
     }
 }
