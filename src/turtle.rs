@@ -253,6 +253,11 @@ pub fn interpret_limited(
         p += n;
         t.module_index = i;
         if has_interp && !prog.interpret[sym as usize].is_empty() {
+            // A query drawn by an interpretation rule is still answered where it stands.
+            if let Action::Query(kind) = prog.symbols.info[sym as usize].action {
+                let st = t.state;
+                t.sink.query(i, kind, &st);
+            }
             t.expanded_here = 0;
             t.expand(sym, params, i as u64, 0)?;
         } else {
