@@ -116,6 +116,9 @@ codes! {
     AlwaysFalse = "W0203", "a rule whose condition is always false";
     SplitWord = "W0301", "a word read as a run of single-letter modules";
     ArityNeverRewritten = "W0302", "a turtle symbol whose parameter count no rule matches";
+    DoesNothing = "W0303", "a letter with parameters that no rule rewrites and nothing draws";
+    StarContext = "W0304", "`*` in a context, read as the scale module and not as a wildcard";
+    SectionLabel = "W0305", "a rule label that is a section name of cpfg or L-Py";
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -138,8 +138,9 @@ impl State {
             Action::Color => {
                 self.color = match arg {
                     Some(c) => c.max(0.0) as u32,
-                    // The wood-to-leaf ramp of the palette ends at 7.
-                    None => (self.color + 1).min(7),
+                    // ABOP's bare `'` steps toward leaves: from ink or bark
+                    // straight to the first green (3), then along the greens to 7.
+                    None => (self.color + 1).clamp(3, 7),
                 }
             }
             Action::Draw | Action::Move => {

@@ -118,6 +118,138 @@ impl<'a> Checker<'a> {
             self.rule_body(r);
         }
         self.unreachable_rules(ls, &rules);
+        self.star_contexts(&rules);
+        self.does_nothing(ls, &rules, &local);
+        self.interpret_cycles(&rules);
+    }
+
+    /// ABOP's and cpfg's `*` in a context means "any module"; here it is the
+    /// scale module, so such a rule never fires where it was meant to.
+    fn star_contexts(&mut self, rules: &[&Rule]) {
+        for r in rules {
+            for m in [&r.left, &r.right].into_iter().flatten().flatten() {
+                if m.name == ModName::Symbol('*') && m.args.is_none() {
+                    self.diags.push(
+                        Diagnostic::warning(
+                            Code::StarContext,
+                            "`*` in a context is the scale module, not a wildcard",
+                        )
+                        .primary(m.span, "matches only a `*` module")
+                        .note("in ABOP and cpfg `*` in a context matches any module; lsyc has no wildcard")
+                        .help("leave that side of the context out: a rule without context matches whatever surrounds the module"),
+                    );
+                }
+            }
+        }
+    }
+
+    /// A letter written with parameters that no rule of any kind rewrites, no
+    /// context reads and the turtle does not draw: a silent no-op, often a
+    /// command of another tool (cpfg's `T(…)` tropism).
+    fn does_nothing(&mut self, ls: &Lsystem, rules: &[&Rule], local: &Local) {
+        let mut handled: HashSet<(&ModName, usize)> = HashSet::new();
+        let mut read: HashSet<&ModName> = HashSet::new();
+        for r in rules {
+            handled.insert((&r.pred.name, r.pred.arity()));
+            for m in [&r.left, &r.right].into_iter().flatten().flatten() {
+                read.insert(&m.name);
+            }
+        }
+        let mut warned: HashSet<(&ModName, usize)> = HashSet::new();
+        let strings = ls.body.stmts.iter().flat_map(|s| match &s.node {
+            Stmt::Axiom(ms) => ms.as_slice(),
+            Stmt::Rule(r) => r.succ.as_slice(),
+            _ => &[],
+        });
+        for m in strings {
+            let arity = m.arity();
+            if arity == 0
+                || !matches!(self.kind(m, local), Kind::Letter)
+                || handled.contains(&(&m.name, arity))
+                || read.contains(&m.name)
+                || !warned.insert((&m.name, arity))
+            {
+                continue;
+            }
+            let name = m.name.text();
+            let mut d = Diagnostic::warning(
+                Code::DoesNothing,
+                format!(
+                    "`{name}` with {arity} parameter{} is never rewritten and draws nothing",
+                    plural(arity)
+                ),
+            )
+            .primary(m.span, "this module has no effect")
+            .note("only `F` and `f`, turtle symbols, elements and modules with `interpret` rules draw");
+            d = if name == "T" && (arity == 4 || arity == 1) {
+                d.help("for tropism write the statement `tropism (x, y, z) e;` in the lsystem (and `tropism(e)` in a string to change e)")
+            } else {
+                d.help(format!(
+                    "add a rule for `{name}` with {arity} parameter{}, an `interpret` rule to draw it, or remove it",
+                    plural(arity)
+                ))
+            };
+            self.diags.push(d);
+        }
+    }
+
+    /// Interpretation rules that always apply and produce, directly or through
+    /// each other, the module they rewrite: interpretation would never end (the
+    /// run fails with E0905); reported here, at the rule.
+    fn interpret_cycles(&mut self, rules: &[&Rule]) {
+        // For each (name, arity): its first interpret rule, when it always applies.
+        let mut first: HashMap<(&ModName, usize), Option<&Rule>> = HashMap::new();
+        for r in rules.iter().filter(|r| r.interpret) {
+            first
+                .entry((&r.pred.name, r.pred.arity()))
+                .or_insert((r.cond.is_none() && r.weight.is_none()).then_some(*r));
+        }
+        let mut reported: HashSet<(&ModName, usize)> = HashSet::new();
+        for r in rules.iter().filter(|r| r.interpret) {
+            let start = (&r.pred.name, r.pred.arity());
+            let Some(Some(rule)) = first.get(&start).copied() else {
+                continue;
+            };
+            // Walk the modules reachable through always-applying rules.
+            let mut seen: HashSet<(&ModName, usize)> = HashSet::new();
+            let mut todo: Vec<(&ModName, usize)> = rule
+                .succ
+                .iter()
+                .map(|m| (&m.name, m.arity()))
+                .collect();
+            let mut cycle = false;
+            while let Some(k) = todo.pop() {
+                if k == start {
+                    cycle = true;
+                    break;
+                }
+                if !seen.insert(k) {
+                    continue;
+                }
+                if let Some(Some(r)) = first.get(&k) {
+                    todo.extend(r.succ.iter().map(|m| (&m.name, m.arity())));
+                }
+            }
+            if !cycle || !reported.insert(start) {
+                continue;
+            }
+            let name = start.0.text();
+            let span = rule.pred.span.to(rule.succ.last().map_or(rule.pred.span, |m| m.span));
+            let mut d = Diagnostic::error(
+                Code::InterpretTooDeep,
+                format!("`interpret {name}` produces `{name}` again, so drawing would never end"),
+            )
+            .primary(span, "this rule always applies and its successor leads back to it")
+            .note("interpretation rules apply again to the modules they produce");
+            d = if rule.succ.iter().any(|m| (&m.name, m.arity()) == start) {
+                d.help(format!(
+                    "derive another letter and interpret that one, e.g. `I` in the rules and `interpret I -> {name} …;`; or give the rule a condition that ends the recursion"
+                ))
+            } else {
+                d.help("give one of these rules a condition that ends the recursion")
+            };
+            self.diags.push(d);
+        }
     }
 
     /// Labels name rules, so two rules of one lsystem may not share one.
@@ -125,6 +257,32 @@ impl<'a> Checker<'a> {
         let mut seen: HashMap<&str, Span> = HashMap::new();
         for s in &ls.body.stmts {
             if let Stmt::Rule(Rule { label: Some(l), .. }) = &s.node {
+                let help = match l.name.as_str() {
+                    "decomposition" | "decompositions" => Some(
+                        "lsyc marks each rule instead of a section: `decompose A -> B C;`",
+                    ),
+                    "homomorphism" | "homomorphisms" | "interpretation" => Some(
+                        "lsyc marks each rule instead of a section: `interpret A -> F;`",
+                    ),
+                    "production" | "productions" | "derivation" | "endgroup" | "group" => {
+                        Some("lsyc rules need no section: remove the label")
+                    }
+                    _ => None,
+                };
+                if let Some(help) = help {
+                    self.diags.push(
+                        Diagnostic::warning(
+                            Code::SectionLabel,
+                            format!(
+                                "`{}:` is read as the label of one rule, not as a section",
+                                l.name
+                            ),
+                        )
+                        .primary(l.span, "a rule label (a name for this rule only)")
+                        .note("cpfg and L-Py divide an L-system into sections; lsyc has none")
+                        .help(help),
+                    );
+                }
                 if let Some(first) = seen.get(l.name.as_str()) {
                     self.diags
                         .push(duplicate("rule label", &l.name, l.span, *first));

@@ -110,6 +110,16 @@ pub enum DeriveError {
     TooManySteps { steps: u64, limit: u32 },
 }
 
+/// The first interpretation rule of the module named `module`.
+fn interpret_rule_span(prog: &Program, module: &str) -> Option<crate::span::Span> {
+    prog.symbols
+        .info
+        .iter()
+        .enumerate()
+        .filter(|(_, i)| i.name.text() == module)
+        .find_map(|(s, _)| prog.interpret[s].first().map(|r| r.span))
+}
+
 /// `A → B → A → …`: the first modules of a decomposition chain and its end.
 fn chain_text(chain: &[String]) -> String {
     let shown: Vec<String> = if chain.len() > 8 {
@@ -194,8 +204,11 @@ impl DeriveError {
             DeriveError::TooMuchMemory { .. } => Diagnostic::error(Code::TooMuchMemory, msg)
                 .primary(prog.name_span, "this lsystem grows too fast")
                 .help("derive fewer steps with -n, or raise the limit with --max-memory"),
-            DeriveError::InterpretTooDeep { .. } => Diagnostic::error(Code::InterpretTooDeep, msg)
-                .primary(prog.name_span, "an `interpret` rule produces a module that is interpreted again, endlessly")
+            DeriveError::InterpretTooDeep { module, .. } => Diagnostic::error(Code::InterpretTooDeep, msg)
+                .primary(
+                    interpret_rule_span(prog, module).unwrap_or(prog.name_span),
+                    "an `interpret` rule produces a module that is interpreted again, endlessly",
+                )
                 .help("interpretation rules must end in modules that draw; a rule like `interpret A -> B; interpret B -> A;` never does"),
             DeriveError::TooMuchDrawing { module, .. } => Diagnostic::error(Code::TooMuchDrawing, msg)
                 .primary(prog.name_span, "its `interpret` rules expand modules into more and more modules")
