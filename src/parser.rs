@@ -240,9 +240,14 @@ fn describe_expected(expected: &[String]) -> Vec<String> {
             "a statement (`axiom …;`, a rule, …)",
             &mut rest,
         );
-        rest.retain(|e| !MODULE_STARTS.contains(&e.as_str()));
+        rest.retain(|e| {
+            !MODULE_STARTS.contains(&e.as_str())
+                && !matches!(e.as_str(), "\"tropism\"" | "\"consider\"" | "\"decompose\"")
+        });
     } else if has_modules {
         take(MODULE_STARTS, "a module", &mut rest);
+        // `tropism(e)` is a module too.
+        rest.retain(|e| e.as_str() != "\"tropism\"");
     }
     if has(EXPR_STARTS) {
         take(EXPR_STARTS, "an expression", &mut rest);

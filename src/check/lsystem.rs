@@ -147,25 +147,40 @@ impl<'a> Checker<'a> {
     /// context reads and the turtle does not draw: a silent no-op, often a
     /// command of another tool (cpfg's `T(…)` tropism).
     fn does_nothing(&mut self, ls: &Lsystem, rules: &[&Rule], local: &Local) {
-        let mut handled: HashSet<(&ModName, usize)> = HashSet::new();
+        // A name with rules of another arity is E0402's business.
+        let mut handled: HashSet<&ModName> = HashSet::new();
         let mut read: HashSet<&ModName> = HashSet::new();
         for r in rules {
-            handled.insert((&r.pred.name, r.pred.arity()));
+            handled.insert(&r.pred.name);
             for m in [&r.left, &r.right].into_iter().flatten().flatten() {
                 read.insert(&m.name);
             }
         }
         let mut warned: HashSet<(&ModName, usize)> = HashSet::new();
-        let strings = ls.body.stmts.iter().flat_map(|s| match &s.node {
-            Stmt::Axiom(ms) => ms.as_slice(),
-            Stmt::Rule(r) => r.succ.as_slice(),
-            _ => &[],
+        let strings = ls.body.stmts.iter().flat_map(|s| {
+            let ms = match &s.node {
+                Stmt::Axiom(ms) => ms.as_slice(),
+                Stmt::Rule(r) => r.succ.as_slice(),
+                _ => &[],
+            };
+            // With the module before each: a letter glued to a letter before it
+            // comes from a split word, which W0301 reports.
+            ms.iter()
+                .enumerate()
+                .map(move |(k, m)| (k.checked_sub(1).map(|j| &ms[j]), m))
         });
-        for m in strings {
+        for (prev, m) in strings {
             let arity = m.arity();
+            let glued = prev.is_some_and(|p| {
+                p.args.is_none()
+                    && matches!(&p.name, ModName::Name(n) if is_letter(n))
+                    && p.span.end == m.span.start
+            });
             if arity == 0
+                || arity > 255
+                || glued
                 || !matches!(self.kind(m, local), Kind::Letter)
-                || handled.contains(&(&m.name, arity))
+                || handled.contains(&m.name)
                 || read.contains(&m.name)
                 || !warned.insert((&m.name, arity))
             {
@@ -212,11 +227,8 @@ impl<'a> Checker<'a> {
             };
             // Walk the modules reachable through always-applying rules.
             let mut seen: HashSet<(&ModName, usize)> = HashSet::new();
-            let mut todo: Vec<(&ModName, usize)> = rule
-                .succ
-                .iter()
-                .map(|m| (&m.name, m.arity()))
-                .collect();
+            let mut todo: Vec<(&ModName, usize)> =
+                rule.succ.iter().map(|m| (&m.name, m.arity())).collect();
             let mut cycle = false;
             while let Some(k) = todo.pop() {
                 if k == start {
@@ -234,12 +246,18 @@ impl<'a> Checker<'a> {
                 continue;
             }
             let name = start.0.text();
-            let span = rule.pred.span.to(rule.succ.last().map_or(rule.pred.span, |m| m.span));
+            let span = rule
+                .pred
+                .span
+                .to(rule.succ.last().map_or(rule.pred.span, |m| m.span));
             let mut d = Diagnostic::error(
                 Code::InterpretTooDeep,
                 format!("`interpret {name}` produces `{name}` again, so drawing would never end"),
             )
-            .primary(span, "this rule always applies and its successor leads back to it")
+            .primary(
+                span,
+                "this rule always applies and its successor leads back to it",
+            )
             .note("interpretation rules apply again to the modules they produce");
             d = if rule.succ.iter().any(|m| (&m.name, m.arity()) == start) {
                 d.help(format!(
@@ -258,12 +276,12 @@ impl<'a> Checker<'a> {
         for s in &ls.body.stmts {
             if let Stmt::Rule(Rule { label: Some(l), .. }) = &s.node {
                 let help = match l.name.as_str() {
-                    "decomposition" | "decompositions" => Some(
-                        "lsyc marks each rule instead of a section: `decompose A -> B C;`",
-                    ),
-                    "homomorphism" | "homomorphisms" | "interpretation" => Some(
-                        "lsyc marks each rule instead of a section: `interpret A -> F;`",
-                    ),
+                    "decomposition" | "decompositions" => {
+                        Some("lsyc marks each rule instead of a section: `decompose A -> B C;`")
+                    }
+                    "homomorphism" | "homomorphisms" | "interpretation" => {
+                        Some("lsyc marks each rule instead of a section: `interpret A -> F;`")
+                    }
                     "production" | "productions" | "derivation" | "endgroup" | "group" => {
                         Some("lsyc rules need no section: remove the label")
                     }
@@ -414,10 +432,10 @@ impl<'a> Checker<'a> {
     fn predecessor(&mut self, r: &Rule, local: &mut Local) {
         let m = &r.pred;
         if r.interpret || r.decompose {
-            let kw = if r.interpret {
-                "interpret"
+            let (kw, a) = if r.interpret {
+                ("interpret", "an")
             } else {
-                "decompose"
+                ("decompose", "a")
             };
             for ctx in [&r.left, &r.right].into_iter().flatten() {
                 let span = match (ctx.first(), ctx.last()) {
@@ -427,7 +445,7 @@ impl<'a> Checker<'a> {
                 self.diags.push(
                     Diagnostic::error(
                         Code::ContextNotAllowed,
-                        format!("an `{kw}` rule cannot have context"),
+                        format!("{a} `{kw}` rule cannot have context"),
                     )
                     .primary(span, "context here")
                     .help(format!(
