@@ -12,8 +12,9 @@ use tiny_skia::{
 /// Segments batched into one path before it is stroked.
 const BATCH: usize = 4096;
 
-/// An element ready to paint: its outline, fill and optional stroke colour.
-type Painted = (tiny_skia::Path, [u8; 3], Option<[u8; 3]>);
+/// An element ready to paint: its outline, its fill (none for `fill "none"`) and
+/// its stroke colour and width in pixels, as the SVG writer paints it.
+type Painted = (tiny_skia::Path, Option<[u8; 3]>, Option<([u8; 3], f32)>);
 
 pub struct PngWriter {
     pixmap: Pixmap,
@@ -90,12 +91,16 @@ impl PngWriter {
         let elements = elements
             .iter()
             .map(|e| {
-                let fill = e
-                    .fill
+                // The SVG writer's defaults: fill #3f7f3a, no stroke, width 1.
+                let fill = match e.fill.as_deref() {
+                    None => Some([63, 127, 58]),
+                    Some(f) => parse_color(f),
+                };
+                let stroke = e
+                    .stroke
                     .as_deref()
                     .and_then(parse_color)
-                    .unwrap_or([63, 127, 58]);
-                let stroke = e.stroke.as_deref().and_then(parse_color);
+                    .map(|c| (c, e.width.unwrap_or(1.0) as f32));
                 element_path(&e.path).map(|p| (p, fill, stroke))
             })
             .collect();
@@ -219,15 +224,19 @@ impl Sink for PngWriter {
             ((self.max.y - o.y) * k + self.off.y) as f32,
         );
         let mut paint = Paint::default();
-        paint.set_color_rgba8(fill[0], fill[1], fill[2], 255);
         paint.anti_alias = true;
         let path = path.clone();
-        self.pixmap
-            .fill_path(&path, &paint, FillRule::Winding, t, None);
-        if let Some(s) = stroke {
+        if let Some(fill) = fill {
+            paint.set_color_rgba8(fill[0], fill[1], fill[2], 255);
+            self.pixmap
+                .fill_path(&path, &paint, FillRule::Winding, t, None);
+        }
+        if let Some((s, width)) = *stroke
+            && width > 0.0
+        {
             paint.set_color_rgba8(s[0], s[1], s[2], 255);
             let stroke = Stroke {
-                width: 1.0,
+                width,
                 ..Stroke::default()
             };
             // A hairline in pixels: stroke the transformed path.

@@ -242,3 +242,77 @@ fn fig_2_8_trees_bend_as_their_tropism_says() {
         assert_ne!(drawn0.bbox, drawn.bbox, "tree {name}");
     }
 }
+
+/// Renders `program` to SVG and PNG with the binary.
+fn render_both(program: &str, dir: &std::path::Path, name: &str) -> (String, tiny_skia::Pixmap) {
+    let src = dir.join(format!("{name}.lsy"));
+    std::fs::write(&src, program).expect("writes");
+    let mut outs = Vec::new();
+    for ext in ["svg", "png"] {
+        let out = dir.join(format!("{name}.{ext}"));
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_lsyc"))
+            .args(["run", src.to_str().expect("utf-8"), "-o"])
+            .arg(&out)
+            .args(["--size", "200"])
+            .output()
+            .expect("lsyc runs");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        outs.push(out);
+    }
+    let svg = std::fs::read_to_string(&outs[0]).expect("svg");
+    let png = tiny_skia::Pixmap::decode_png(&std::fs::read(&outs[1]).expect("png")).expect("png");
+    (svg, png)
+}
+
+/// The fill colour usvg reads for the element paths of an SVG (`None`: no fill).
+fn svg_element_fills(svg: &str) -> Vec<Option<[u8; 3]>> {
+    let tree = usvg::Tree::from_str(svg, &usvg::Options::default()).expect("usvg reads it");
+    let mut out = Vec::new();
+    fn walk(g: &usvg::Group, out: &mut Vec<Option<[u8; 3]>>) {
+        for n in g.children() {
+            match n {
+                usvg::Node::Group(g) => walk(g, out),
+                usvg::Node::Path(p) if p.stroke().is_none() || p.fill().is_some() => {
+                    out.push(p.fill().and_then(|f| match f.paint() {
+                        usvg::Paint::Color(c) => Some([c.red, c.green, c.blue]),
+                        _ => None,
+                    }))
+                }
+                usvg::Node::Path(_) => out.push(None),
+                _ => {}
+            }
+        }
+    }
+    walk(tree.root(), &mut out);
+    out
+}
+
+#[test]
+fn png_and_svg_agree_on_element_fills() {
+    // One square element fills the picture; the centre pixel of the PNG must
+    // be the colour the SVG gives the element (or the background for "none").
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (fill, stroke) in [
+        ("fill \"#d03020\";", ""),
+        ("fill \"none\";", "stroke \"#2040d0\"; width 2;"),
+        ("", ""),
+    ] {
+        let program = format!(
+            "element Sq {{ path \"M-5 0 L5 0 L5 10 L-5 10 Z\"; {fill} {stroke} }}\nlsystem S {{ axiom Sq; }}\n"
+        );
+        let (svg, png) = render_both(&program, dir.path(), "sq");
+        let fills = svg_element_fills(&svg);
+        assert_eq!(fills.len(), 1, "{fill}: {fills:?}\n{svg}");
+        let c = png
+            .pixel(png.width() / 2, png.height() / 2)
+            .expect("centre");
+        let got = [c.red(), c.green(), c.blue()];
+        match fills[0] {
+            Some(want) => assert_eq!(got, want, "{fill}: the PNG paints another colour"),
+            None => assert!(
+                got.iter().all(|&v| v > 230),
+                "{fill}: the PNG fills an element the SVG leaves empty: {got:?}"
+            ),
+        }
+    }
+}
