@@ -43,7 +43,7 @@ pub fn decompose(
         let params = &s.params[p..p + n];
         p += n;
         d.module(sym, params, i as u64, 0)?;
-        if d.out.len() % 1024 == 0 {
+        if (i + 1).is_multiple_of(1024) {
             check_limits(step, d.out.len(), d.out.params.len(), limits, false)?;
         }
     }

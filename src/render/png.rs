@@ -223,8 +223,10 @@ impl Sink for PngWriter {
             ((o.x - self.min.x) * k + self.off.x) as f32,
             ((self.max.y - o.y) * k + self.off.y) as f32,
         );
-        let mut paint = Paint::default();
-        paint.anti_alias = true;
+        let mut paint = Paint {
+            anti_alias: true,
+            ..Paint::default()
+        };
         let path = path.clone();
         if let Some(fill) = fill {
             paint.set_color_rgba8(fill[0], fill[1], fill[2], 255);
