@@ -105,9 +105,20 @@ pub enum Stmt {
     Step(Expr),
     Axiom(Vec<Module>),
     Ignore(Vec<Module>),
+    /// `consider A B;`: context matching sees only these modules (and brackets).
+    Consider(Vec<Module>),
+    /// `tropism (x, y, z) e;`: after every `F` the heading bends toward T.
+    Tropism(Tropism),
     Module(ModuleDecl),
     Rule(Rule),
     Error,
+}
+
+/// `tropism (x, y, z) e;`: the tropism vector T and the elasticity e (ABOP §2.2).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tropism {
+    pub dir: [Expr; 3],
+    pub elasticity: Expr,
 }
 
 /// `module Apex(len, depth);`
@@ -130,6 +141,8 @@ pub struct Rule {
     pub label: Option<Ident>,
     /// A homomorphism (interpretation) rule: applied when drawing, not when deriving.
     pub interpret: bool,
+    /// A decomposition rule: applied after each derivation step until none matches.
+    pub decompose: bool,
     pub left: Option<Vec<Module>>,
     pub pred: Module,
     pub right: Option<Vec<Module>>,

@@ -89,6 +89,8 @@ codes! {
     MissingAxiom = "E0603", "an lsystem without an axiom";
     DuplicateSetting = "E0604", "a setting given twice";
     NoLsystem = "E0605", "a file with no lsystem to run";
+    IgnoreAndConsider = "E0606", "`ignore` and `consider` in one lsystem";
+    ContextNotAllowed = "E0607", "context on an `interpret` or `decompose` rule";
     InvalidPath = "E0701", "element path data that is not valid SVG";
     MissingPath = "E0702", "an element without a `path`";
     UnknownProperty = "E0703", "an element property lsyc does not know";
@@ -107,6 +109,7 @@ codes! {
     TooManySteps = "E0907", "more derivation steps than the limit";
     TooMuchDrawing = "E0908", "interpretation that would draw more than the module limit";
     DrawingTooLarge = "E0909", "a drawing with coordinates too large to write";
+    DecomposeTooDeep = "E0910", "decomposition rules that expand into each other too deeply";
     Unused = "W0101", "a declaration that nothing uses";
     UnusedParameter = "W0102", "a rule parameter that nothing uses";
     NeverProduced = "W0201", "a rule whose predecessor never appears";
@@ -117,6 +120,9 @@ codes! {
     NeverSeeded = "W0801", "a guide never seeded while a link to it kept its tokens";
     DeriveRanOut = "W0802", "a system stopped by `derive` with query modules still to answer";
     LeavesAndComesBack = "W0803", "growth that leaves its guide and comes back in";
+    DoesNothing = "W0303", "a letter with parameters that no rule rewrites and nothing draws";
+    StarContext = "W0304", "`*` in a context, read as the scale module and not as a wildcard";
+    SectionLabel = "W0305", "a rule label that is a section name of cpfg or L-Py";
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -147,11 +147,20 @@ impl Dumper {
             Stmt::Step(e) => format!("step {}", self.expr(e)),
             Stmt::Axiom(ms) => format!("axiom {}", self.modules(ms)),
             Stmt::Ignore(ms) => format!("ignore {}", self.modules(ms)),
+            Stmt::Consider(ms) => format!("consider {}", self.modules(ms)),
+            Stmt::Tropism(t) => format!(
+                "tropism ({}, {}, {}) {}",
+                self.expr(&t.dir[0]),
+                self.expr(&t.dir[1]),
+                self.expr(&t.dir[2]),
+                self.expr(&t.elasticity)
+            ),
             Stmt::Module(m) => return self.module_decl(m),
             Stmt::Rule(r) => {
                 let Rule {
                     label,
                     interpret,
+                    decompose,
                     left,
                     pred,
                     right,
@@ -165,6 +174,9 @@ impl Dumper {
                 }
                 if *interpret {
                     t.push_str(" interpret");
+                }
+                if *decompose {
+                    t.push_str(" decompose");
                 }
                 if let Some(l) = left {
                     let _ = write!(t, " left=[{}]", self.modules(l));

@@ -324,6 +324,22 @@ fn stmt(s: &Stmt, scope: &Scope) -> String {
             out.push(';');
             out
         }
+        Stmt::Consider(ms) => {
+            let mut out = "consider".to_string();
+            for m in ms {
+                out.push(' ');
+                write_module(&mut out, m);
+            }
+            out.push(';');
+            out
+        }
+        Stmt::Tropism(t) => format!(
+            "tropism ({}, {}, {}) {};",
+            format_expr(&t.dir[0]),
+            format_expr(&t.dir[1]),
+            format_expr(&t.dir[2]),
+            format_expr(&t.elasticity)
+        ),
         Stmt::Module(m) => module_decl(m),
         Stmt::Rule(r) => rule(r, scope),
         Stmt::Error => String::new(),
@@ -338,6 +354,9 @@ fn rule(r: &Rule, scope: &Scope) -> String {
     }
     if r.interpret {
         out.push_str("interpret ");
+    }
+    if r.decompose {
+        out.push_str("decompose ");
     }
     if let Some(left) = r.left.as_deref().filter(|l| !l.is_empty()) {
         out.push_str(&format_modules(left, scope));
@@ -861,6 +880,7 @@ mod tests {
             Stmt::Rule(Rule {
                 label: None,
                 interpret: false,
+                decompose: false,
                 left: None,
                 pred: Module::new(ModName::Name(pred.to_string()), None),
                 right: None,
@@ -952,6 +972,7 @@ mod tests {
         let rule = Rule {
             label: Some(Ident::new("grow")),
             interpret: false,
+            decompose: false,
             left: Some(vec![m("B", None)]),
             pred: m("A", Some(vec![var("l")])),
             right: None,

@@ -68,6 +68,12 @@ pub enum Token {
     Interpret,
     #[token("cut")]
     Cut,
+    #[token("tropism")]
+    Tropism,
+    #[token("consider")]
+    Consider,
+    #[token("decompose")]
+    Decompose,
     #[token("true")]
     True,
     #[token("false")]
@@ -333,7 +339,20 @@ fn stray_diagnostic(source: &str, start: usize, end: usize) -> Diagnostic {
         Span::new(start, end),
         "no token of the language starts here",
     );
+    let after = &source[end..];
     d = match first {
+        '#' if after.starts_with("define") => d.help(
+            "cpfg's `#define N 5` is a constant in lsyc: `const N = 5;` (before the lsystem; `-D N=…` overrides it)",
+        ),
+        '#' if after.starts_with("ignore") => {
+            d.help("cpfg's `#ignore: + -` is a statement in the lsystem: `ignore + -;`")
+        }
+        '#' if after.starts_with("consider") => {
+            d.help("cpfg's `#consider: A B` is a statement in the lsystem: `consider A B;`")
+        }
+        '#' if after.starts_with("include") => {
+            d.help("lsyc has no `#include`: a program is one file")
+        }
         '#' => d.help("lsyc sets the line width with `!(w)`; `#` is cpfg's width symbol"),
         '@' => d.help(
             "cpfg's `@` commands are not part of lsyc; see the turtle table in docs/language.md",
@@ -416,6 +435,9 @@ impl Token {
             Token::Ignore => "ignore",
             Token::Interpret => "interpret",
             Token::Cut => "cut",
+            Token::Tropism => "tropism",
+            Token::Consider => "consider",
+            Token::Decompose => "decompose",
             Token::True => "true",
             Token::False => "false",
             Token::Epsilon => "ε",

@@ -240,9 +240,14 @@ fn describe_expected(expected: &[String]) -> Vec<String> {
             "a statement (`axiom …;`, a rule, …)",
             &mut rest,
         );
-        rest.retain(|e| !MODULE_STARTS.contains(&e.as_str()));
+        rest.retain(|e| {
+            !MODULE_STARTS.contains(&e.as_str())
+                && !matches!(e.as_str(), "\"tropism\"" | "\"consider\"" | "\"decompose\"")
+        });
     } else if has_modules {
         take(MODULE_STARTS, "a module", &mut rest);
+        // `tropism(e)` is a module too.
+        rest.retain(|e| e.as_str() != "\"tropism\"");
     }
     if has(EXPR_STARTS) {
         take(EXPR_STARTS, "an expression", &mut rest);
@@ -344,11 +349,28 @@ fn explain_context(
             break;
         }
         if let Token::Label(name) = &t.1 {
-            d = d.note(format!(
-                "`{name}:` is read as a rule label; for a condition write a space before the colon: `{name} : …`"
-            ));
+            d = match name.as_str() {
+                "ω" | "omega" | "axiom" | "Axiom" => d
+                    .note(format!("`{name}:` is read as a rule label"))
+                    .help("the axiom is a statement: `axiom F;`"),
+                "ignore" | "consider" => d
+                    .note(format!("`{name}:` is read as a rule label"))
+                    .help(format!("`{name}` takes the modules without a colon: `{name} + - F;`")),
+                _ => d.note(format!(
+                    "`{name}:` is read as a rule label; for a condition write a space before the colon: `{name} : …`"
+                )),
+            };
             break;
         }
+    }
+    // cpfg and L-Py close an lsystem with a word; lsyc with `}`.
+    if let Some(t) = tokens
+        .iter()
+        .find(|t| matches!(&t.1, Token::Ident(w) if w == "endlsystem" || w == "endgroup"))
+    {
+        d = d
+            .secondary(Span::new(t.0, t.2), "cpfg's and L-Py's end of an lsystem")
+            .help("an lsyc lsystem ends with its closing `}`: remove `endlsystem`");
     }
     d
 }
@@ -386,6 +408,20 @@ fn syntax_error_at(
                 d = d.note(format!(
                     "{tok} is a keyword of the language and cannot be used as a name"
                 ));
+            }
+            if tok == Token::Assign {
+                d = d.help("to compare, write `==`; `=` only defines a constant");
+            }
+            if tok == Token::Star
+                && tokens
+                    .iter()
+                    .rev()
+                    .find(|t| t.0 < l)
+                    .is_some_and(|t| t.1 == Token::Colon)
+            {
+                d = d.help(
+                    "`: *` is cpfg's \"no condition\"; in lsyc leave the condition out: `A -> …`",
+                );
             }
             if matches!(tok, Token::Label(_)) {
                 d = d.note("a name followed directly by `:` is a rule label; write a space before `:` for a condition");

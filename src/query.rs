@@ -14,6 +14,10 @@ pub enum QueryKind {
     Position,
     /// `?H`: the turtle's heading.
     Heading,
+    /// `?U`: the turtle's up vector.
+    Up,
+    /// `?L`: the turtle's left vector.
+    Left,
     /// `?D_L`: the distance to the closest link edge.
     DistanceLink,
     /// `?D_G`: the distance to the closest guide edge.
@@ -55,6 +59,20 @@ pub const QUERIES: &[Query] = &[
         outputs: &["hx", "hy", "hz"],
         inputs: &[],
         doc: "turtle heading (unit vector)",
+    },
+    Query {
+        name: "?U",
+        kind: QueryKind::Up,
+        outputs: &["ux", "uy", "uz"],
+        inputs: &[],
+        doc: "turtle up vector (unit vector)",
+    },
+    Query {
+        name: "?L",
+        kind: QueryKind::Left,
+        outputs: &["lx", "ly", "lz"],
+        inputs: &[],
+        doc: "turtle left vector (unit vector)",
     },
     Query {
         name: "?D_L",
@@ -106,6 +124,16 @@ pub const QUERIES: &[Query] = &[
         doc: "whether the next element of length delta collides with a guide edge, link or element",
     },
 ];
+
+impl QueryKind {
+    /// Whether the turtle alone answers it (in every run, not only in scenes).
+    pub fn is_turtle(self) -> bool {
+        matches!(
+            self,
+            QueryKind::Position | QueryKind::Heading | QueryKind::Up | QueryKind::Left
+        )
+    }
+}
 
 pub fn lookup(name: &str) -> Option<&'static Query> {
     QUERIES.iter().find(|q| q.name == name)

@@ -57,6 +57,11 @@ pub fn is_letter(name: &str) -> bool {
     matches!((cs.next(), cs.next()), (Some(c), None) if c.is_alphabetic())
 }
 
+/// Multi-letter modules the language itself defines (keywords in module strings).
+pub fn is_builtin(name: &str) -> bool {
+    name == "tropism"
+}
+
 /// Whether an undeclared name can be split into single letters.
 pub fn splits(name: &str) -> bool {
     name.chars().all(char::is_alphabetic)
@@ -76,7 +81,7 @@ pub fn resolve(file: &mut File, diags: &mut Vec<Diagnostic>) {
         };
         for stmt in &mut ls.body.stmts {
             match &mut stmt.node {
-                Stmt::Axiom(ms) | Stmt::Ignore(ms) => r.split_list(ms),
+                Stmt::Axiom(ms) | Stmt::Ignore(ms) | Stmt::Consider(ms) => r.split_list(ms),
                 Stmt::Rule(rule) => {
                     if let Some(l) = &mut rule.left {
                         r.split_list(l);
@@ -162,6 +167,7 @@ impl Resolver<'_> {
         if let ModName::Name(n) = &m.name
             && !self.scope.declares(n)
             && !is_letter(n)
+            && !is_builtin(n)
             && !splits(n)
             && self.reported.insert(n.clone())
         {
@@ -187,7 +193,7 @@ impl Resolver<'_> {
             let ModName::Name(name) = &m.name else {
                 unreachable!("needs_split only accepts names")
             };
-            if word_like(name) {
+            if word_like(name) || (m.args.is_some() && lower_word(name)) {
                 let spaced: Vec<String> = name.chars().map(String::from).collect();
                 self.diags.push(
                     Diagnostic::warning(
@@ -253,7 +259,14 @@ fn undeclared(name: &str, m: &Module) -> Diagnostic {
     .primary(m.name_span, "multi-letter names must be declared");
     let letters: String = name.chars().take_while(|c| c.is_alphabetic()).collect();
     let digits: String = name[letters.len()..].to_string();
-    if !letters.is_empty()
+    let digit_runs = name.chars().filter(char::is_ascii_digit).count();
+    let mixed = digits.chars().any(|c| c.is_alphabetic());
+    if digit_runs > 0 && mixed {
+        d.help(format!(
+            "digits are numbers in lsyc, not module names, so `{name}` is one name: write subscripted letters as letters (`F1` → `A`, with `interpret A -> F;`), or declare `module {letters}{};` and write the modules apart",
+            digits.chars().take_while(char::is_ascii_digit).collect::<String>()
+        ))
+    } else if !letters.is_empty()
         && !digits.is_empty()
         && digits.chars().all(|c| c.is_ascii_digit())
         && m.args.is_none()
@@ -275,9 +288,19 @@ fn word_like(name: &str) -> bool {
     name.chars().count() >= 3 && first.is_some_and(char::is_uppercase) && cs.all(char::is_lowercase)
 }
 
+/// `leaf`, `apex`: a lowercase word of three letters or more, not one letter
+/// repeated (`fff`).
+fn lower_word(name: &str) -> bool {
+    let mut cs = name.chars();
+    let first = cs.next();
+    name.chars().count() >= 3
+        && name.chars().all(char::is_lowercase)
+        && name.chars().any(|c| Some(c) != first)
+}
+
 fn needs_split(m: &Module, scope: &Scope) -> bool {
     match &m.name {
-        ModName::Name(n) => !scope.declares(n) && !is_letter(n) && splits(n),
+        ModName::Name(n) => !scope.declares(n) && !is_letter(n) && !is_builtin(n) && splits(n),
         _ => false,
     }
 }

@@ -64,7 +64,7 @@ pub fn derive(
     let start = Instant::now();
     let args = vec![0.0; prog.params.len()];
     let result = derive::axiom(&prog, &args, opts.seed)
-        .and_then(|a| derive::derive(&prog, a, steps, opts.seed, opts.limits, progress));
+        .and_then(|a| turtle::derive(&prog, a, steps, opts.seed, opts.limits, progress));
     let string = result.map_err(|e| e.diagnostic(&prog))?;
     Ok(Derived {
         prog,

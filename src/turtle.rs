@@ -46,6 +46,9 @@ pub struct State {
     pub scale: f64,
     pub width: f64,
     pub color: u32,
+    /// The elasticity e of tropism: after each `F` the heading turns toward
+    /// the lsystem's tropism vector T by e·|H × T| radians.
+    pub elasticity: f64,
 }
 
 impl Default for State {
@@ -58,9 +61,14 @@ impl Default for State {
             scale: 1.0,
             width: 0.0,
             color: 0,
+            elasticity: 0.0,
         }
     }
 }
+
+/// The tropism vector T of programs that set an elasticity without a
+/// `tropism` statement: down, against the turtle's start heading.
+pub const DEFAULT_TROPISM: [f64; 3] = [0.0, -1.0, 0.0];
 
 /// The sine and cosine of the last angle turned by: most turns of a program are
 /// by the same angle, so most need no trigonometry.
@@ -130,8 +138,9 @@ impl State {
             Action::Color => {
                 self.color = match arg {
                     Some(c) => c.max(0.0) as u32,
-                    // The wood-to-leaf ramp of the palette ends at 7.
-                    None => (self.color + 1).min(7),
+                    // ABOP's bare `'` steps toward leaves: from ink or bark
+                    // straight to the first green (3), then along the greens to 7.
+                    None => (self.color + 1).clamp(3, 7),
                 }
             }
             Action::Draw | Action::Move => {
@@ -139,6 +148,20 @@ impl State {
             }
             _ => {}
         }
+    }
+
+    /// Bends the frame toward `t` (ABOP §2.2): a rotation by e·|H × T| radians
+    /// about H × T, which turns H toward T.
+    pub fn bend(&mut self, t: DVec3) {
+        let axis = self.h.cross(t);
+        let len = axis.length();
+        if self.elasticity == 0.0 || len < 1e-12 {
+            return;
+        }
+        let q = glam::DQuat::from_axis_angle(axis / len, self.elasticity * len);
+        self.h = (q * self.h).normalize();
+        self.l = (q * self.l).normalize();
+        self.u = self.h.cross(self.l);
     }
 }
 
@@ -197,7 +220,13 @@ pub fn interpret_limited(
     limits: Limits,
     sink: &mut dyn Sink,
 ) -> Result<Drawn, DeriveError> {
+    let mut start = start;
+    if let Some((_, e)) = prog.tropism {
+        start.elasticity = e;
+    }
+    let tropism = DVec3::from(prog.tropism.map_or(DEFAULT_TROPISM, |t| t.0));
     let mut t = Turtle {
+        tropism,
         expanded: s.len(),
         max_modules: limits.max_modules,
         expanded_here: 0,
@@ -234,6 +263,11 @@ pub fn interpret_limited(
         p += n;
         t.module_index = i;
         if has_interp && !prog.interpret[sym as usize].is_empty() {
+            // A query drawn by an interpretation rule is still answered where it stands.
+            if let Action::Query(kind) = prog.symbols.info[sym as usize].action {
+                let st = t.state;
+                t.sink.query(i, kind, &st);
+            }
             t.expanded_here = 0;
             t.expand(sym, params, i as u64, 0)?;
         } else {
@@ -245,6 +279,8 @@ pub fn interpret_limited(
 
 struct Turtle<'a> {
     prog: &'a Program,
+    /// The tropism vector T.
+    tropism: DVec3,
     sink: &'a mut dyn Sink,
     state: State,
     stack: Vec<State>,
@@ -397,6 +433,9 @@ impl Turtle<'_> {
                 self.state
                     .apply(action, arg, prog.angle, prog.step, &mut self.trig);
                 let to = self.state.pos;
+                if action == Action::Draw {
+                    self.state.bend(self.tropism);
+                }
                 if let Some(poly) = self.polygons.last_mut() {
                     if poly.is_empty() {
                         poly.push(from);
@@ -455,12 +494,96 @@ impl Turtle<'_> {
                 let st = self.state;
                 self.sink.query(self.module_index, kind, &st);
             }
+            Action::Elasticity => {
+                self.state.elasticity = arg.unwrap_or(prog.tropism.map_or(0.0, |t| t.1));
+            }
             Action::None | Action::Cut => {}
             other => self
                 .state
                 .apply(other, arg, prog.angle, prog.step, &mut self.trig),
         }
     }
+}
+
+/// Whether the program holds a turtle query (`?P ?H ?U ?L`).
+pub fn has_turtle_queries(prog: &Program) -> bool {
+    prog.symbols.info.iter().any(|i| match i.action {
+        Action::Query(k) => crate::query::QUERIES[k as usize].kind.is_turtle(),
+        _ => false,
+    })
+}
+
+/// Records the turtle's state at each query module of the string itself.
+struct Answers {
+    at: Vec<(usize, u8, State)>,
+}
+
+impl Sink for Answers {
+    fn segment(&mut self, _: DVec3, _: DVec3, _: f64, _: u32) {}
+    fn polygon(&mut self, _: &[DVec3], _: u32) {}
+    fn element(&mut self, _: u16, _: DVec3, _: DVec3, _: DVec3, _: f64, _: u32) {}
+    fn query(&mut self, module: usize, kind: u8, state: &State) {
+        if crate::query::QUERIES[kind as usize].kind.is_turtle() {
+            self.at.push((module, kind, *state));
+        }
+    }
+}
+
+/// Answers the turtle queries of `s` as cpfg does: the string is interpreted
+/// and each `?P ?H ?U ?L` receives the position or the frame vector the turtle
+/// has where it stands. A query that an interpretation rule produces (not in the
+/// string itself) is not answered.
+pub fn answer_queries(
+    prog: &Program,
+    s: &mut ModString,
+    seed: u64,
+    limits: Limits,
+) -> Result<(), DeriveError> {
+    let mut sink = Answers { at: Vec::new() };
+    interpret_limited(prog, s, seed, State::default(), limits, &mut sink)?;
+    if sink.at.is_empty() {
+        return Ok(());
+    }
+    let mut offset = Vec::with_capacity(s.len());
+    let mut p = 0;
+    for &x in &s.syms {
+        offset.push(p);
+        p += prog.symbols.arity(x);
+    }
+    for (i, kind, st) in sink.at {
+        let sym = s.syms[i] as usize;
+        // Only the module itself: an interpretation rule may have met one.
+        if prog.symbols.info[sym].action != Action::Query(kind) || prog.symbols.arity(s.syms[i]) < 3
+        {
+            continue;
+        }
+        let v = match crate::query::QUERIES[kind as usize].kind {
+            crate::query::QueryKind::Position => st.pos,
+            crate::query::QueryKind::Heading => st.h,
+            crate::query::QueryKind::Up => st.u,
+            _ => st.l,
+        };
+        s.params[offset[i]..offset[i] + 3].copy_from_slice(&[v.x, v.y, v.z]);
+    }
+    Ok(())
+}
+
+/// Derives as `derive::derive` does, and answers the turtle queries of the
+/// string after each step (and on the start string) when the program has any.
+pub fn derive(
+    prog: &Program,
+    start: ModString,
+    steps: u32,
+    seed: u64,
+    limits: Limits,
+    progress: &(dyn Fn(u32, usize) + Sync),
+) -> Result<ModString, DeriveError> {
+    if !has_turtle_queries(prog) {
+        return crate::derive::derive(prog, start, steps, seed, limits, progress);
+    }
+    crate::derive::derive_with(prog, start, steps, seed, limits, progress, &mut |s, _| {
+        answer_queries(prog, s, seed, limits)
+    })
 }
 
 /// A sink that only counts (for `--stats` without output, and tests).

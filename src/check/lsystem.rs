@@ -45,6 +45,8 @@ struct Local {
     warned: HashSet<(ModName, usize)>,
     /// Queries whose pass-through mismatch is already reported.
     pass_reported: HashSet<&'static str>,
+    /// Whether a `consider` list was given.
+    considers: bool,
 }
 
 impl<'a> Checker<'a> {
@@ -59,6 +61,7 @@ impl<'a> Checker<'a> {
             query_pass: HashMap::new(),
             warned: HashSet::new(),
             pass_reported: HashSet::new(),
+            considers: false,
         };
         self.settings(ls, &mut local);
         let rules: Vec<&Rule> = ls
@@ -87,7 +90,9 @@ impl<'a> Checker<'a> {
                     }
                     self.brackets(ms);
                 }
-                Stmt::Ignore(ms) => self.module_list(ms, Role::Ignore, &mut local),
+                Stmt::Ignore(ms) | Stmt::Consider(ms) => {
+                    self.module_list(ms, Role::Ignore, &mut local)
+                }
                 Stmt::Rule(r) => {
                     for ctx in [&r.left, &r.right].into_iter().flatten() {
                         self.module_list(ctx, Role::Context, &mut local);
@@ -113,6 +118,156 @@ impl<'a> Checker<'a> {
             self.rule_body(r);
         }
         self.unreachable_rules(ls, &rules);
+        self.star_contexts(&rules);
+        self.does_nothing(ls, &rules, &local);
+        self.interpret_cycles(&rules);
+    }
+
+    /// ABOP's and cpfg's `*` in a context means "any module"; here it is the
+    /// scale module, so such a rule never fires where it was meant to.
+    fn star_contexts(&mut self, rules: &[&Rule]) {
+        for r in rules {
+            for m in [&r.left, &r.right].into_iter().flatten().flatten() {
+                if m.name == ModName::Symbol('*') && m.args.is_none() {
+                    self.diags.push(
+                        Diagnostic::warning(
+                            Code::StarContext,
+                            "`*` in a context is the scale module, not a wildcard",
+                        )
+                        .primary(m.span, "matches only a `*` module")
+                        .note("in ABOP and cpfg `*` in a context matches any module; lsyc has no wildcard")
+                        .help("leave that side of the context out: a rule without context matches whatever surrounds the module"),
+                    );
+                }
+            }
+        }
+    }
+
+    /// A letter written with parameters that no rule of any kind rewrites, no
+    /// context reads and the turtle does not draw: a silent no-op, often a
+    /// command of another tool (cpfg's `T(…)` tropism).
+    fn does_nothing(&mut self, ls: &Lsystem, rules: &[&Rule], local: &Local) {
+        // A name with rules of another arity is E0402's business.
+        let mut handled: HashSet<&ModName> = HashSet::new();
+        let mut read: HashSet<&ModName> = HashSet::new();
+        for r in rules {
+            handled.insert(&r.pred.name);
+            for m in [&r.left, &r.right].into_iter().flatten().flatten() {
+                read.insert(&m.name);
+            }
+        }
+        let mut warned: HashSet<(&ModName, usize)> = HashSet::new();
+        let strings = ls.body.stmts.iter().flat_map(|s| {
+            let ms = match &s.node {
+                Stmt::Axiom(ms) => ms.as_slice(),
+                Stmt::Rule(r) => r.succ.as_slice(),
+                _ => &[],
+            };
+            // With the module before each: a letter glued to a letter before it
+            // comes from a split word, which W0301 reports.
+            ms.iter()
+                .enumerate()
+                .map(move |(k, m)| (k.checked_sub(1).map(|j| &ms[j]), m))
+        });
+        for (prev, m) in strings {
+            let arity = m.arity();
+            let glued = prev.is_some_and(|p| {
+                p.args.is_none()
+                    && matches!(&p.name, ModName::Name(n) if is_letter(n))
+                    && p.span.end == m.span.start
+            });
+            if arity == 0
+                || arity > 255
+                || glued
+                || !matches!(self.kind(m, local), Kind::Letter)
+                || handled.contains(&m.name)
+                || read.contains(&m.name)
+                || !warned.insert((&m.name, arity))
+            {
+                continue;
+            }
+            let name = m.name.text();
+            let mut d = Diagnostic::warning(
+                Code::DoesNothing,
+                format!(
+                    "`{name}` with {arity} parameter{} is never rewritten and draws nothing",
+                    plural(arity)
+                ),
+            )
+            .primary(m.span, "this module has no effect")
+            .note("only `F` and `f`, turtle symbols, elements and modules with `interpret` rules draw");
+            d = if name == "T" && (arity == 4 || arity == 1) {
+                d.help("for tropism write the statement `tropism (x, y, z) e;` in the lsystem (and `tropism(e)` in a string to change e)")
+            } else {
+                d.help(format!(
+                    "add a rule for `{name}` with {arity} parameter{}, an `interpret` rule to draw it, or remove it",
+                    plural(arity)
+                ))
+            };
+            self.diags.push(d);
+        }
+    }
+
+    /// Interpretation rules that always apply and produce, directly or through
+    /// each other, the module they rewrite: interpretation would never end (the
+    /// run fails with E0905); reported here, at the rule.
+    fn interpret_cycles(&mut self, rules: &[&Rule]) {
+        // For each (name, arity): its first interpret rule, when it always applies.
+        let mut first: HashMap<(&ModName, usize), Option<&Rule>> = HashMap::new();
+        for r in rules.iter().filter(|r| r.interpret) {
+            first
+                .entry((&r.pred.name, r.pred.arity()))
+                .or_insert((r.cond.is_none() && r.weight.is_none()).then_some(*r));
+        }
+        let mut reported: HashSet<(&ModName, usize)> = HashSet::new();
+        for r in rules.iter().filter(|r| r.interpret) {
+            let start = (&r.pred.name, r.pred.arity());
+            let Some(Some(rule)) = first.get(&start).copied() else {
+                continue;
+            };
+            // Walk the modules reachable through always-applying rules.
+            let mut seen: HashSet<(&ModName, usize)> = HashSet::new();
+            let mut todo: Vec<(&ModName, usize)> =
+                rule.succ.iter().map(|m| (&m.name, m.arity())).collect();
+            let mut cycle = false;
+            while let Some(k) = todo.pop() {
+                if k == start {
+                    cycle = true;
+                    break;
+                }
+                if !seen.insert(k) {
+                    continue;
+                }
+                if let Some(Some(r)) = first.get(&k) {
+                    todo.extend(r.succ.iter().map(|m| (&m.name, m.arity())));
+                }
+            }
+            if !cycle || !reported.insert(start) {
+                continue;
+            }
+            let name = start.0.text();
+            let span = rule
+                .pred
+                .span
+                .to(rule.succ.last().map_or(rule.pred.span, |m| m.span));
+            let mut d = Diagnostic::error(
+                Code::InterpretTooDeep,
+                format!("`interpret {name}` produces `{name}` again, so drawing would never end"),
+            )
+            .primary(
+                span,
+                "this rule always applies and its successor leads back to it",
+            )
+            .note("interpretation rules apply again to the modules they produce");
+            d = if rule.succ.iter().any(|m| (&m.name, m.arity()) == start) {
+                d.help(format!(
+                    "derive another letter and interpret that one, e.g. `I` in the rules and `interpret I -> {name} …;`; or give the rule a condition that ends the recursion"
+                ))
+            } else {
+                d.help("give one of these rules a condition that ends the recursion")
+            };
+            self.diags.push(d);
+        }
     }
 
     /// Labels name rules, so two rules of one lsystem may not share one.
@@ -120,6 +275,32 @@ impl<'a> Checker<'a> {
         let mut seen: HashMap<&str, Span> = HashMap::new();
         for s in &ls.body.stmts {
             if let Stmt::Rule(Rule { label: Some(l), .. }) = &s.node {
+                let help = match l.name.as_str() {
+                    "decomposition" | "decompositions" => {
+                        Some("lsyc marks each rule instead of a section: `decompose A -> B C;`")
+                    }
+                    "homomorphism" | "homomorphisms" | "interpretation" => {
+                        Some("lsyc marks each rule instead of a section: `interpret A -> F;`")
+                    }
+                    "production" | "productions" | "derivation" | "endgroup" | "group" => {
+                        Some("lsyc rules need no section: remove the label")
+                    }
+                    _ => None,
+                };
+                if let Some(help) = help {
+                    self.diags.push(
+                        Diagnostic::warning(
+                            Code::SectionLabel,
+                            format!(
+                                "`{}:` is read as the label of one rule, not as a section",
+                                l.name
+                            ),
+                        )
+                        .primary(l.span, "a rule label (a name for this rule only)")
+                        .note("cpfg and L-Py divide an L-system into sections; lsyc has none")
+                        .help(help),
+                    );
+                }
                 if let Some(first) = seen.get(l.name.as_str()) {
                     self.diags
                         .push(duplicate("rule label", &l.name, l.span, *first));
@@ -139,7 +320,7 @@ impl<'a> Checker<'a> {
                 match self.modules.get(n.as_str()) {
                     Some(info) if info.element => Kind::Element,
                     Some(info) => Kind::Declared(info.arity.unwrap_or(0)),
-                    None if n == "F" || n == "f" => Kind::Turtle,
+                    None if n == "F" || n == "f" || n == "tropism" => Kind::Turtle,
                     None if is_letter(n) => Kind::Letter,
                     None => Kind::Undeclared,
                 }
@@ -158,6 +339,8 @@ impl<'a> Checker<'a> {
                 Stmt::Derive(_) => "derive",
                 Stmt::Step(_) => "step",
                 Stmt::Axiom(_) => "axiom",
+                Stmt::Tropism(_) => "tropism",
+                Stmt::Ignore(_) | Stmt::Consider(_) => "ignore",
                 Stmt::Module(m) => {
                     if let Some((_, first)) = local.decls.get(&m.name.name) {
                         self.diags
@@ -175,7 +358,31 @@ impl<'a> Checker<'a> {
                 }
                 _ => continue,
             };
-            let span = Span::new(s.span.start as usize, s.span.start as usize + key.len());
+            let word = match &s.node {
+                Stmt::Consider(_) => "consider",
+                _ => key,
+            };
+            let span = Span::new(s.span.start as usize, s.span.start as usize + word.len());
+            if key == "ignore" {
+                // Several `ignore` lists add up; `consider` is the complement and
+                // cannot be mixed with them.
+                if let Some(first) = seen.get(key)
+                    && (matches!(s.node, Stmt::Consider(_)) || local.considers)
+                {
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::IgnoreAndConsider,
+                            "`ignore` and `consider` cannot both be given in one lsystem",
+                        )
+                        .primary(span, "given here")
+                        .secondary(*first, "the other list")
+                        .help("keep one: `consider` lists the modules context sees, `ignore` the modules it skips"),
+                    );
+                }
+                local.considers |= matches!(s.node, Stmt::Consider(_));
+                seen.entry(key).or_insert(span);
+                continue;
+            }
             if let Some(first) = seen.get(key) {
                 self.diags.push(
                     Diagnostic::error(Code::DuplicateSetting, format!("`{key}` is given twice"))
@@ -196,6 +403,16 @@ impl<'a> Checker<'a> {
                 Stmt::Derive(e) => {
                     self.const_int(e, "the number of derivation steps", 0.0, 1_000_000.0);
                 }
+                Stmt::Tropism(t) => {
+                    for (e, what) in t.dir.iter().zip([
+                        "the tropism vector's x",
+                        "the tropism vector's y",
+                        "the tropism vector's z",
+                    ]) {
+                        self.const_num(e, what);
+                    }
+                    self.const_num(&t.elasticity, "the elasticity");
+                }
                 _ => {}
             }
         }
@@ -214,6 +431,29 @@ impl<'a> Checker<'a> {
     /// Checks a rule's predecessor and context patterns and records arities.
     fn predecessor(&mut self, r: &Rule, local: &mut Local) {
         let m = &r.pred;
+        if r.interpret || r.decompose {
+            let (kw, a) = if r.interpret {
+                ("interpret", "an")
+            } else {
+                ("decompose", "a")
+            };
+            for ctx in [&r.left, &r.right].into_iter().flatten() {
+                let span = match (ctx.first(), ctx.last()) {
+                    (Some(a), Some(b)) => a.span.to(b.span),
+                    _ => m.span,
+                };
+                self.diags.push(
+                    Diagnostic::error(
+                        Code::ContextNotAllowed,
+                        format!("{a} `{kw}` rule cannot have context"),
+                    )
+                    .primary(span, "context here")
+                    .help(format!(
+                        "`{kw}` rules rewrite one module by itself (conditions and weights are allowed); match the context in a derivation rule"
+                    )),
+                );
+            }
+        }
         let arity = m.arity();
         match self.kind(m, local) {
             Kind::Structure => self.diags.push(
@@ -408,7 +648,7 @@ impl<'a> Checker<'a> {
                     self.diags.push(
                         Diagnostic::error(
                             Code::ArgsNotAllowed,
-                            "an ignore list names modules without parameters",
+                            "an `ignore` or `consider` list names modules without parameters",
                         )
                         .primary(m.span, "parameters here")
                         .help(format!("write just `{}`", m.name.text())),
@@ -626,11 +866,12 @@ impl<'a> Checker<'a> {
             match &s.node {
                 Stmt::Axiom(ms) => produced.extend(ms.iter().map(|m| &m.name)),
                 Stmt::Rule(r) if !r.interpret => produced.extend(r.succ.iter().map(|m| &m.name)),
+                Stmt::Tropism(_) => {}
                 _ => {}
             }
         }
         let mut reported: HashSet<&ModName> = HashSet::new();
-        let mut always: HashMap<(bool, &ModName, usize), Span> = HashMap::new();
+        let mut always: HashMap<(u8, &ModName, usize), Span> = HashMap::new();
         let mut prev: Option<&Rule> = None;
         for r in rules {
             let name = &r.pred.name;
@@ -672,10 +913,10 @@ impl<'a> Checker<'a> {
                 }
                 self.diags.push(d);
             }
-            let key = (r.interpret, name, r.pred.arity());
+            let key = (rule_kind(r), name, r.pred.arity());
             let same_group = r.weight.is_some()
                 && prev.is_some_and(|p| {
-                    p.weight.is_some() && p.pred.name == *name && p.interpret == r.interpret
+                    p.weight.is_some() && p.pred.name == *name && rule_kind(p) == rule_kind(r)
                 });
             if let Some(&earlier) = always.get(&key) {
                 if !same_group {
@@ -697,5 +938,16 @@ impl<'a> Checker<'a> {
             }
             prev = Some(r);
         }
+    }
+}
+
+/// 0 for a derivation rule, 1 for `interpret`, 2 for `decompose`.
+fn rule_kind(r: &Rule) -> u8 {
+    if r.interpret {
+        1
+    } else if r.decompose {
+        2
+    } else {
+        0
     }
 }

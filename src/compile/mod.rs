@@ -44,6 +44,8 @@ pub enum Action {
     Element(u16),
     /// A query module (index into `query::QUERIES`), answered by the environment.
     Query(u8),
+    /// `tropism(e)`: sets the elasticity of tropism for the rest of the branch.
+    Elasticity,
 }
 
 #[derive(Clone, Debug)]
@@ -134,6 +136,10 @@ pub struct Program {
     pub rules: Vec<Vec<CompiledRule>>,
     /// Interpretation (homomorphism) rules per symbol.
     pub interpret: Vec<Vec<CompiledRule>>,
+    /// Decomposition rules per symbol, applied after each derivation step.
+    pub decompose: Vec<Vec<CompiledRule>>,
+    /// `tropism (x, y, z) e;`: the vector T and the starting elasticity.
+    pub tropism: Option<([f64; 3], f64)>,
     /// For D0L programs: the fixed successor of every symbol.
     pub d0l: Option<Vec<Vec<Sym>>>,
     /// Symbols skipped when matching context.
@@ -249,6 +255,7 @@ fn action_of(name: &ModName, element: Option<u16>) -> Action {
     match name {
         ModName::Name(n) if n == "F" => Action::Draw,
         ModName::Name(n) if n == "f" => Action::Move,
+        ModName::Name(n) if n == "tropism" => Action::Elasticity,
         ModName::Name(_) => element.map_or(Action::None, Action::Element),
         ModName::Symbol(c) => match c {
             '+' => Action::TurnLeft,
@@ -461,6 +468,8 @@ impl<'a> Compiler<'a> {
         let mut derive = 1u32;
         let mut axiom_mods: &[Module] = &[];
         let mut ignore_mods: Vec<&Module> = Vec::new();
+        let mut consider_mods: Option<Vec<&Module>> = None;
+        let mut tropism = None;
         for s in &ls.body.stmts {
             match &s.node {
                 Stmt::Angle(e) => angle = self.checked.value_of(e).unwrap_or(angle),
@@ -468,6 +477,11 @@ impl<'a> Compiler<'a> {
                 Stmt::Derive(e) => derive = self.checked.value_of(e).map_or(derive, |v| v as u32),
                 Stmt::Axiom(ms) => axiom_mods = ms,
                 Stmt::Ignore(ms) => ignore_mods.extend(ms.iter()),
+                Stmt::Consider(ms) => consider_mods.get_or_insert_default().extend(ms.iter()),
+                Stmt::Tropism(t) => {
+                    let v = |e| self.checked.value_of(e).unwrap_or(0.0);
+                    tropism = Some(([v(&t.dir[0]), v(&t.dir[1]), v(&t.dir[2])], v(&t.elasticity)));
+                }
                 _ => {}
             }
         }
@@ -478,34 +492,54 @@ impl<'a> Compiler<'a> {
             .map(|(i, p)| (p.name.clone(), i as u16))
             .collect();
         let axiom = self.emit_list(axiom_mods, &axiom_env)?;
-        let mut rules: Vec<(Sym, CompiledRule, bool)> = Vec::new();
-        let mut prev: Option<(Sym, bool, bool)> = None;
+        let mut rules: Vec<(Sym, CompiledRule, u8)> = Vec::new();
+        let mut prev: Option<(Sym, u8, bool)> = None;
         for s in &ls.body.stmts {
             let Stmt::Rule(r) = &s.node else { continue };
             let (sym, mut cr) = self.rule(r)?;
             // Consecutive weighted rules for one symbol form one stochastic group.
             let weighted = cr.weight.is_some();
-            let continues = weighted && prev == Some((sym, r.interpret, true));
+            let kind = if r.interpret {
+                1
+            } else if r.decompose {
+                2
+            } else {
+                0
+            };
+            let continues = weighted && prev == Some((sym, kind, true));
             if !continues {
                 self.group += 1;
             }
             cr.group = self.group;
-            prev = Some((sym, r.interpret, weighted));
-            rules.push((sym, cr, r.interpret));
+            prev = Some((sym, kind, weighted));
+            rules.push((sym, cr, kind));
         }
         let n = self.symbols.len();
         let mut by_sym: Vec<Vec<CompiledRule>> = vec![Vec::new(); n];
         let mut interp: Vec<Vec<CompiledRule>> = vec![Vec::new(); n];
+        let mut decomp: Vec<Vec<CompiledRule>> = vec![Vec::new(); n];
         let mut has_context = false;
-        for (sym, cr, is_interp) in rules {
-            has_context |= !cr.left.is_empty() || !cr.right.is_empty();
-            if is_interp {
-                interp[sym as usize].push(cr);
-            } else {
-                by_sym[sym as usize].push(cr);
+        for (sym, cr, kind) in rules {
+            match kind {
+                1 => interp[sym as usize].push(cr),
+                2 => decomp[sym as usize].push(cr),
+                _ => {
+                    has_context |= !cr.left.is_empty() || !cr.right.is_empty();
+                    by_sym[sym as usize].push(cr);
+                }
             }
         }
         let mut ignore = vec![false; n];
+        if let Some(consider) = &consider_mods {
+            // `consider` is the complement of `ignore`: context sees only these.
+            for (i, info) in self.symbols.info.iter().enumerate() {
+                let named = consider.iter().any(|m| {
+                    m.name == info.name
+                        || (m.name == ModName::Cut && info.name == ModName::Symbol('%'))
+                });
+                ignore[i] = !named && !matches!(info.action, Action::Push | Action::Pop);
+            }
+        }
         for m in ignore_mods {
             for (i, info) in self.symbols.info.iter().enumerate() {
                 if info.name == m.name
@@ -526,7 +560,7 @@ impl<'a> Compiler<'a> {
                     | Action::TurnAround
                     | Action::RollHorizontal
             )
-        });
+        }) || tropism.is_some_and(|(t, _)| t[2] != 0.0);
         let d0l = d0l_table(&self.symbols, &by_sym, &self.chunk);
         Ok(Program {
             name: ls.name.name.clone(),
@@ -536,6 +570,8 @@ impl<'a> Compiler<'a> {
             axiom,
             rules: by_sym,
             interpret: interp,
+            decompose: decomp,
+            tropism,
             d0l,
             ignore,
             has_context,
@@ -606,7 +642,11 @@ impl Program {
                 self.chunk.disassemble(*code, &mut out);
             }
         }
-        for (kind, table) in [("rule", &self.rules), ("interpret", &self.interpret)] {
+        for (kind, table) in [
+            ("rule", &self.rules),
+            ("interpret", &self.interpret),
+            ("decompose", &self.decompose),
+        ] {
             for (s, rules) in table.iter().enumerate() {
                 for (k, r) in rules.iter().enumerate() {
                     let _ = writeln!(

@@ -8,6 +8,7 @@
 //! (seed, step, position). Must not draw.
 
 mod context;
+pub mod decompose;
 
 use crate::compile::{Action, CompiledRule, Program, Sym};
 use crate::diagnostic::{Code, Diagnostic};
@@ -96,9 +97,40 @@ pub enum DeriveError {
         limit: usize,
         module: Option<String>,
     },
+    /// Decomposition rules expanded into each other `depth` times; `chain` holds
+    /// the modules decomposed, outermost first, and `span` the last rule.
+    #[error("decomposition rules expand {} more than {depth} levels deep", chain_text(.chain))]
+    DecomposeTooDeep {
+        chain: Vec<String>,
+        depth: usize,
+        span: crate::span::Span,
+    },
     /// More steps were asked for than `MAX_STEPS`.
     #[error("{steps} derivation steps were asked for; the most is {limit}")]
     TooManySteps { steps: u64, limit: u32 },
+}
+
+/// The first interpretation rule of the module named `module`.
+fn interpret_rule_span(prog: &Program, module: &str) -> Option<crate::span::Span> {
+    prog.symbols
+        .info
+        .iter()
+        .enumerate()
+        .filter(|(_, i)| i.name.text() == module)
+        .find_map(|(s, _)| prog.interpret[s].first().map(|r| r.span))
+}
+
+/// `A → B → A → …`: the first modules of a decomposition chain and its end.
+fn chain_text(chain: &[String]) -> String {
+    let shown: Vec<String> = if chain.len() > 8 {
+        let mut v: Vec<String> = chain[..6].iter().map(|m| format!("`{m}`")).collect();
+        v.push("…".to_string());
+        v.extend(chain[chain.len() - 2..].iter().map(|m| format!("`{m}`")));
+        v
+    } else {
+        chain.iter().map(|m| format!("`{m}`")).collect()
+    };
+    shown.join(" → ")
 }
 
 fn when(step: u32) -> String {
@@ -172,8 +204,11 @@ impl DeriveError {
             DeriveError::TooMuchMemory { .. } => Diagnostic::error(Code::TooMuchMemory, msg)
                 .primary(prog.name_span, "this lsystem grows too fast")
                 .help("derive fewer steps with -n, or raise the limit with --max-memory"),
-            DeriveError::InterpretTooDeep { .. } => Diagnostic::error(Code::InterpretTooDeep, msg)
-                .primary(prog.name_span, "an `interpret` rule produces a module that is interpreted again, endlessly")
+            DeriveError::InterpretTooDeep { module, .. } => Diagnostic::error(Code::InterpretTooDeep, msg)
+                .primary(
+                    interpret_rule_span(prog, module).unwrap_or(prog.name_span),
+                    "an `interpret` rule produces a module that is interpreted again, endlessly",
+                )
                 .help("interpretation rules must end in modules that draw; a rule like `interpret A -> B; interpret B -> A;` never does"),
             DeriveError::TooMuchDrawing { module, .. } => Diagnostic::error(Code::TooMuchDrawing, msg)
                 .primary(prog.name_span, "its `interpret` rules expand modules into more and more modules")
@@ -182,6 +217,11 @@ impl DeriveError {
                 } else {
                     "derive fewer steps, or raise the limit with --max-modules"
                 }),
+            DeriveError::DecomposeTooDeep { span, .. } => {
+                Diagnostic::error(Code::DecomposeTooDeep, msg)
+                    .primary(*span, "this `decompose` rule keeps producing modules that decompose again")
+                    .help("decomposition must end in modules that no `decompose` rule matches; end the recursion with a condition on a parameter that decreases")
+            }
             DeriveError::TooManySteps { limit, .. } => Diagnostic::error(Code::TooManySteps, msg)
                 .primary(prog.name_span, "this lsystem would be derived that often")
                 .help(format!("ask for at most {limit} steps with -n")),
@@ -239,6 +279,22 @@ pub fn derive(
     limits: Limits,
     progress: &(dyn Fn(u32, usize) + Sync),
 ) -> Result<ModString, DeriveError> {
+    derive_with(prog, start, steps, seed, limits, progress, &mut |_, _| {
+        Ok(())
+    })
+}
+
+/// Like `derive`, with `after(string, step)` called on the start string (step 0)
+/// and after each step, before the next: the turtle answers query modules there.
+pub fn derive_with(
+    prog: &Program,
+    start: ModString,
+    steps: u32,
+    seed: u64,
+    limits: Limits,
+    progress: &(dyn Fn(u32, usize) + Sync),
+    after: &mut dyn FnMut(&mut ModString, u32) -> Result<(), DeriveError>,
+) -> Result<ModString, DeriveError> {
     if steps > MAX_STEPS {
         return Err(DeriveError::TooManySteps {
             steps: u64::from(steps),
@@ -247,13 +303,16 @@ pub fn derive(
     }
     if let Some(table) = &prog.d0l
         && !prog.has_cut
+        && !decompose::has_rules(prog)
     {
         d0l_forecast(table, &start, steps, limits)?;
     }
     let settles = !prog.draws_random();
     let mut s = start;
+    after(&mut s, 0)?;
     for k in 1..=steps {
-        let next = step(prog, &s, k, seed, limits)?;
+        let mut next = step(prog, &s, k, seed, limits)?;
+        after(&mut next, k)?;
         // A program without random draws that rewrites a string into itself
         // does so at every later step: stop deriving, the string is final.
         let fixed = settles && next == s;
@@ -316,11 +375,16 @@ pub fn step(
         Some(table) => d0l_step(table, s, step, limits)?,
         None => parametric_step(prog, s, step, seed, limits)?,
     };
-    Ok(if prog.has_cut {
+    let out = if prog.has_cut {
         apply_cut(prog, out)
     } else {
         out
-    })
+    };
+    if decompose::has_rules(prog) {
+        decompose::decompose(prog, out, step, seed, limits)
+    } else {
+        Ok(out)
+    }
 }
 
 /// Checks a step's size against the limits. `exact`: the counts are the

@@ -141,6 +141,8 @@ pub(crate) fn query(
     match kind {
         QueryKind::Position => Answer::new(&[st.pos.x, st.pos.y, st.pos.z]),
         QueryKind::Heading => Answer::new(&[st.h.x, st.h.y, st.h.z]),
+        QueryKind::Up => Answer::new(&[st.u.x, st.u.y, st.u.z]),
+        QueryKind::Left => Answer::new(&[st.l.x, st.l.y, st.l.z]),
         QueryKind::DistanceLink => nearest(&link_edges(true)),
         QueryKind::DistanceGuide => nearest(&guide_edges()),
         // Drawn segments have ids after the guide's edges, as for ?N_A and ?X.

@@ -416,6 +416,7 @@ fn rule(
     let mut rule = node(Stmt::Rule(Rule {
         label: None,
         interpret: false,
+        decompose: false,
         left: None,
         pred: Module::new(ModName::Name(m.to_string()), Some(vec![var("l"), var("w")])),
         right: None,

@@ -92,9 +92,10 @@ impl PngWriter {
         let elements = elements
             .iter()
             .map(|e| {
+                // The SVG writer's defaults: fill #3f7f3a, no stroke, width 1.
                 let fill = match e.fill.as_deref() {
-                    Some("none") => None,
-                    f => Some(f.and_then(parse_color).unwrap_or([63, 127, 58])),
+                    None => Some([63, 127, 58]),
+                    Some(f) => parse_color(f),
                 };
                 let width = e.width.unwrap_or(1.0) as f32;
                 let stroke = e

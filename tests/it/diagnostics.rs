@@ -23,6 +23,8 @@ const CLI_ONLY: &[Code] = &[
     Code::TooManySteps,
     Code::TooMuchDrawing,
     Code::DrawingTooLarge,
+    // Runaway decomposition: tests/it/plants.rs.
+    Code::DecomposeTooDeep,
     // Only `lsyc run` needs an lsystem: tests/it/hostile.rs.
     Code::NoLsystem,
     // Warnings of a scene's run: tests/it/guided.rs.

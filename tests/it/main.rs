@@ -16,6 +16,7 @@ mod infer;
 mod layers;
 mod lines;
 mod outputs;
+mod plants;
 mod roundtrip;
 mod run;
 mod scene;

@@ -359,7 +359,13 @@ fn steps_beyond_the_limit_are_an_error() {
 
 #[test]
 fn endless_interpretation_is_an_error() {
+    // A cycle of rules that always apply is caught by the checker, at the rule.
     let src = "lsystem I { axiom A; interpret A -> B; interpret B -> A F; }";
+    let err = derive_text(src, Some(0)).err().unwrap_or_default();
+    assert!(err.contains("error[E0905]"), "{err}");
+    // One behind a condition that always holds is caught while drawing.
+    let src =
+        "lsystem I { axiom A(0); interpret A(n) : n >= 0 -> B(n); interpret B(n) -> A(n + 1) F; }";
     let d = derive_text(src, Some(0)).expect("derives");
     let err = run::measure(&d, 0).expect_err("fails");
     assert_eq!(err.code, lsyc::diagnostic::Code::InterpretTooDeep);

@@ -737,6 +737,7 @@ impl RuleWriter<'_> {
         let mut n = node(Stmt::Rule(Rule {
             label: None,
             interpret: false,
+            decompose: false,
             left: None,
             pred: self.pred.clone(),
             right: None,

@@ -46,6 +46,7 @@ fn rule(pred: Module, succ: Vec<Module>, interpret: bool) -> Node<Stmt> {
     node(Stmt::Rule(Rule {
         label: None,
         interpret,
+        decompose: false,
         left: None,
         pred,
         right: None,
