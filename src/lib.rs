@@ -17,6 +17,7 @@ pub mod fmt;
 pub mod frontend;
 pub mod geometry;
 pub mod infer;
+pub mod lsp;
 pub mod lexer;
 pub mod number;
 pub mod parser;

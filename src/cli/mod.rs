@@ -7,6 +7,7 @@ mod check;
 mod edit;
 mod fmt;
 mod infer;
+mod lsp;
 mod run;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -84,6 +85,8 @@ pub enum Command {
         after_help = "Examples:\n  lsyc edit palm.lsy --move frond4.v4=100,480 --pin trunk1\n  lsyc edit palm.lsy --by trunk3.v2=30,-5 --pin trunk2\n  lsyc edit palm.lsy --pin trunk1 --translate frond1=10,0 --rotate frond1=15 --write"
     )]
     Edit(edit::Args),
+    /// A Language Server on stdin and stdout, for editors (docs/lsp.md).
+    Lsp(lsp::Args),
 }
 
 /// Where diagnostics go and how they look.
@@ -221,6 +224,7 @@ pub fn main() -> ExitCode {
         Command::Run(args) => run::run(args, &reporter),
         Command::Infer(args) => infer::run(args, &reporter),
         Command::Edit(args) => edit::run(args, &reporter),
+        Command::Lsp(args) => lsp::run(args),
     };
     ExitCode::from(status)
 }
