@@ -14,6 +14,7 @@ mod hostile_svg;
 mod infer;
 mod layers;
 mod lines;
+mod lsp;
 mod roundtrip;
 mod run;
 mod scene;
