@@ -555,3 +555,42 @@ fn scene_hover_definition_and_query_modules() {
     let symbols = c.request("textDocument/documentSymbol", json!({"textDocument": {"uri": uri}}));
     insta::assert_snapshot!("lsp_symbols_palm", show_symbols(&symbols, 0));
 }
+
+/// The VS Code extension's files are valid JSON, claim `.lsy`, start `lsyc
+/// lsp`, and the TextMate grammar knows every keyword and built-in function.
+#[test]
+fn editor_support_files_fit_the_language() {
+    let dir = root().join("editors/vscode");
+    let json = |name: &str| -> Value {
+        let text = std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        serde_json::from_str(&text).unwrap_or_else(|e| panic!("{name}: {e}"))
+    };
+    let pkg = json("package.json");
+    assert_eq!(pkg["contributes"]["languages"][0]["extensions"], json!([".lsy"]));
+    let grammar_path = pkg["contributes"]["grammars"][0]["path"].as_str().expect("grammar path");
+    let grammar = json(grammar_path.trim_start_matches("./"));
+    json("language-configuration.json");
+    let lock = json("package-lock.json");
+    assert_eq!(
+        lock["packages"][""]["dependencies"], pkg["dependencies"],
+        "package-lock.json is out of date: run `npm install --package-lock-only` in editors/vscode"
+    );
+    let client = std::fs::read_to_string(dir.join(pkg["main"].as_str().expect("main"))).expect("client");
+    assert!(client.contains("args: [\"lsp\"]"), "the client does not start `lsyc lsp`");
+    let text = grammar.to_string();
+    let lexer_keywords: Vec<&str> = lsyc::lsp::words::KEYWORDS
+        .iter()
+        .map(|k| k.word)
+        .filter(|w| {
+            let lexed = lsyc::lexer::lex(w);
+            matches!(&lexed.tokens[..], [(_, t, _)] if t.is_keyword())
+        })
+        .collect();
+    assert!(lexer_keywords.len() > 20, "{lexer_keywords:?}");
+    for w in lexer_keywords {
+        assert!(text.contains(w), "the grammar does not highlight the keyword `{w}`");
+    }
+    for b in lsyc::builtins::BUILTINS {
+        assert!(text.contains(&format!("|{}|", b.name)) || text.contains(&format!("({}|", b.name)) || text.contains(&format!("|{})", b.name)), "the grammar does not know `{}`", b.name);
+    }
+}
