@@ -36,8 +36,14 @@ fn frame(out: &mut Vec<u8>, v: serde_json::Value) {
 fn session(text: &str, n: u64) -> Vec<u8> {
     let uri = "file:///bench/doc.lsy";
     let mut out = Vec::new();
-    frame(&mut out, json!({"jsonrpc": "2.0", "id": 1, "method": "initialize", "params": {"capabilities": {}}}));
-    frame(&mut out, json!({"jsonrpc": "2.0", "method": "initialized", "params": {}}));
+    frame(
+        &mut out,
+        json!({"jsonrpc": "2.0", "id": 1, "method": "initialize", "params": {"capabilities": {}}}),
+    );
+    frame(
+        &mut out,
+        json!({"jsonrpc": "2.0", "method": "initialized", "params": {}}),
+    );
     frame(
         &mut out,
         json!({"jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {"textDocument": {"uri": uri, "languageId": "lsy", "version": 1, "text": text}}}),
@@ -45,7 +51,11 @@ fn session(text: &str, n: u64) -> Vec<u8> {
     let line = text.trim_end().lines().count().saturating_sub(1);
     for i in 0..n {
         let start = json!({"line": line, "character": 0});
-        let end = if i % 2 == 0 { start.clone() } else { json!({"line": line, "character": 1}) };
+        let end = if i % 2 == 0 {
+            start.clone()
+        } else {
+            json!({"line": line, "character": 1})
+        };
         let typed = if i % 2 == 0 { " " } else { "" };
         frame(
             &mut out,
@@ -55,7 +65,10 @@ fn session(text: &str, n: u64) -> Vec<u8> {
             }}),
         );
     }
-    frame(&mut out, json!({"jsonrpc": "2.0", "id": 2, "method": "shutdown"}));
+    frame(
+        &mut out,
+        json!({"jsonrpc": "2.0", "id": 2, "method": "shutdown"}),
+    );
     frame(&mut out, json!({"jsonrpc": "2.0", "method": "exit"}));
     out
 }

@@ -80,7 +80,10 @@ impl Analysis {
 
     /// The diagnostics as the protocol has them.
     pub fn lsp_diagnostics(&self, uri: &lsp::Uri) -> Vec<lsp::Diagnostic> {
-        self.diagnostics.iter().map(|d| self.convert(d, uri)).collect()
+        self.diagnostics
+            .iter()
+            .map(|d| self.convert(d, uri))
+            .collect()
     }
 
     fn convert(&self, d: &Diagnostic, uri: &lsp::Uri) -> lsp::Diagnostic {

@@ -77,7 +77,9 @@ fn typed_params(text: &str, offset: usize, item_start: usize) -> (Vec<String>, b
             match t {
                 Token::LParen => depth += 1,
                 Token::RParen => depth -= 1,
-                Token::Ident(n) if depth > 0 && n != "_" && !names.contains(n) => names.push(n.clone()),
+                Token::Ident(n) if depth > 0 && n != "_" && !names.contains(n) => {
+                    names.push(n.clone())
+                }
                 _ => {}
             }
         }
@@ -98,8 +100,19 @@ struct Out {
 }
 
 impl Out {
-    fn push(&mut self, label: &str, kind: CompletionItemKind, detail: Option<String>, doc: Option<String>, rank: u8) {
-        if self.items.iter().any(|i| i.label == label && i.kind == Some(kind)) {
+    fn push(
+        &mut self,
+        label: &str,
+        kind: CompletionItemKind,
+        detail: Option<String>,
+        doc: Option<String>,
+        rank: u8,
+    ) {
+        if self
+            .items
+            .iter()
+            .any(|i| i.label == label && i.kind == Some(kind))
+        {
             return;
         }
         self.items.push(CompletionItem {
@@ -129,7 +142,11 @@ fn symbol_item(out: &mut Out, a: &Analysis, s: &Symbol) {
     };
     let detail = match (&s.origin, s.kind) {
         (Origin::Item(i), Kind::Const) => match a.file.items.stmts.get(*i).map(|n| &n.node) {
-            Some(Item::Const(c)) => Some(format!("const {} = {}", c.name.name, crate::fmt::format_expr(&c.value))),
+            Some(Item::Const(c)) => Some(format!(
+                "const {} = {}",
+                c.name.name,
+                crate::fmt::format_expr(&c.value)
+            )),
             _ => None,
         },
         _ => Some(s.kind.noun().to_string()),
@@ -148,22 +165,44 @@ pub fn complete(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
     let typing_query = a.text[start..offset].starts_with('?');
     let queries = |out: &mut Out| {
         for q in query::QUERIES {
-            out.push(q.name, CompletionItemKind::FUNCTION, Some(q.signature()), Some(query_text(q.name)), 4);
+            out.push(
+                q.name,
+                CompletionItemKind::FUNCTION,
+                Some(q.signature()),
+                Some(query_text(q.name)),
+                4,
+            );
         }
     };
     if typing_query {
         queries(&mut out);
         return out.items;
     }
-    let consts: Vec<&Symbol> = a.index.visible(None).filter(|s| s.kind == Kind::Const).collect();
+    let consts: Vec<&Symbol> = a
+        .index
+        .visible(None)
+        .filter(|s| s.kind == Kind::Const)
+        .collect();
     let keywords = |out: &mut Out, ctx: &[Context]| {
         for k in words::KEYWORDS.iter().filter(|k| ctx.contains(&k.context)) {
-            out.push(k.word, CompletionItemKind::KEYWORD, None, Some(k.doc.to_string()), 5);
+            out.push(
+                k.word,
+                CompletionItemKind::KEYWORD,
+                None,
+                Some(k.doc.to_string()),
+                5,
+            );
         }
     };
     let functions = |out: &mut Out| {
         for b in builtins::BUILTINS {
-            out.push(b.name, CompletionItemKind::FUNCTION, Some(format!("{}/{}", b.name, b.arity)), Some(b.doc.to_string()), 6);
+            out.push(
+                b.name,
+                CompletionItemKind::FUNCTION,
+                Some(format!("{}/{}", b.name, b.arity)),
+                Some(b.doc.to_string()),
+                6,
+            );
         }
     };
     match place {
@@ -188,7 +227,13 @@ pub fn complete(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
             let item_start = a.file.items.stmts[i].span.start as usize;
             let (params, is_axiom) = typed_params(&a.text, offset, item_start);
             for p in &params {
-                out.push(p, CompletionItemKind::VARIABLE, Some("rule parameter".to_string()), None, 1);
+                out.push(
+                    p,
+                    CompletionItemKind::VARIABLE,
+                    Some("rule parameter".to_string()),
+                    None,
+                    1,
+                );
             }
             if is_axiom {
                 for s in a.index.visible(Some(i)) {
@@ -198,14 +243,23 @@ pub fn complete(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
                 }
             }
             for s in a.index.visible(Some(i)) {
-                if matches!(s.kind, Kind::Const | Kind::Module | Kind::Element | Kind::Letter) {
+                if matches!(
+                    s.kind,
+                    Kind::Const | Kind::Module | Kind::Element | Kind::Letter
+                ) {
                     symbol_item(&mut out, a, s);
                 }
             }
             queries(&mut out);
             keywords(&mut out, &[Context::Lsystem, Context::Anywhere]);
             for w in words::TURTLE {
-                out.push(&w.symbol.to_string(), CompletionItemKind::OPERATOR, Some(w.form.to_string()), Some(turtle_text(w)), 7);
+                out.push(
+                    &w.symbol.to_string(),
+                    CompletionItemKind::OPERATOR,
+                    Some(w.form.to_string()),
+                    Some(turtle_text(w)),
+                    7,
+                );
             }
             functions(&mut out);
         }

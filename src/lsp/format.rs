@@ -41,10 +41,7 @@ pub fn format(text: &str) -> Option<Vec<TextEdit>> {
         suf -= 1;
     }
     let lines = LineIndex::new(text);
-    let range = lines.range(
-        text,
-        crate::span::Span::new(pre, text.len() - suf),
-    );
+    let range = lines.range(text, crate::span::Span::new(pre, text.len() - suf));
     Some(vec![TextEdit {
         range,
         new_text: out[pre..out.len() - suf].to_string(),

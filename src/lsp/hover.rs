@@ -61,13 +61,20 @@ fn target_text(a: &Analysis, t: &Target) -> Option<String> {
         Target::Cut => words::turtle('%').map(|w| format!("```lsy\ncut\n```\n\n{}", w.meaning)),
         Target::Function(f) => Some(match builtins::lookup(f) {
             Some(b) => {
-                let args: Vec<String> = (0..b.arity).map(|i| ["x", "y", "z"][i.min(2)].to_string()).collect();
+                let args: Vec<String> = (0..b.arity)
+                    .map(|i| ["x", "y", "z"][i.min(2)].to_string())
+                    .collect();
                 let random = if b.random {
                     "\n\nDrawn from the run's seeded generator (`--seed`)."
                 } else {
                     ""
                 };
-                format!("```lsy\n{}({})\n```\n\n{}{random}", b.name, args.join(", "), b.doc)
+                format!(
+                    "```lsy\n{}({})\n```\n\n{}{random}",
+                    b.name,
+                    args.join(", "),
+                    b.doc
+                )
             }
             None => format!("`{f}` is not a built-in function"),
         }),
@@ -80,13 +87,21 @@ pub fn query_text(q: &str) -> String {
             "```lsy\n{}\n```\n\nQuery module: {}.\n\nOutputs, filled by the environment after each derivation step: {}. Then the pass-through parameters the program chooses{}.",
             q.signature(),
             q.doc,
-            q.outputs.iter().map(|o| format!("`{o}`")).collect::<Vec<_>>().join(", "),
+            q.outputs
+                .iter()
+                .map(|o| format!("`{o}`"))
+                .collect::<Vec<_>>()
+                .join(", "),
             if q.inputs.is_empty() {
                 String::new()
             } else {
                 format!(
                     ", of which the environment reads {}",
-                    q.inputs.iter().map(|o| format!("`{o}`")).collect::<Vec<_>>().join(", ")
+                    q.inputs
+                        .iter()
+                        .map(|o| format!("`{o}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 )
             }
         ),
@@ -135,7 +150,13 @@ fn params(ps: &[crate::ast::Ident]) -> String {
     if ps.is_empty() {
         String::new()
     } else {
-        format!("({})", ps.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", "))
+        format!(
+            "({})",
+            ps.iter()
+                .map(|p| p.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
     }
 }
 
@@ -151,8 +172,17 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
     let declared = s.decl.map(|d| format!("line {}", a.line_of(d)));
     match (&s.origin, s.kind) {
         (Origin::Item(i), Kind::Const) => {
-            if let Some(Node { node: Item::Const(c), trivia, .. }) = item(a, *i) {
-                parts.push(format!("```lsy\nconst {} = {}\n```", c.name.name, format_expr(&c.value)));
+            if let Some(Node {
+                node: Item::Const(c),
+                trivia,
+                ..
+            }) = item(a, *i)
+            {
+                parts.push(format!(
+                    "```lsy\nconst {} = {}\n```",
+                    c.name.name,
+                    format_expr(&c.value)
+                ));
                 let doc = comments(trivia);
                 if !doc.is_empty() {
                     parts.push(doc);
@@ -171,18 +201,29 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
             }
         }
         (Origin::Item(i), Kind::Module) | (Origin::LsystemStmt(i, _), Kind::Module) => {
-            let (decl, trivia, place) = match (&s.origin, item(a, *i).map(|n| (&n.node, &n.trivia))) {
-                (Origin::Item(_), Some((Item::Module(m), t))) => (Some(m), Some(t), "file".to_string()),
-                (Origin::LsystemStmt(_, j), Some((Item::Lsystem(l), _))) => match l.body.stmts.get(*j) {
-                    Some(Node { node: Stmt::Module(m), trivia, .. }) => {
-                        (Some(m), Some(trivia), format!("lsystem `{}`", l.name.name))
+            let (decl, trivia, place) = match (&s.origin, item(a, *i).map(|n| (&n.node, &n.trivia)))
+            {
+                (Origin::Item(_), Some((Item::Module(m), t))) => {
+                    (Some(m), Some(t), "file".to_string())
+                }
+                (Origin::LsystemStmt(_, j), Some((Item::Lsystem(l), _))) => {
+                    match l.body.stmts.get(*j) {
+                        Some(Node {
+                            node: Stmt::Module(m),
+                            trivia,
+                            ..
+                        }) => (Some(m), Some(trivia), format!("lsystem `{}`", l.name.name)),
+                        _ => (None, None, String::new()),
                     }
-                    _ => (None, None, String::new()),
-                },
+                }
                 _ => (None, None, String::new()),
             };
             if let Some(m) = decl {
-                parts.push(format!("```lsy\nmodule {}{}\n```", m.name.name, params(&m.params)));
+                parts.push(format!(
+                    "```lsy\nmodule {}{}\n```",
+                    m.name.name,
+                    params(&m.params)
+                ));
                 if let Some(t) = trivia {
                     let doc = comments(t);
                     if !doc.is_empty() {
@@ -199,7 +240,12 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
             parts.push(rules_text(a, s));
         }
         (Origin::Item(i), Kind::Element) => {
-            if let Some(Node { node: Item::Element(e), trivia, .. }) = item(a, *i) {
+            if let Some(Node {
+                node: Item::Element(e),
+                trivia,
+                ..
+            }) = item(a, *i)
+            {
                 let mut props = Vec::new();
                 for p in &e.props.stmts {
                     let v = match &p.node.value {
@@ -214,7 +260,11 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
                     };
                     props.push(format!("    {} {};", p.node.key.name, v));
                 }
-                parts.push(format!("```lsy\nelement {} {{\n{}\n}}\n```", e.name.name, props.join("\n")));
+                parts.push(format!(
+                    "```lsy\nelement {} {{\n{}\n}}\n```",
+                    e.name.name,
+                    props.join("\n")
+                ));
                 let doc = comments(trivia);
                 if !doc.is_empty() {
                     parts.push(doc);
@@ -226,13 +276,22 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
             }
         }
         (Origin::Item(i), Kind::Lsystem) => {
-            if let Some(Node { node: Item::Lsystem(l), trivia, .. }) = item(a, *i) {
+            if let Some(Node {
+                node: Item::Lsystem(l),
+                trivia,
+                ..
+            }) = item(a, *i)
+            {
                 let mut head = format!("lsystem {}{}", l.name.name, params(&l.params));
                 let mut rules = 0;
                 for st in &l.body.stmts {
                     match &st.node {
-                        Stmt::Angle(e) => head.push_str(&format!("\n    angle {};", format_expr(e))),
-                        Stmt::Derive(e) => head.push_str(&format!("\n    derive {};", format_expr(e))),
+                        Stmt::Angle(e) => {
+                            head.push_str(&format!("\n    angle {};", format_expr(e)))
+                        }
+                        Stmt::Derive(e) => {
+                            head.push_str(&format!("\n    derive {};", format_expr(e)))
+                        }
                         Stmt::Step(e) => head.push_str(&format!("\n    step {};", format_expr(e))),
                         Stmt::Rule(_) => rules += 1,
                         _ => {}
@@ -251,26 +310,55 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
             }
         }
         (Origin::Item(i), Kind::Scene) => {
-            if let Some(Node { node: Item::Scene(sc), trivia, .. }) = item(a, *i) {
-                let guides = sc.body.stmts.iter().filter(|s| matches!(s.node, crate::ast::SceneStmt::Guide(_))).count();
-                let links = sc.body.stmts.iter().filter(|s| matches!(s.node, crate::ast::SceneStmt::Link(_))).count();
+            if let Some(Node {
+                node: Item::Scene(sc),
+                trivia,
+                ..
+            }) = item(a, *i)
+            {
+                let guides = sc
+                    .body
+                    .stmts
+                    .iter()
+                    .filter(|s| matches!(s.node, crate::ast::SceneStmt::Guide(_)))
+                    .count();
+                let links = sc
+                    .body
+                    .stmts
+                    .iter()
+                    .filter(|s| matches!(s.node, crate::ast::SceneStmt::Link(_)))
+                    .count();
                 parts.push(format!("```lsy\nscene {}\n```", sc.name.name));
                 let doc = comments(trivia);
                 if !doc.is_empty() {
                     parts.push(doc);
                 }
-                parts.push(format!("{guides} guides, {links} links; declared at {}.", declared.clone().unwrap_or_default()));
+                parts.push(format!(
+                    "{guides} guides, {links} links; declared at {}.",
+                    declared.clone().unwrap_or_default()
+                ));
             }
         }
         (Origin::Guide(i, j), _) => {
-            if let Some(Node { node: Item::Scene(sc), .. }) = item(a, *i)
-                && let Some(Node { node: crate::ast::SceneStmt::Guide(g), trivia, .. }) = sc.body.stmts.get(*j)
+            if let Some(Node {
+                node: Item::Scene(sc),
+                ..
+            }) = item(a, *i)
+                && let Some(Node {
+                    node: crate::ast::SceneStmt::Guide(g),
+                    trivia,
+                    ..
+                }) = sc.body.stmts.get(*j)
             {
                 let mut lines = vec![format!("guide {}", g.name.name)];
                 for gs in &g.body.stmts {
                     match &gs.node {
-                        crate::ast::GuideStmt::Polygon(ps) => lines.push(format!("    polygon with {} vertices", ps.len())),
-                        crate::ast::GuideStmt::System(n) => lines.push(format!("    system {};", n.name)),
+                        crate::ast::GuideStmt::Polygon(ps) => {
+                            lines.push(format!("    polygon with {} vertices", ps.len()))
+                        }
+                        crate::ast::GuideStmt::System(n) => {
+                            lines.push(format!("    system {};", n.name))
+                        }
                         crate::ast::GuideStmt::Seed(_) => lines.push("    seed …;".to_string()),
                         _ => {}
                     }
@@ -295,13 +383,24 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
                 lsystem_name(a, *i)
             ));
         }
-        (Origin::RuleParam { item: i, stmt, module, arg }, _) => {
+        (
+            Origin::RuleParam {
+                item: i,
+                stmt,
+                module,
+                arg,
+            },
+            _,
+        ) => {
             parts.push(format!("```lsy\n{}\n```", s.name));
             let rule_line = match item(a, *i).map(|n| &n.node) {
                 Some(Item::Lsystem(l)) => l.body.stmts.get(*stmt).map(|st| {
                     let text = a.slice(st.span);
                     let first = text.lines().next().unwrap_or("");
-                    (a.line_of(st.span), first.chars().take(80).collect::<String>())
+                    (
+                        a.line_of(st.span),
+                        first.chars().take(80).collect::<String>(),
+                    )
                 }),
                 _ => None,
             };
@@ -318,12 +417,18 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
             };
             parts.push(format!("Rule parameter: {what}."));
             if let Some((line, text)) = rule_line {
-                parts.push(format!("Bound by the rule at line {line}:\n```lsy\n{text}\n```"));
+                parts.push(format!(
+                    "Bound by the rule at line {line}:\n```lsy\n{text}\n```"
+                ));
             }
         }
         (Origin::Letter(i), _) => {
             parts.push(format!("```lsy\n{}\n```", s.name));
-            if let Some(c) = s.name.chars().next().filter(|_| s.name.chars().count() == 1)
+            if let Some(c) = s
+                .name
+                .chars()
+                .next()
+                .filter(|_| s.name.chars().count() == 1)
                 && let Some(w) = words::turtle(c)
             {
                 parts.push(format!("Turtle: {}.", w.meaning));

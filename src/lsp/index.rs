@@ -168,7 +168,10 @@ impl Index {
     }
 
     /// Every occurrence of a target, declarations included, in order.
-    pub fn occurrences_of<'a>(&'a self, t: &'a Target) -> impl Iterator<Item = &'a Occurrence> + 'a {
+    pub fn occurrences_of<'a>(
+        &'a self,
+        t: &'a Target,
+    ) -> impl Iterator<Item = &'a Occurrence> + 'a {
         self.occurrences.iter().filter(move |o| &o.target == t)
     }
 
@@ -236,7 +239,9 @@ impl Builder {
         if span.is_empty() && !matches!(target, Target::Symbol(_)) {
             return;
         }
-        self.index.occurrences.push(Occurrence { span, target, decl });
+        self.index
+            .occurrences
+            .push(Occurrence { span, target, decl });
     }
 
     fn file(&mut self, file: &File) {
@@ -253,7 +258,12 @@ impl Builder {
             if name.name.is_empty() {
                 continue;
             }
-            self.define((None, ns, name.name.clone()), kind, name.span, Origin::Item(i));
+            self.define(
+                (None, ns, name.name.clone()),
+                kind,
+                name.span,
+                Origin::Item(i),
+            );
         }
         for (i, item) in file.items.stmts.iter().enumerate() {
             match &item.node {
@@ -374,7 +384,8 @@ impl Builder {
             origin: Origin::Letter(ls),
             scope: Some(ls),
         });
-        self.keys.insert((Some(ls), Ns::Letter, name.to_string()), id);
+        self.keys
+            .insert((Some(ls), Ns::Letter, name.to_string()), id);
         Some(id)
     }
 

@@ -19,7 +19,11 @@ fn sym(
 ) -> DocumentSymbol {
     let span = span.to(select);
     DocumentSymbol {
-        name: if name.is_empty() { "?".to_string() } else { name },
+        name: if name.is_empty() {
+            "?".to_string()
+        } else {
+            name
+        },
         detail,
         kind,
         tags: None,

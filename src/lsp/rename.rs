@@ -18,10 +18,15 @@ use lsp_types::TextEdit;
 
 /// The name at an offset that can be renamed, with its span.
 pub fn prepare(a: &Analysis, offset: usize) -> Result<(Span, String), String> {
-    let occ = a.index.at(offset).ok_or("there is no name here to rename")?;
+    let occ = a
+        .index
+        .at(offset)
+        .ok_or("there is no name here to rename")?;
     match &occ.target {
         Target::Symbol(id) => Ok((occ.span, a.index.symbols[*id].name.clone())),
-        Target::Query(_) => Err("query modules are the environment's; they cannot be renamed".into()),
+        Target::Query(_) => {
+            Err("query modules are the environment's; they cannot be renamed".into())
+        }
         Target::Turtle(_) | Target::Cut => Err("turtle symbols cannot be renamed".into()),
         Target::Function(_) => Err("built-in functions cannot be renamed".into()),
     }
@@ -41,7 +46,10 @@ fn shape(ix: &Index) -> Vec<usize> {
 
 pub fn rename(a: &Analysis, offset: usize, new_name: &str) -> Result<Vec<TextEdit>, String> {
     let (_, old) = prepare(a, offset)?;
-    let occ = a.index.at(offset).ok_or("there is no name here to rename")?;
+    let occ = a
+        .index
+        .at(offset)
+        .ok_or("there is no name here to rename")?;
     let Target::Symbol(id) = occ.target else {
         return Err("only names can be renamed".into());
     };
@@ -50,7 +58,9 @@ pub fn rename(a: &Analysis, offset: usize, new_name: &str) -> Result<Vec<TextEdi
     let is_name = lexed.diagnostics.is_empty()
         && matches!(&lexed.tokens[..], [(_, Token::Ident(n), _)] if n == new_name);
     if !is_name {
-        return Err(format!("`{new_name}` is not a name (names are letters, digits and `_`, and not a keyword)"));
+        return Err(format!(
+            "`{new_name}` is not a name (names are letters, digits and `_`, and not a keyword)"
+        ));
     }
     if new_name == old {
         return Ok(Vec::new());
@@ -60,8 +70,12 @@ pub fn rename(a: &Analysis, offset: usize, new_name: &str) -> Result<Vec<TextEdi
             "`{old}` is an undeclared single-letter module; `{new_name}` would be read as several modules (declare `module {new_name};` first, or choose one letter)"
         ));
     }
-    if matches!(sym.kind, Kind::Letter | Kind::Module | Kind::Element) && matches!(new_name, "F" | "f") {
-        return Err("`F` and `f` draw and move; a module renamed to them would change the drawing".into());
+    if matches!(sym.kind, Kind::Letter | Kind::Module | Kind::Element)
+        && matches!(new_name, "F" | "f")
+    {
+        return Err(
+            "`F` and `f` draw and move; a module renamed to them would change the drawing".into(),
+        );
     }
     let module_like = |k: Kind| matches!(k, Kind::Module | Kind::Element | Kind::Letter);
     let clash = a.index.symbols.iter().any(|s| {
@@ -77,7 +91,10 @@ pub fn rename(a: &Analysis, offset: usize, new_name: &str) -> Result<Vec<TextEdi
             }
     });
     if clash {
-        return Err(format!("`{new_name}` is already a {} here", sym.kind.noun()));
+        return Err(format!(
+            "`{new_name}` is already a {} here",
+            sym.kind.noun()
+        ));
     }
     let spans: Vec<Span> = a
         .index

@@ -146,7 +146,10 @@ impl<W: Write> Server<W> {
             },
             (State::Running, req::Initialize::METHOD) => Response {
                 id,
-                response_result: Err(error(ErrorCode::InvalidRequest, "the server is already initialized")),
+                response_result: Err(error(
+                    ErrorCode::InvalidRequest,
+                    "the server is already initialized",
+                )),
             },
             (State::Running, req::Shutdown::METHOD) => {
                 self.state = State::ShutDown;
@@ -156,6 +159,9 @@ impl<W: Write> Server<W> {
         }
     }
 
+    // lsp-types keys `WorkspaceEdit::changes` by `Uri`, which clippy deems
+    // mutable (a cache inside); the map is built and sent, never mutated by key.
+    #[allow(clippy::mutable_key_type)]
     fn dispatch(&mut self, r: Request) -> Response {
         let m = r.method.clone();
         match m.as_str() {
@@ -169,57 +175,91 @@ impl<W: Write> Server<W> {
                 let Some(sym) = a.index.at(off).and_then(|o| a.index.symbol(&o.target)) else {
                     return Ok(None);
                 };
-                let spans: Vec<_> = sym.decl.into_iter().chain(if sym.decl.is_none() { sym.rules.clone() } else { Vec::new() }).collect();
+                let spans: Vec<_> = sym
+                    .decl
+                    .into_iter()
+                    .chain(if sym.decl.is_none() {
+                        sym.rules.clone()
+                    } else {
+                        Vec::new()
+                    })
+                    .collect();
                 let locs: Vec<lsp::Location> = spans
                     .into_iter()
-                    .map(|sp| lsp::Location { uri: tdp.text_document.uri.clone(), range: a.range(sp) })
+                    .map(|sp| lsp::Location {
+                        uri: tdp.text_document.uri.clone(),
+                        range: a.range(sp),
+                    })
                     .collect();
                 Ok(match locs.len() {
                     0 => None,
-                    1 => locs.into_iter().next().map(lsp::GotoDefinitionResponse::Scalar),
+                    1 => locs
+                        .into_iter()
+                        .next()
+                        .map(lsp::GotoDefinitionResponse::Scalar),
                     _ => Some(lsp::GotoDefinitionResponse::Array(locs)),
                 })
             }),
             req::References::METHOD => self.on::<req::References>(r, |s, p| {
                 let tdp = &p.text_document_position;
                 let (a, off) = s.at(tdp)?;
-                let Some(o) = a.index.at(off) else { return Ok(None) };
+                let Some(o) = a.index.at(off) else {
+                    return Ok(None);
+                };
                 Ok(Some(
                     a.index
                         .occurrences_of(&o.target)
                         .filter(|x| p.context.include_declaration || !x.decl)
-                        .map(|x| lsp::Location { uri: tdp.text_document.uri.clone(), range: a.range(x.span) })
-                        .collect(),
-                ))
-            }),
-            req::DocumentHighlightRequest::METHOD => self.on::<req::DocumentHighlightRequest>(r, |s, p| {
-                let (a, off) = s.at(&p.text_document_position_params)?;
-                let Some(o) = a.index.at(off) else { return Ok(None) };
-                Ok(Some(
-                    a.index
-                        .occurrences_of(&o.target)
-                        .map(|x| lsp::DocumentHighlight {
+                        .map(|x| lsp::Location {
+                            uri: tdp.text_document.uri.clone(),
                             range: a.range(x.span),
-                            kind: Some(if x.decl { lsp::DocumentHighlightKind::WRITE } else { lsp::DocumentHighlightKind::READ }),
                         })
                         .collect(),
                 ))
             }),
+            req::DocumentHighlightRequest::METHOD => {
+                self.on::<req::DocumentHighlightRequest>(r, |s, p| {
+                    let (a, off) = s.at(&p.text_document_position_params)?;
+                    let Some(o) = a.index.at(off) else {
+                        return Ok(None);
+                    };
+                    Ok(Some(
+                        a.index
+                            .occurrences_of(&o.target)
+                            .map(|x| lsp::DocumentHighlight {
+                                range: a.range(x.span),
+                                kind: Some(if x.decl {
+                                    lsp::DocumentHighlightKind::WRITE
+                                } else {
+                                    lsp::DocumentHighlightKind::READ
+                                }),
+                            })
+                            .collect(),
+                    ))
+                })
+            }
             req::Completion::METHOD => self.on::<req::Completion>(r, |s, p| {
                 let (a, off) = s.at(&p.text_document_position)?;
-                Ok(Some(lsp::CompletionResponse::Array(complete::complete(a, off))))
+                Ok(Some(lsp::CompletionResponse::Array(complete::complete(
+                    a, off,
+                ))))
             }),
-            req::DocumentSymbolRequest::METHOD => self.on::<req::DocumentSymbolRequest>(r, |s, p| {
-                let a = s.doc(&p.text_document.uri)?;
-                Ok(Some(lsp::DocumentSymbolResponse::Nested(outline::outline(a))))
-            }),
+            req::DocumentSymbolRequest::METHOD => {
+                self.on::<req::DocumentSymbolRequest>(r, |s, p| {
+                    let a = s.doc(&p.text_document.uri)?;
+                    Ok(Some(lsp::DocumentSymbolResponse::Nested(outline::outline(
+                        a,
+                    ))))
+                })
+            }
             req::Formatting::METHOD => self.on::<req::Formatting>(r, |s, p| {
                 let a = s.doc(&p.text_document.uri)?;
                 Ok(format::format(&a.text))
             }),
             req::PrepareRenameRequest::METHOD => self.on::<req::PrepareRenameRequest>(r, |s, p| {
                 let (a, off) = s.at(&p)?;
-                let (span, name) = rename::prepare(a, off).map_err(|m| error(ErrorCode::RequestFailed, m))?;
+                let (span, name) =
+                    rename::prepare(a, off).map_err(|m| error(ErrorCode::RequestFailed, m))?;
                 Ok(Some(lsp::PrepareRenameResponse::RangeWithPlaceholder {
                     range: a.range(span),
                     placeholder: name,
@@ -228,14 +268,21 @@ impl<W: Write> Server<W> {
             req::Rename::METHOD => self.on::<req::Rename>(r, |s, p| {
                 let tdp = &p.text_document_position;
                 let (a, off) = s.at(tdp)?;
-                let edits = rename::rename(a, off, &p.new_name).map_err(|m| error(ErrorCode::RequestFailed, m))?;
+                let edits = rename::rename(a, off, &p.new_name)
+                    .map_err(|m| error(ErrorCode::RequestFailed, m))?;
                 let mut changes = HashMap::new();
                 changes.insert(tdp.text_document.uri.clone(), edits);
-                Ok(Some(lsp::WorkspaceEdit { changes: Some(changes), ..Default::default() }))
+                Ok(Some(lsp::WorkspaceEdit {
+                    changes: Some(changes),
+                    ..Default::default()
+                }))
             }),
             other => Response {
                 id: r.id,
-                response_result: Err(error(ErrorCode::MethodNotFound, format!("lsyc does not handle `{other}`"))),
+                response_result: Err(error(
+                    ErrorCode::MethodNotFound,
+                    format!("lsyc does not handle `{other}`"),
+                )),
             },
         }
     }
@@ -252,15 +299,30 @@ impl<W: Write> Server<W> {
             Err(e) => {
                 return Response {
                     id: r.id,
-                    response_result: Err(error(ErrorCode::InvalidParams, format!("invalid parameters for `{}`: {e}", R::METHOD))),
+                    response_result: Err(error(
+                        ErrorCode::InvalidParams,
+                        format!("invalid parameters for `{}`: {e}", R::METHOD),
+                    )),
                 };
             }
         };
-        let result = catch_unwind(AssertUnwindSafe(|| f(self, params)))
-            .unwrap_or_else(|_| Err(error(ErrorCode::InternalError, format!("lsyc failed while answering `{}`", R::METHOD))));
-        match result.and_then(|v| serde_json::to_value(v).map_err(|e| error(ErrorCode::InternalError, e.to_string()))) {
-            Ok(v) => Response { id: r.id, response_result: Ok(v) },
-            Err(e) => Response { id: r.id, response_result: Err(e) },
+        let result = catch_unwind(AssertUnwindSafe(|| f(self, params))).unwrap_or_else(|_| {
+            Err(error(
+                ErrorCode::InternalError,
+                format!("lsyc failed while answering `{}`", R::METHOD),
+            ))
+        });
+        match result.and_then(|v| {
+            serde_json::to_value(v).map_err(|e| error(ErrorCode::InternalError, e.to_string()))
+        }) {
+            Ok(v) => Response {
+                id: r.id,
+                response_result: Ok(v),
+            },
+            Err(e) => Response {
+                id: r.id,
+                response_result: Err(e),
+            },
         }
     }
 
@@ -268,7 +330,12 @@ impl<W: Write> Server<W> {
         self.docs
             .get(uri.as_str())
             .map(|d| &d.analysis)
-            .ok_or_else(|| error(ErrorCode::InvalidParams, format!("`{}` is not open", uri.as_str())))
+            .ok_or_else(|| {
+                error(
+                    ErrorCode::InvalidParams,
+                    format!("`{}` is not open", uri.as_str()),
+                )
+            })
     }
 
     fn at(&self, p: &lsp::TextDocumentPositionParams) -> Result<(&Analysis, usize), ResponseError> {
@@ -288,7 +355,8 @@ impl<W: Write> Server<W> {
                 }
             }
             note::DidChangeTextDocument::METHOD => {
-                if let Ok(p) = serde_json::from_value::<lsp::DidChangeTextDocumentParams>(n.params) {
+                if let Ok(p) = serde_json::from_value::<lsp::DidChangeTextDocumentParams>(n.params)
+                {
                     let uri = p.text_document.uri;
                     if let Some(doc) = self.docs.get(uri.as_str()) {
                         let mut text = doc.analysis.text.clone();
@@ -315,12 +383,22 @@ impl<W: Write> Server<W> {
             return Ok(()); // the last analysis stays; the panic is on stderr
         };
         let diags = analysis.lsp_diagnostics(&uri);
-        self.docs.insert(uri.as_str().to_string(), Document { version, analysis });
+        self.docs
+            .insert(uri.as_str().to_string(), Document { version, analysis });
         self.publish(uri, diags, Some(version))
     }
 
-    fn publish(&mut self, uri: lsp::Uri, diagnostics: Vec<lsp::Diagnostic>, version: Option<i32>) -> io::Result<()> {
-        let params = lsp::PublishDiagnosticsParams { uri, diagnostics, version };
+    fn publish(
+        &mut self,
+        uri: lsp::Uri,
+        diagnostics: Vec<lsp::Diagnostic>,
+        version: Option<i32>,
+    ) -> io::Result<()> {
+        let params = lsp::PublishDiagnosticsParams {
+            uri,
+            diagnostics,
+            version,
+        };
         let n = Notification::new(note::PublishDiagnostics::METHOD.to_string(), params);
         transport::write(&mut self.out, n.into())
     }

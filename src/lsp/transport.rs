@@ -47,10 +47,17 @@ pub fn read(r: &mut impl BufRead) -> io::Result<Incoming> {
     let mut line = Vec::new();
     loop {
         line.clear();
-        let n = r.by_ref().take(MAX_HEADER_LINE).read_until(b'\n', &mut line)?;
+        let n = r
+            .by_ref()
+            .take(MAX_HEADER_LINE)
+            .read_until(b'\n', &mut line)?;
         if n == 0 {
             return Ok(if saw_header {
-                invalid(Value::Null, ErrorCode::ParseError, "the stream ended inside a message's headers")
+                invalid(
+                    Value::Null,
+                    ErrorCode::ParseError,
+                    "the stream ended inside a message's headers",
+                )
             } else {
                 Incoming::Eof
             });
@@ -73,19 +80,23 @@ pub fn read(r: &mut impl BufRead) -> io::Result<Incoming> {
         saw_header = true;
         match text.split_once(':') {
             Some((name, value)) if name.trim().eq_ignore_ascii_case("content-length") => {
-                length = Some(
-                    value
-                        .trim()
-                        .parse::<usize>()
-                        .map_err(|_| format!("`Content-Length: {}` is not a length", value.trim())),
-                );
+                length =
+                    Some(value.trim().parse::<usize>().map_err(|_| {
+                        format!("`Content-Length: {}` is not a length", value.trim())
+                    }));
             }
             Some(_) => {} // Content-Type and others
             None => length = Some(Err(format!("`{text}` is not a header"))),
         }
     }
     let len = match length {
-        None => return Ok(invalid(Value::Null, ErrorCode::ParseError, "a message without `Content-Length`")),
+        None => {
+            return Ok(invalid(
+                Value::Null,
+                ErrorCode::ParseError,
+                "a message without `Content-Length`",
+            ));
+        }
         Some(Err(e)) => return Ok(invalid(Value::Null, ErrorCode::ParseError, e)),
         Some(Ok(n)) => n,
     };
@@ -100,7 +111,11 @@ pub fn read(r: &mut impl BufRead) -> io::Result<Incoming> {
     let mut body = vec![0; len];
     if let Err(e) = r.read_exact(&mut body) {
         return if e.kind() == io::ErrorKind::UnexpectedEof {
-            Ok(invalid(Value::Null, ErrorCode::ParseError, "the stream ended inside a message"))
+            Ok(invalid(
+                Value::Null,
+                ErrorCode::ParseError,
+                "the stream ended inside a message",
+            ))
         } else {
             Err(e)
         };
@@ -132,14 +147,24 @@ fn skip_line(r: &mut impl BufRead) -> io::Result<()> {
 pub fn parse(body: &[u8]) -> Incoming {
     let value: Value = match serde_json::from_slice(body) {
         Ok(v) => v,
-        Err(e) => return invalid(Value::Null, ErrorCode::ParseError, format!("the message is not JSON: {e}")),
+        Err(e) => {
+            return invalid(
+                Value::Null,
+                ErrorCode::ParseError,
+                format!("the message is not JSON: {e}"),
+            );
+        }
     };
     let id = match value.get("id") {
         Some(id @ (Value::Number(_) | Value::String(_))) => id.clone(),
         _ => Value::Null,
     };
     if !value.is_object() {
-        return invalid(id, ErrorCode::InvalidRequest, "a message must be a JSON object");
+        return invalid(
+            id,
+            ErrorCode::InvalidRequest,
+            "a message must be a JSON object",
+        );
     }
     let has_id = value.get("id").is_some_and(|v| !v.is_null());
     match serde_json::from_value::<Message>(value) {
@@ -150,7 +175,11 @@ pub fn parse(body: &[u8]) -> Incoming {
             "a request id must be an integer or a string",
         ),
         Ok(m) => Incoming::Message(m),
-        Err(e) => invalid(id, ErrorCode::InvalidRequest, format!("not a JSON-RPC message: {e}")),
+        Err(e) => invalid(
+            id,
+            ErrorCode::InvalidRequest,
+            format!("not a JSON-RPC message: {e}"),
+        ),
     }
 }
 
@@ -161,7 +190,12 @@ pub fn write(w: &mut impl Write, msg: Message) -> io::Result<()> {
 
 /// Writes an error response whose id may be `null` (which `lsp_server`'s
 /// `RequestId` cannot hold).
-pub fn write_error(w: &mut impl Write, id: Value, code: ErrorCode, message: &str) -> io::Result<()> {
+pub fn write_error(
+    w: &mut impl Write,
+    id: Value,
+    code: ErrorCode,
+    message: &str,
+) -> io::Result<()> {
     let v = serde_json::json!({
         "jsonrpc": "2.0",
         "id": id,
@@ -186,8 +220,13 @@ mod tests {
         loop {
             match read(&mut r).expect("in memory") {
                 Incoming::Eof => return out,
-                Incoming::Message(m) => out.push(format!("message {}", serde_json::to_string(&m).expect("json"))),
-                Incoming::Invalid { id, code, .. } => out.push(format!("invalid {id} {}", code as i32)),
+                Incoming::Message(m) => out.push(format!(
+                    "message {}",
+                    serde_json::to_string(&m).expect("json")
+                )),
+                Incoming::Invalid { id, code, .. } => {
+                    out.push(format!("invalid {id} {}", code as i32))
+                }
             }
         }
     }

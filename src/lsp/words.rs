@@ -21,25 +21,61 @@ const fn t(symbol: char, form: &'static str, meaning: &'static str) -> TurtleWor
 }
 
 pub const TURTLE: &[TurtleWord] = &[
-    t('F', "F(d)", "draw forward d·s (the scale s); d defaults to the lsystem's `step`"),
-    t('f', "f(d)", "move forward d·s without drawing; d defaults to the lsystem's `step`"),
-    t('+', "+(a)", "turn left about U by a degrees (default: the lsystem's `angle`)"),
-    t('-', "-(a)", "turn right about U by a degrees (default: the lsystem's `angle`)"),
+    t(
+        'F',
+        "F(d)",
+        "draw forward d·s (the scale s); d defaults to the lsystem's `step`",
+    ),
+    t(
+        'f',
+        "f(d)",
+        "move forward d·s without drawing; d defaults to the lsystem's `step`",
+    ),
+    t(
+        '+',
+        "+(a)",
+        "turn left about U by a degrees (default: the lsystem's `angle`)",
+    ),
+    t(
+        '-',
+        "-(a)",
+        "turn right about U by a degrees (default: the lsystem's `angle`)",
+    ),
     t('&', "&(a)", "pitch down about L by a degrees (H toward −U)"),
     t('^', "^(a)", "pitch up about L by a degrees"),
     t('\\', "\\(a)", "roll left about H by a degrees"),
-    t('/', "/(a)", "roll right about H by a degrees; `//` starts a comment, so write `/ /`"),
+    t(
+        '/',
+        "/(a)",
+        "roll right about H by a degrees; `//` starts a comment, so write `/ /`",
+    ),
     t('|', "|", "turn around: 180° about U"),
     t('$', "$", "roll about H until L is horizontal"),
     t('*', "*(k)", "multiply the turtle's scale s by k"),
-    t('[', "[", "push the whole turtle state (position, frame, scale, width, colour)"),
+    t(
+        '[',
+        "[",
+        "push the whole turtle state (position, frame, scale, width, colour)",
+    ),
     t(']', "]", "pop the turtle state pushed by the matching `[`"),
     t('{', "{", "start a polygon"),
     t('}', "}", "close and fill the polygon"),
     t('.', ".", "record a polygon vertex"),
-    t('!', "!(w)", "set the line width to w; a bare `!` multiplies it by 0.7"),
-    t('\'', "'(c)", "set the colour index to c; a bare `'` steps along the wood-to-leaf ramp"),
-    t('%', "%", "cut: erase the rest of the branch (at derivation); same as `cut`"),
+    t(
+        '!',
+        "!(w)",
+        "set the line width to w; a bare `!` multiplies it by 0.7",
+    ),
+    t(
+        '\'',
+        "'(c)",
+        "set the colour index to c; a bare `'` steps along the wood-to-leaf ramp",
+    ),
+    t(
+        '%',
+        "%",
+        "cut: erase the rest of the branch (at derivation); same as `cut`",
+    ),
 ];
 
 pub fn turtle(c: char) -> Option<&'static TurtleWord> {
@@ -71,35 +107,143 @@ const fn k(word: &'static str, context: Context, doc: &'static str) -> Keyword {
 }
 
 pub const KEYWORDS: &[Keyword] = &[
-    k("lsystem", Context::Top, "`lsystem Name(params) { … }`: an L-system: settings, an axiom and rules"),
-    k("module", Context::Top, "`module Name(params);`: declares a multi-letter module and its parameters"),
-    k("const", Context::Top, "`const name = value;`: a constant, overridable with `-D name=value`"),
-    k("element", Context::Top, "`element Name { path \"…\"; }`: a terminal that prints its path at the turtle"),
-    k("scene", Context::Top, "`scene Name { guide …; link …; }`: guides and links of an Open L-system"),
-    k("angle", Context::Lsystem, "`angle a;`: the default turn of bare `+ - & ^ \\ /`, in degrees"),
-    k("derive", Context::Lsystem, "`derive n;`: the default number of derivation steps"),
-    k("step", Context::Lsystem, "`step d;`: the default length of bare `F` and `f`"),
-    k("axiom", Context::Lsystem, "`axiom …;`: the module string derivation starts from"),
-    k("ignore", Context::Lsystem, "`ignore + - …;`: modules context matching skips"),
-    k("module", Context::Lsystem, "`module Name(params);`: a multi-letter module of this lsystem"),
-    k("interpret", Context::Lsystem, "`interpret A -> …;`: a rule applied when drawing, not when deriving"),
-    k("cut", Context::Anywhere, "`cut` (or `%`): erase the rest of the branch"),
+    k(
+        "lsystem",
+        Context::Top,
+        "`lsystem Name(params) { … }`: an L-system: settings, an axiom and rules",
+    ),
+    k(
+        "module",
+        Context::Top,
+        "`module Name(params);`: declares a multi-letter module and its parameters",
+    ),
+    k(
+        "const",
+        Context::Top,
+        "`const name = value;`: a constant, overridable with `-D name=value`",
+    ),
+    k(
+        "element",
+        Context::Top,
+        "`element Name { path \"…\"; }`: a terminal that prints its path at the turtle",
+    ),
+    k(
+        "scene",
+        Context::Top,
+        "`scene Name { guide …; link …; }`: guides and links of an Open L-system",
+    ),
+    k(
+        "angle",
+        Context::Lsystem,
+        "`angle a;`: the default turn of bare `+ - & ^ \\ /`, in degrees",
+    ),
+    k(
+        "derive",
+        Context::Lsystem,
+        "`derive n;`: the default number of derivation steps",
+    ),
+    k(
+        "step",
+        Context::Lsystem,
+        "`step d;`: the default length of bare `F` and `f`",
+    ),
+    k(
+        "axiom",
+        Context::Lsystem,
+        "`axiom …;`: the module string derivation starts from",
+    ),
+    k(
+        "ignore",
+        Context::Lsystem,
+        "`ignore + - …;`: modules context matching skips",
+    ),
+    k(
+        "module",
+        Context::Lsystem,
+        "`module Name(params);`: a multi-letter module of this lsystem",
+    ),
+    k(
+        "interpret",
+        Context::Lsystem,
+        "`interpret A -> …;`: a rule applied when drawing, not when deriving",
+    ),
+    k(
+        "cut",
+        Context::Anywhere,
+        "`cut` (or `%`): erase the rest of the branch",
+    ),
     k("true", Context::Anywhere, "the boolean true"),
     k("false", Context::Anywhere, "the boolean false"),
-    k("path", Context::Element, "`path \"M0 0 …\";`: the element's SVG path, base at the origin, pointing +y"),
-    k("fill", Context::Element, "`fill \"green\";`: the element's fill colour"),
-    k("stroke", Context::Element, "`stroke \"black\";`: the element's outline colour"),
-    k("width", Context::Element, "`width w;`: the element's outline width"),
-    k("guide", Context::Scene, "`guide name { polygon …; system …; seed …; }`: a polygon that hosts an lsystem"),
-    k("link", Context::Scene, "`link a.edge(i) -> b.edge(j) { tokens n; heading a; }`: messages between guides"),
-    k("polygon", Context::Guide, "`polygon (x, y) (x, y) …;`: the guide's outline; edge i joins vertex i to i+1"),
-    k("system", Context::Guide, "`system Name;`: the lsystem the guide hosts"),
-    k("seed", Context::Guide, "`seed (x, y) heading a with (args);`: runs the lsystem's axiom there"),
-    k("heading", Context::Guide, "`heading a`: the direction, in degrees"),
-    k("with", Context::Guide, "`with (args)`: the values a seed passes to the lsystem's parameters"),
-    k("tokens", Context::Link, "`tokens n;`: how many messages the link carries"),
-    k("heading", Context::Link, "`heading a;`: the heading a message seeds the end guide with"),
-    k("edge", Context::Scene, "`guide.edge(i)`: edge i of a guide's polygon"),
+    k(
+        "path",
+        Context::Element,
+        "`path \"M0 0 …\";`: the element's SVG path, base at the origin, pointing +y",
+    ),
+    k(
+        "fill",
+        Context::Element,
+        "`fill \"green\";`: the element's fill colour",
+    ),
+    k(
+        "stroke",
+        Context::Element,
+        "`stroke \"black\";`: the element's outline colour",
+    ),
+    k(
+        "width",
+        Context::Element,
+        "`width w;`: the element's outline width",
+    ),
+    k(
+        "guide",
+        Context::Scene,
+        "`guide name { polygon …; system …; seed …; }`: a polygon that hosts an lsystem",
+    ),
+    k(
+        "link",
+        Context::Scene,
+        "`link a.edge(i) -> b.edge(j) { tokens n; heading a; }`: messages between guides",
+    ),
+    k(
+        "polygon",
+        Context::Guide,
+        "`polygon (x, y) (x, y) …;`: the guide's outline; edge i joins vertex i to i+1",
+    ),
+    k(
+        "system",
+        Context::Guide,
+        "`system Name;`: the lsystem the guide hosts",
+    ),
+    k(
+        "seed",
+        Context::Guide,
+        "`seed (x, y) heading a with (args);`: runs the lsystem's axiom there",
+    ),
+    k(
+        "heading",
+        Context::Guide,
+        "`heading a`: the direction, in degrees",
+    ),
+    k(
+        "with",
+        Context::Guide,
+        "`with (args)`: the values a seed passes to the lsystem's parameters",
+    ),
+    k(
+        "tokens",
+        Context::Link,
+        "`tokens n;`: how many messages the link carries",
+    ),
+    k(
+        "heading",
+        Context::Link,
+        "`heading a;`: the heading a message seeds the end guide with",
+    ),
+    k(
+        "edge",
+        Context::Scene,
+        "`guide.edge(i)`: edge i of a guide's polygon",
+    ),
 ];
 
 /// The keyword's text for hover (the first entry for a word).

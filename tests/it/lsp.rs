@@ -5,7 +5,7 @@
 use crate::support::root;
 use serde_json::{Value, json};
 use std::collections::VecDeque;
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::mpsc::{Receiver, RecvTimeoutError, channel};
 use std::time::{Duration, Instant};
@@ -111,7 +111,10 @@ impl Client {
     }
 
     fn initialize(&mut self) -> Value {
-        let r = self.request("initialize", json!({"processId": null, "rootUri": null, "capabilities": {}}));
+        let r = self.request(
+            "initialize",
+            json!({"processId": null, "rootUri": null, "capabilities": {}}),
+        );
         self.notify("initialized", json!({}));
         r
     }
@@ -255,7 +258,10 @@ fn show_diagnostics(p: &Value) -> String {
 }
 
 fn hover_text(v: &Value) -> String {
-    v["contents"]["value"].as_str().unwrap_or_else(|| panic!("no hover: {v}")).to_string()
+    v["contents"]["value"]
+        .as_str()
+        .unwrap_or_else(|| panic!("no hover: {v}"))
+        .to_string()
 }
 
 fn gallery(name: &str) -> String {
@@ -282,7 +288,10 @@ fn session_on_a_gallery_program() {
         "documentFormattingProvider",
         "renameProvider",
     ] {
-        assert!(caps.get(cap).is_some_and(|v| !v.is_null()), "{cap} missing: {caps}");
+        assert!(
+            caps.get(cap).is_some_and(|v| !v.is_null()),
+            "{cap} missing: {caps}"
+        );
     }
     assert_eq!(init["serverInfo"]["name"], "lsyc");
 
@@ -319,11 +328,26 @@ fn session_on_a_gallery_program() {
     // Completion inside a rule: its parameters, the constants, the query
     // modules with their signatures, turtle symbols and keywords.
     let items = c.request("textDocument/completion", doc(pos(&text, "l * r2", 0)));
-    let labels: Vec<&str> = items.as_array().expect("items").iter().map(|i| i["label"].as_str().expect("label")).collect();
-    for want in ["l", "w", "r1", "wr", "A", "B", "?X", "?N_G", "+", "axiom", "sin"] {
-        assert!(labels.contains(&want), "completion lacks `{want}`: {labels:?}");
+    let labels: Vec<&str> = items
+        .as_array()
+        .expect("items")
+        .iter()
+        .map(|i| i["label"].as_str().expect("label"))
+        .collect();
+    for want in [
+        "l", "w", "r1", "wr", "A", "B", "?X", "?N_G", "+", "axiom", "sin",
+    ] {
+        assert!(
+            labels.contains(&want),
+            "completion lacks `{want}`: {labels:?}"
+        );
     }
-    let qx = items.as_array().expect("items").iter().find(|i| i["label"] == "?X").expect("?X");
+    let qx = items
+        .as_array()
+        .expect("items")
+        .iter()
+        .find(|i| i["label"] == "?X")
+        .expect("?X");
     assert_eq!(qx["detail"], "?X(found, id, delta, …)");
     // After `?`, only query modules, replacing the `?` typed.
     let mut typing = text.clone();
@@ -336,15 +360,26 @@ fn session_on_a_gallery_program() {
     c.notification("textDocument/publishDiagnostics");
     let items = c.request("textDocument/completion", doc(position_of(&typing, at + 2)));
     let items = items.as_array().expect("items");
-    assert!(items.iter().all(|i| i["label"].as_str().is_some_and(|l| l.starts_with('?'))), "{items:?}");
-    assert_eq!(items[0]["textEdit"]["range"]["start"], position_of(&typing, at));
+    assert!(
+        items
+            .iter()
+            .all(|i| i["label"].as_str().is_some_and(|l| l.starts_with('?'))),
+        "{items:?}"
+    );
+    assert_eq!(
+        items[0]["textEdit"]["range"]["start"],
+        position_of(&typing, at)
+    );
 
     // Back to the program, then break it: diagnostics with codes on the right lines.
     c.notify(
         "textDocument/didChange",
         json!({"textDocument": {"uri": uri, "version": 3}, "contentChanges": [{"text": text}]}),
     );
-    assert_eq!(c.notification("textDocument/publishDiagnostics")["diagnostics"], json!([]));
+    assert_eq!(
+        c.notification("textDocument/publishDiagnostics")["diagnostics"],
+        json!([])
+    );
     let broken = text
         .replace("B(l * r2, w * wr)]/(d)", "B(l * r3, w * wr)]/(d)")
         .replace("C(l * r1, w * wr);\n    C", "C(l * r1);\n    C")
@@ -378,7 +413,10 @@ fn session_on_a_gallery_program() {
         json!({"textDocument": {"uri": uri, "version": 6}, "contentChanges": [{"text": text}]}),
     );
     c.notification("textDocument/publishDiagnostics");
-    let symbols = c.request("textDocument/documentSymbol", json!({"textDocument": {"uri": uri}}));
+    let symbols = c.request(
+        "textDocument/documentSymbol",
+        json!({"textDocument": {"uri": uri}}),
+    );
     insta::assert_snapshot!("lsp_symbols_monopodial", show_symbols(&symbols, 0));
 
     let prep = c.request("textDocument/prepareRename", doc(pos(&text, "r2,", 0)));
@@ -390,9 +428,17 @@ fn session_on_a_gallery_program() {
     let renamed = apply(&text, &edit["changes"][uri]);
     // The declaration and its three uses; comments are left alone.
     assert_eq!(renamed.matches("q2").count(), 4, "{renamed}");
-    assert_eq!(renamed.matches("r2").count(), text.matches("r2").count() - 4);
+    assert_eq!(
+        renamed.matches("r2").count(),
+        text.matches("r2").count() - 4
+    );
     assert!(renamed.contains("-D r2=0.9"), "{renamed}");
-    assert_eq!(lsyc::frontend::run(&renamed, Vec::new(), &[]).diagnostics.len(), 0);
+    assert_eq!(
+        lsyc::frontend::run(&renamed, Vec::new(), &[])
+            .diagnostics
+            .len(),
+        0
+    );
     // A module (here a letter) across the file.
     let edit = c.request(
         "textDocument/rename",
@@ -486,20 +532,29 @@ fn formatting_gives_what_lsyc_fmt_prints() {
     let uri = "file:///tmp/messy.lsy";
     c.open(uri, &messy);
     let opts = json!({"tabSize": 4, "insertSpaces": true});
-    let edits = c.request("textDocument/formatting", json!({"textDocument": {"uri": uri}, "options": opts}));
+    let edits = c.request(
+        "textDocument/formatting",
+        json!({"textDocument": {"uri": uri}, "options": opts}),
+    );
     assert!(!edits.as_array().expect("edits").is_empty());
     assert_eq!(apply(&messy, &edits), expected);
 
     // Already canonical: no edits.
     let uri2 = "file:///tmp/palm.lsy";
     c.open(uri2, &canonical);
-    let edits = c.request("textDocument/formatting", json!({"textDocument": {"uri": uri2}, "options": opts}));
+    let edits = c.request(
+        "textDocument/formatting",
+        json!({"textDocument": {"uri": uri2}, "options": opts}),
+    );
     assert_eq!(edits, json!([]));
 
     // A file that does not parse: no edits, no error, and the server goes on.
     let uri3 = "file:///tmp/broken.lsy";
     c.open(uri3, "lsystem A {\n  axiom F;\n  F -> F[+F;\n  oops (\n");
-    let edits = c.request("textDocument/formatting", json!({"textDocument": {"uri": uri3}, "options": opts}));
+    let edits = c.request(
+        "textDocument/formatting",
+        json!({"textDocument": {"uri": uri3}, "options": opts}),
+    );
     assert!(edits.is_null() || edits == json!([]), "{edits}");
     assert_eq!(c.request("shutdown", Value::Null), Value::Null);
     c.notify("exit", Value::Null);
@@ -514,7 +569,10 @@ fn positions_count_utf16_code_units() {
     let text = "const a = 1; /* é 𝄞 */ const b = nope;\nlsystem L { axiom F(a + b); }\n";
     let d = c.open("file:///tmp/utf16.lsy", text);
     let ds = d["diagnostics"].as_array().expect("diagnostics");
-    let e = ds.iter().find(|d| d["code"] == "E0302").unwrap_or_else(|| panic!("{d}"));
+    let e = ds
+        .iter()
+        .find(|d| d["code"] == "E0302")
+        .unwrap_or_else(|| panic!("{d}"));
     assert_eq!(e["range"]["start"], pos(text, "nope", 0));
     assert_eq!(e["range"]["start"]["character"], 34);
     // Hover after the wide characters lands on the right name.
@@ -546,13 +604,23 @@ fn scene_hover_definition_and_query_modules() {
     }
     insta::assert_snapshot!("lsp_hover_palm", hovers);
     // `system Trunk;` in a guide goes to the lsystem.
-    let def = c.request("textDocument/definition", doc(pos(&text, "system Trunk", 0)));
+    let def = c.request(
+        "textDocument/definition",
+        doc(pos(&text, "system Trunk", 0)),
+    );
     // the position of `Trunk` in `system Trunk`
     let at = text.find("system Trunk").expect("system") + "system ".len();
     let def2 = c.request("textDocument/definition", doc(position_of(&text, at)));
     assert!(def.is_null() || def == def2);
-    assert_eq!(def2["range"]["start"], pos(&text, "Trunk(D, w)", 0), "{def2}");
-    let symbols = c.request("textDocument/documentSymbol", json!({"textDocument": {"uri": uri}}));
+    assert_eq!(
+        def2["range"]["start"],
+        pos(&text, "Trunk(D, w)", 0),
+        "{def2}"
+    );
+    let symbols = c.request(
+        "textDocument/documentSymbol",
+        json!({"textDocument": {"uri": uri}}),
+    );
     insta::assert_snapshot!("lsp_symbols_palm", show_symbols(&symbols, 0));
 }
 
@@ -562,12 +630,18 @@ fn scene_hover_definition_and_query_modules() {
 fn editor_support_files_fit_the_language() {
     let dir = root().join("editors/vscode");
     let json = |name: &str| -> Value {
-        let text = std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let text =
+            std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
         serde_json::from_str(&text).unwrap_or_else(|e| panic!("{name}: {e}"))
     };
     let pkg = json("package.json");
-    assert_eq!(pkg["contributes"]["languages"][0]["extensions"], json!([".lsy"]));
-    let grammar_path = pkg["contributes"]["grammars"][0]["path"].as_str().expect("grammar path");
+    assert_eq!(
+        pkg["contributes"]["languages"][0]["extensions"],
+        json!([".lsy"])
+    );
+    let grammar_path = pkg["contributes"]["grammars"][0]["path"]
+        .as_str()
+        .expect("grammar path");
     let grammar = json(grammar_path.trim_start_matches("./"));
     json("language-configuration.json");
     let lock = json("package-lock.json");
@@ -575,8 +649,12 @@ fn editor_support_files_fit_the_language() {
         lock["packages"][""]["dependencies"], pkg["dependencies"],
         "package-lock.json is out of date: run `npm install --package-lock-only` in editors/vscode"
     );
-    let client = std::fs::read_to_string(dir.join(pkg["main"].as_str().expect("main"))).expect("client");
-    assert!(client.contains("args: [\"lsp\"]"), "the client does not start `lsyc lsp`");
+    let client =
+        std::fs::read_to_string(dir.join(pkg["main"].as_str().expect("main"))).expect("client");
+    assert!(
+        client.contains("args: [\"lsp\"]"),
+        "the client does not start `lsyc lsp`"
+    );
     let text = grammar.to_string();
     let lexer_keywords: Vec<&str> = lsyc::lsp::words::KEYWORDS
         .iter()
@@ -588,9 +666,18 @@ fn editor_support_files_fit_the_language() {
         .collect();
     assert!(lexer_keywords.len() > 20, "{lexer_keywords:?}");
     for w in lexer_keywords {
-        assert!(text.contains(w), "the grammar does not highlight the keyword `{w}`");
+        assert!(
+            text.contains(w),
+            "the grammar does not highlight the keyword `{w}`"
+        );
     }
     for b in lsyc::builtins::BUILTINS {
-        assert!(text.contains(&format!("|{}|", b.name)) || text.contains(&format!("({}|", b.name)) || text.contains(&format!("|{})", b.name)), "the grammar does not know `{}`", b.name);
+        assert!(
+            text.contains(&format!("|{}|", b.name))
+                || text.contains(&format!("({}|", b.name))
+                || text.contains(&format!("|{})", b.name)),
+            "the grammar does not know `{}`",
+            b.name
+        );
     }
 }
