@@ -86,6 +86,9 @@ pub enum Command {
     )]
     Edit(edit::Args),
     /// A Language Server on stdin and stdout, for editors (docs/lsp.md).
+    #[command(
+        after_help = "Examples:\n  lsyc lsp       # started by an editor's LSP client; see editors/README.md"
+    )]
     Lsp(lsp::Args),
 }
 
