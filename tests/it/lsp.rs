@@ -681,3 +681,68 @@ fn editor_support_files_fit_the_language() {
         );
     }
 }
+
+/// Over the gallery and the test corpus (valid, broken and hostile programs):
+/// every use the index finds lies in the text on character boundaries and
+/// names what is written there; every use of a declared thing goes to a
+/// declaration of the same name; hover, completion, symbols, prepareRename and
+/// formatting answer at every name without panicking; formatting's edits give
+/// `fmt`'s text whenever the file parses.
+#[test]
+fn every_file_every_name() {
+    use lsyc::lsp::index::Target;
+    use lsyc::lsp::{Analysis, complete, format, hover, outline, rename};
+    let files = crate::support::lsy_files(&["lang-examples", "tests/data"]);
+    assert!(files.len() > 60, "{}", files.len());
+    let mut names = 0;
+    for path in files {
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue; // invalid UTF-8 on purpose: an editor would not send it
+        };
+        if text.len() > 1 << 20 {
+            continue;
+        }
+        let rel = crate::support::rel(&path);
+        let a = Analysis::new(text.clone());
+        for o in &a.index.occurrences {
+            let (s, e) = (o.span.start as usize, o.span.end as usize);
+            assert!(e <= text.len() && text.is_char_boundary(s) && text.is_char_boundary(e), "{rel}: {o:?}");
+            let written = &text[s..e];
+            match &o.target {
+                Target::Symbol(id) => {
+                    let sym = &a.index.symbols[*id];
+                    assert_eq!(written, sym.name, "{rel}: {o:?}");
+                    if let Some(d) = sym.decl {
+                        assert_eq!(&text[d.range()], sym.name, "{rel}: declaration of {}", sym.name);
+                    }
+                    names += 1;
+                }
+                Target::Query(q) => assert_eq!(written, q, "{rel}"),
+                Target::Turtle(c) => assert_eq!(written, c.to_string(), "{rel}"),
+                Target::Cut => assert_eq!(written, "cut", "{rel}"),
+                Target::Function(f) => assert_eq!(written, f, "{rel}"),
+            }
+            assert!(hover::hover(&a, s).is_some(), "{rel}: no hover at {o:?}");
+            assert!(a.index.at(s).is_some(), "{rel}");
+            if matches!(o.target, Target::Symbol(_)) {
+                assert!(rename::prepare(&a, s).is_ok(), "{rel}: {o:?}");
+            }
+        }
+        // Completion anywhere (every 97th byte on a boundary) answers.
+        for off in (0..=text.len()).step_by(97).filter(|&o| text.is_char_boundary(o)) {
+            complete::complete(&a, off);
+            hover::hover(&a, off);
+        }
+        outline::outline(&a);
+        let parsed = lsyc::parser::parse(&text);
+        match format::format(&text) {
+            Some(edits) => {
+                let want = lsyc::fmt::format_file(&parsed.file);
+                let edits = serde_json::to_value(edits).expect("json");
+                assert_eq!(apply(&text, &edits), want, "{rel}");
+            }
+            None => assert!(parsed.diagnostics.iter().any(|d| d.is_error()), "{rel}"),
+        }
+    }
+    assert!(names > 2000, "only {names} names indexed");
+}
