@@ -485,3 +485,76 @@ impl Builder {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lsp::{Analysis, rename};
+
+    fn uses(a: &Analysis, name: &str, kind: Kind) -> Vec<String> {
+        let id = a
+            .index
+            .symbols
+            .iter()
+            .position(|s| s.name == name && s.kind == kind)
+            .unwrap_or_else(|| panic!("no {kind:?} {name}"));
+        a.index
+            .occurrences_of(&Target::Symbol(id))
+            .map(|o| format!("{}{}", a.line_of(o.span), if o.decl { "d" } else { "" }))
+            .collect()
+    }
+
+    const SRC: &str = "const l = 1;\n\
+        lsystem T(n) {\n\
+        axiom A(l + n);\n\
+        A(l) : l < 9 -> F(l) A(l + 1);\n\
+        }\n\
+        lsystem U { axiom A(l); }\n\
+        scene S {\n\
+        guide g { polygon (0, 0) (1, 0) (1, l); system T; }\n\
+        guide h { polygon (0, 0) (1, 0) (1, 1); system U; }\n\
+        link g.edge(0) -> h.edge(1) { tokens l; }\n\
+        }\n";
+
+    #[test]
+    fn scopes_follow_the_language() {
+        let a = Analysis::new(SRC.to_string());
+        assert!(
+            a.diagnostics.iter().all(|d| !d.is_error()),
+            "{:?}",
+            a.diagnostics
+        );
+        // The rule's `l` shadows the constant; the axioms see the constant.
+        assert_eq!(uses(&a, "l", Kind::Const), ["1d", "3", "6", "8", "10"]);
+        assert_eq!(uses(&a, "l", Kind::Param), ["4d", "4", "4", "4"]);
+        assert_eq!(uses(&a, "n", Kind::Param), ["2d", "3"]);
+        // `A` of T and `A` of U are different letter modules.
+        let letters: Vec<_> = a.index.symbols.iter().filter(|s| s.name == "A").collect();
+        assert_eq!(letters.len(), 2);
+        assert_eq!(uses(&a, "T", Kind::Lsystem), ["2d", "8"]);
+        assert_eq!(uses(&a, "g", Kind::Guide), ["8d", "10"]);
+    }
+
+    #[test]
+    fn renames_keep_the_meaning() {
+        let a = Analysis::new(SRC.to_string());
+        let at = |needle: &str| SRC.find(needle).expect("needle");
+        assert_eq!(
+            rename::rename(&a, at("l = 1"), "len").map(|e| e.len()),
+            Ok(5)
+        );
+        assert_eq!(rename::rename(&a, at("l) :"), "k").map(|e| e.len()), Ok(4));
+        // The parameter `n` would capture the constant's use in T's axiom.
+        assert!(rename::rename(&a, at("l = 1"), "n").is_err());
+        // A letter module stays one letter; `F` would draw.
+        assert!(rename::rename(&a, at("A(l) :"), "Apex").is_err());
+        assert!(rename::rename(&a, at("A(l) :"), "F").is_err());
+        assert_eq!(
+            rename::rename(&a, at("A(l) :"), "B").map(|e| e.len()),
+            Ok(3)
+        );
+        assert!(rename::rename(&a, at("g {"), "h").is_err(), "taken");
+        assert!(rename::rename(&a, at("g {"), "axiom").is_err(), "a keyword");
+        assert!(rename::rename(&a, at("l = 1"), "2x").is_err(), "not a name");
+    }
+}

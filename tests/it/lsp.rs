@@ -706,14 +706,22 @@ fn every_file_every_name() {
         let a = Analysis::new(text.clone());
         for o in &a.index.occurrences {
             let (s, e) = (o.span.start as usize, o.span.end as usize);
-            assert!(e <= text.len() && text.is_char_boundary(s) && text.is_char_boundary(e), "{rel}: {o:?}");
+            assert!(
+                e <= text.len() && text.is_char_boundary(s) && text.is_char_boundary(e),
+                "{rel}: {o:?}"
+            );
             let written = &text[s..e];
             match &o.target {
                 Target::Symbol(id) => {
                     let sym = &a.index.symbols[*id];
                     assert_eq!(written, sym.name, "{rel}: {o:?}");
                     if let Some(d) = sym.decl {
-                        assert_eq!(&text[d.range()], sym.name, "{rel}: declaration of {}", sym.name);
+                        assert_eq!(
+                            &text[d.range()],
+                            sym.name,
+                            "{rel}: declaration of {}",
+                            sym.name
+                        );
                     }
                     names += 1;
                 }
@@ -729,7 +737,10 @@ fn every_file_every_name() {
             }
         }
         // Completion anywhere (every 97th byte on a boundary) answers.
-        for off in (0..=text.len()).step_by(97).filter(|&o| text.is_char_boundary(o)) {
+        for off in (0..=text.len())
+            .step_by(97)
+            .filter(|&o| text.is_char_boundary(o))
+        {
             complete::complete(&a, off);
             hover::hover(&a, off);
         }
