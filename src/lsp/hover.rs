@@ -113,8 +113,10 @@ pub fn turtle_text(w: &words::TurtleWord) -> String {
     format!("```lsy\n{}\n```\n\nTurtle: {}.", w.form, w.meaning)
 }
 
-/// The comments a person wrote above and beside a node, without delimiters.
-fn comments(t: &Trivia) -> String {
+/// The comments a person wrote about a node: the block of comments right above
+/// it (not one a blank line keeps apart, such as a file's header) and the one
+/// beside it, without delimiters.
+fn comments(text: &str, t: &Trivia) -> String {
     let strip = |s: &str| -> String {
         let s = s.trim();
         let s = s.strip_prefix("//").unwrap_or(s);
@@ -122,7 +124,25 @@ fn comments(t: &Trivia) -> String {
         let s = s.strip_suffix("*/").unwrap_or(s);
         s.trim().to_string()
     };
-    let mut lines: Vec<String> = t.leading.iter().map(|c| strip(&c.text)).collect();
+    let mut block = 0;
+    if !t.blank_after_leading {
+        for (i, c) in t.leading.iter().enumerate().rev() {
+            block += 1;
+            let Some(prev) = i.checked_sub(1).map(|j| &t.leading[j]) else {
+                break;
+            };
+            let gap = text
+                .get(prev.span.end as usize..c.span.start as usize)
+                .unwrap_or("");
+            if gap.matches('\n').count() > 1 {
+                break;
+            }
+        }
+    }
+    let mut lines: Vec<String> = t.leading[t.leading.len() - block..]
+        .iter()
+        .map(|c| strip(&c.text))
+        .collect();
     if let Some(c) = &t.trailing {
         lines.push(strip(&c.text));
     }
@@ -183,7 +203,7 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
                     c.name.name,
                     format_expr(&c.value)
                 ));
-                let doc = comments(trivia);
+                let doc = comments(&a.text, trivia);
                 if !doc.is_empty() {
                     parts.push(doc);
                 }
@@ -225,7 +245,7 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
                     params(&m.params)
                 ));
                 if let Some(t) = trivia {
-                    let doc = comments(t);
+                    let doc = comments(&a.text, t);
                     if !doc.is_empty() {
                         parts.push(doc);
                     }
@@ -265,7 +285,7 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
                     e.name.name,
                     props.join("\n")
                 ));
-                let doc = comments(trivia);
+                let doc = comments(&a.text, trivia);
                 if !doc.is_empty() {
                     parts.push(doc);
                 }
@@ -298,7 +318,7 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
                     }
                 }
                 parts.push(format!("```lsy\n{head}\n```"));
-                let doc = comments(trivia);
+                let doc = comments(&a.text, trivia);
                 if !doc.is_empty() {
                     parts.push(doc);
                 }
@@ -329,7 +349,7 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
                     .filter(|s| matches!(s.node, crate::ast::SceneStmt::Link(_)))
                     .count();
                 parts.push(format!("```lsy\nscene {}\n```", sc.name.name));
-                let doc = comments(trivia);
+                let doc = comments(&a.text, trivia);
                 if !doc.is_empty() {
                     parts.push(doc);
                 }
@@ -364,7 +384,7 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
                     }
                 }
                 parts.push(format!("```lsy\n{}\n```", lines.join("\n")));
-                let doc = comments(trivia);
+                let doc = comments(&a.text, trivia);
                 if !doc.is_empty() {
                     parts.push(doc);
                 }
