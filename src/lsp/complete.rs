@@ -156,6 +156,9 @@ fn symbol_item(out: &mut Out, a: &Analysis, s: &Symbol) {
 
 pub fn complete(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
     let offset = offset.min(a.text.len());
+    if !a.text.is_char_boundary(offset) || super::hover::in_line_comment(&a.text, offset) {
+        return Vec::new();
+    }
     let start = prefix_start(&a.text, offset);
     let mut out = Out {
         items: Vec::new(),
@@ -265,4 +268,35 @@ pub fn complete(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
         }
     }
     out.items
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nothing_in_comments_and_places_decide() {
+        let text = "// derive\nconst k = 2;\nlsystem A(n) {\n    axiom F(n);\n    F(x) -> F(x * k) // x\n;\n}\n";
+        let a = Analysis::new(text.to_string());
+        let labels = |off: usize| -> Vec<String> {
+            complete(&a, off).into_iter().map(|i| i.label).collect()
+        };
+        assert!(labels(5).is_empty(), "inside a comment");
+        assert!(labels(text.find("// x").expect("x") + 4).is_empty());
+        let top = labels(text.find("const").expect("const"));
+        assert!(
+            top.contains(&"lsystem".to_string()) && !top.contains(&"axiom".to_string()),
+            "{top:?}"
+        );
+        let rule = labels(text.find("x * k").expect("rule") + 4);
+        for want in ["x", "k", "F", "?X", "+", "axiom", "sqrt"] {
+            assert!(rule.contains(&want.to_string()), "{want}: {rule:?}");
+        }
+        assert!(
+            !rule.contains(&"n".to_string()),
+            "the lsystem's parameter is the axiom's only"
+        );
+        let axiom = labels(text.find("F(n)").expect("axiom") + 2);
+        assert!(axiom.contains(&"n".to_string()), "{axiom:?}");
+    }
 }

@@ -18,6 +18,7 @@ use lsp_types as lsp;
 pub fn hover(a: &Analysis, offset: usize) -> Option<lsp::Hover> {
     let (text, span) = match a.index.at(offset) {
         Some(o) => (target_text(a, &o.target)?, o.span),
+        None if in_line_comment(&a.text, offset) => return None,
         None => {
             let (word, span) = word_at(&a.text, offset)?;
             let k = words::keyword(word)?;
@@ -31,6 +32,26 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<lsp::Hover> {
         }),
         range: Some(a.range(span)),
     })
+}
+
+/// Whether an offset is after `//` on its line (outside a string).
+pub fn in_line_comment(text: &str, offset: usize) -> bool {
+    let offset = offset.min(text.len());
+    let Some(before) = text.get(..offset) else {
+        return false;
+    };
+    let line = &before[before.rfind('\n').map_or(0, |i| i + 1)..];
+    let mut in_str = false;
+    let mut prev = ' ';
+    for c in line.chars() {
+        match c {
+            '"' if prev != '\\' => in_str = !in_str,
+            '/' if prev == '/' && !in_str => return true,
+            _ => {}
+        }
+        prev = c;
+    }
+    false
 }
 
 /// The word (letters, digits, `_`) around an offset.
