@@ -62,7 +62,10 @@ fn prefix_start(text: &str, offset: usize) -> usize {
 /// its predecessor (and contexts), before `:` or `->`.
 fn typed_params(text: &str, offset: usize, item_start: usize) -> (Vec<String>, bool) {
     let before = &text[item_start..offset];
-    let start = before.rfind([';', '{', '}']).map_or(0, |i| i + 1);
+    // The statement starts after the last `;`, or after the lsystem's `{`
+    // (braces inside a body are polygon symbols, not blocks).
+    let open = before.find('{').map_or(0, |i| i + 1);
+    let start = before.rfind(';').map_or(0, |i| i + 1).max(open);
     let stmt = &before[start..];
     let lexed = lex(stmt);
     let toks: Vec<&Token> = lexed.tokens.iter().map(|(_, t, _)| t).collect();
@@ -276,7 +279,7 @@ mod tests {
 
     #[test]
     fn nothing_in_comments_and_places_decide() {
-        let text = "// derive\nconst k = 2;\nlsystem A(n) {\n    axiom F(n);\n    F(x) -> F(x * k) // x\n;\n}\n";
+        let text = "// derive\nconst k = 2;\nlsystem A(n) {\n    axiom F(n);\n    F(x) -> {F(x * k) // x\n;\n}\n";
         let a = Analysis::new(text.to_string());
         let labels = |off: usize| -> Vec<String> {
             complete(&a, off).into_iter().map(|i| i.label).collect()
