@@ -18,6 +18,7 @@ pub mod frontend;
 pub mod geometry;
 pub mod infer;
 pub mod lexer;
+pub mod lsp;
 pub mod number;
 pub mod parser;
 pub mod path;

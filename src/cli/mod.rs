@@ -8,6 +8,7 @@ mod docs;
 mod edit;
 mod fmt;
 mod infer;
+mod lsp;
 mod run;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -98,6 +99,11 @@ pub enum Command {
         after_help = "Examples:\n  lsyc man | man -l -\n  lsyc man run | man -l -\n  lsyc man > lsyc.1"
     )]
     Man(docs::ManArgs),
+    /// A Language Server on stdin and stdout, for editors (docs/lsp.md).
+    #[command(
+        after_help = "Examples:\n  lsyc lsp       # started by an editor's LSP client; see editors/README.md"
+    )]
+    Lsp(lsp::Args),
 }
 
 /// Where diagnostics go and how they look.
@@ -237,6 +243,7 @@ pub fn main() -> ExitCode {
         Command::Edit(args) => edit::run(args, &reporter),
         Command::Completions(args) => docs::completions(args, &reporter),
         Command::Man(args) => docs::man(args, &reporter),
+        Command::Lsp(args) => lsp::run(args),
     };
     ExitCode::from(status)
 }

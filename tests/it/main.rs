@@ -15,6 +15,7 @@ mod hostile_svg;
 mod infer;
 mod layers;
 mod lines;
+mod lsp;
 mod outputs;
 mod plants;
 mod roundtrip;

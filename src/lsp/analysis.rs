@@ -1,0 +1,135 @@
+//! One document's analysis: the checker's diagnostics and the symbol index,
+//! made again from the text on every change.
+//!
+//! Owns: the per-keystroke work (parse, check, index) and turning lsyc's
+//! diagnostics into the protocol's (ranges in UTF-16, codes, related places,
+//! warnings as warnings). It asks `frontend` exactly what `lsyc check` asks,
+//! so the editor and the command line never disagree.
+
+use super::index::Index;
+use super::text::LineIndex;
+use crate::ast::File;
+use crate::check::Checked;
+use crate::diagnostic::{Code, Diagnostic, Severity};
+use crate::frontend;
+use crate::source::MAX_SOURCE_BYTES;
+use crate::span::Span;
+use lsp_types as lsp;
+
+pub struct Analysis {
+    pub text: String,
+    pub lines: LineIndex,
+    pub file: File,
+    pub diagnostics: Vec<Diagnostic>,
+    /// The checker's findings (constants' values), when the file parsed.
+    pub checked: Option<Checked>,
+    pub index: Index,
+}
+
+impl Analysis {
+    pub fn new(text: String) -> Analysis {
+        let lines = LineIndex::new(&text);
+        if text.len() as u64 > MAX_SOURCE_BYTES {
+            let d = Diagnostic::error(
+                Code::FileTooLarge,
+                format!(
+                    "the document is {} MiB; lsyc reads programs up to {} MiB",
+                    text.len() / (1024 * 1024),
+                    MAX_SOURCE_BYTES / (1024 * 1024)
+                ),
+            )
+            .primary(Span::new(0, 0), "too large to check");
+            return Analysis {
+                text,
+                lines,
+                file: File::default(),
+                diagnostics: vec![d],
+                checked: None,
+                index: Index::default(),
+            };
+        }
+        let fe = frontend::run(&text, Vec::new(), &[]);
+        let index = Index::build(&fe.file);
+        Analysis {
+            text,
+            lines,
+            file: fe.file,
+            diagnostics: fe.diagnostics,
+            checked: fe.checked,
+            index,
+        }
+    }
+
+    pub fn range(&self, span: Span) -> lsp::Range {
+        self.lines.range(&self.text, span)
+    }
+
+    pub fn offset(&self, pos: lsp::Position) -> usize {
+        self.lines.offset(&self.text, pos)
+    }
+
+    /// The 1-based line of a span, for messages.
+    pub fn line_of(&self, span: Span) -> usize {
+        self.lines.line(span.start as usize) + 1
+    }
+
+    /// The source text of a span.
+    pub fn slice(&self, span: Span) -> &str {
+        self.text.get(span.range()).unwrap_or("")
+    }
+
+    /// The diagnostics as the protocol has them.
+    pub fn lsp_diagnostics(&self, uri: &lsp::Uri) -> Vec<lsp::Diagnostic> {
+        self.diagnostics
+            .iter()
+            .map(|d| self.convert(d, uri))
+            .collect()
+    }
+
+    fn convert(&self, d: &Diagnostic, uri: &lsp::Uri) -> lsp::Diagnostic {
+        let pi = d.labels.iter().position(|l| l.primary);
+        let range = pi.map_or_else(lsp::Range::default, |i| self.range(d.labels[i].span));
+        let mut message = d.message.clone();
+        for n in &d.notes {
+            message.push_str("\nnote: ");
+            message.push_str(n);
+        }
+        if let Some(h) = &d.help {
+            message.push_str("\nhelp: ");
+            message.push_str(h);
+        }
+        let related: Vec<lsp::DiagnosticRelatedInformation> = d
+            .labels
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| Some(*i) != pi)
+            .map(|(_, l)| lsp::DiagnosticRelatedInformation {
+                location: lsp::Location {
+                    uri: uri.clone(),
+                    range: self.range(l.span),
+                },
+                message: if l.message.is_empty() {
+                    "related".to_string()
+                } else {
+                    l.message.clone()
+                },
+            })
+            .collect();
+        let tags = matches!(d.code, Code::Unused | Code::UnusedParameter)
+            .then(|| vec![lsp::DiagnosticTag::UNNECESSARY]);
+        lsp::Diagnostic {
+            range,
+            severity: Some(match d.severity {
+                Severity::Error => lsp::DiagnosticSeverity::ERROR,
+                Severity::Warning => lsp::DiagnosticSeverity::WARNING,
+            }),
+            code: Some(lsp::NumberOrString::String(d.code.as_str().to_string())),
+            code_description: None,
+            source: Some("lsyc".to_string()),
+            message,
+            related_information: (!related.is_empty()).then_some(related),
+            tags,
+            data: None,
+        }
+    }
+}

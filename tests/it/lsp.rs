@@ -1,0 +1,759 @@
+//! `lsyc lsp` driven by a scripted client: the built binary on pipes, JSON-RPC
+//! with `Content-Length` framing, every wait bounded so that a hang fails the
+//! test instead of stalling CI.
+
+use crate::support::root;
+use serde_json::{Value, json};
+use std::collections::VecDeque;
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, channel};
+use std::time::{Duration, Instant};
+
+const WAIT: Duration = Duration::from_secs(20);
+
+struct Client {
+    child: Child,
+    stdin: ChildStdin,
+    rx: Receiver<Value>,
+    /// Notifications read while waiting for a response.
+    pending: VecDeque<Value>,
+    next_id: i64,
+}
+
+impl Client {
+    fn start() -> Client {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_lsyc"))
+            .arg("lsp")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("start lsyc lsp");
+        let stdin = child.stdin.take().expect("stdin");
+        let stdout = child.stdout.take().expect("stdout");
+        let (tx, rx) = channel();
+        std::thread::spawn(move || {
+            let mut r = BufReader::new(stdout);
+            while let Some(v) = read_frame(&mut r) {
+                if tx.send(v).is_err() {
+                    return;
+                }
+            }
+        });
+        Client {
+            child,
+            stdin,
+            rx,
+            pending: VecDeque::new(),
+            next_id: 1,
+        }
+    }
+
+    fn send_raw(&mut self, body: &[u8]) {
+        write!(self.stdin, "Content-Length: {}\r\n\r\n", body.len()).expect("write");
+        self.stdin.write_all(body).expect("write");
+        self.stdin.flush().expect("flush");
+    }
+
+    fn send(&mut self, v: &Value) {
+        self.send_raw(v.to_string().as_bytes());
+    }
+
+    fn recv(&mut self) -> Value {
+        match self.rx.recv_timeout(WAIT) {
+            Ok(v) => v,
+            Err(RecvTimeoutError::Timeout) => {
+                let _ = self.child.kill();
+                panic!("lsyc lsp did not answer within {WAIT:?}")
+            }
+            Err(RecvTimeoutError::Disconnected) => panic!("lsyc lsp closed its output"),
+        }
+    }
+
+    /// Sends a request and waits for its response (the whole message).
+    fn request_raw(&mut self, method: &str, params: Value) -> Value {
+        let id = self.next_id;
+        self.next_id += 1;
+        self.send(&json!({"jsonrpc": "2.0", "id": id, "method": method, "params": params}));
+        loop {
+            let v = self.recv();
+            if v.get("id") == Some(&json!(id)) {
+                return v;
+            }
+            self.pending.push_back(v);
+        }
+    }
+
+    /// A request's result; fails on an error response.
+    fn request(&mut self, method: &str, params: Value) -> Value {
+        let v = self.request_raw(method, params);
+        assert!(v.get("error").is_none(), "{method}: {v}");
+        v["result"].clone()
+    }
+
+    fn notify(&mut self, method: &str, params: Value) {
+        self.send(&json!({"jsonrpc": "2.0", "method": method, "params": params}));
+    }
+
+    /// The next notification of `method`.
+    fn notification(&mut self, method: &str) -> Value {
+        if let Some(i) = self.pending.iter().position(|v| v["method"] == method) {
+            return self.pending.remove(i).expect("present")["params"].clone();
+        }
+        loop {
+            let v = self.recv();
+            if v["method"] == method {
+                return v["params"].clone();
+            }
+            self.pending.push_back(v);
+        }
+    }
+
+    fn initialize(&mut self) -> Value {
+        let r = self.request(
+            "initialize",
+            json!({"processId": null, "rootUri": null, "capabilities": {}}),
+        );
+        self.notify("initialized", json!({}));
+        r
+    }
+
+    fn open(&mut self, uri: &str, text: &str) -> Value {
+        self.notify(
+            "textDocument/didOpen",
+            json!({"textDocument": {"uri": uri, "languageId": "lsy", "version": 1, "text": text}}),
+        );
+        self.notification("textDocument/publishDiagnostics")
+    }
+
+    /// Waits for the process to end and returns its exit code.
+    fn wait(mut self) -> Option<i32> {
+        let start = Instant::now();
+        loop {
+            if let Some(s) = self.child.try_wait().expect("wait") {
+                return s.code();
+            }
+            if start.elapsed() > WAIT {
+                let _ = self.child.kill();
+                panic!("lsyc lsp did not exit within {WAIT:?}");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+}
+
+impl Drop for Client {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn read_frame(r: &mut impl BufRead) -> Option<Value> {
+    let mut len = None;
+    loop {
+        let mut line = String::new();
+        if r.read_line(&mut line).ok()? == 0 {
+            return None;
+        }
+        let line = line.trim_end();
+        if line.is_empty() {
+            break;
+        }
+        if let Some(v) = line.strip_prefix("Content-Length: ") {
+            len = v.parse::<usize>().ok();
+        }
+    }
+    let mut body = vec![0; len?];
+    r.read_exact(&mut body).ok()?;
+    serde_json::from_slice(&body).ok()
+}
+
+fn pos(text: &str, needle: &str, nth: usize) -> Value {
+    let off = text
+        .match_indices(needle)
+        .nth(nth)
+        .unwrap_or_else(|| panic!("`{needle}` #{nth} not in the text"))
+        .0;
+    position_of(text, off)
+}
+
+/// A byte offset as an LSP position (UTF-16 columns), computed independently
+/// of the server.
+fn position_of(text: &str, off: usize) -> Value {
+    let before = &text[..off];
+    let line = before.matches('\n').count();
+    let start = before.rfind('\n').map_or(0, |i| i + 1);
+    let character: usize = before[start..].encode_utf16().count();
+    json!({"line": line, "character": character})
+}
+
+fn offset_of(text: &str, p: &Value) -> usize {
+    let line = p["line"].as_u64().expect("line") as usize;
+    let ch = p["character"].as_u64().expect("character") as usize;
+    let start: usize = text.split_inclusive('\n').take(line).map(str::len).sum();
+    let mut units = 0;
+    for (i, c) in text[start..].char_indices() {
+        if units >= ch || c == '\n' {
+            return start + i;
+        }
+        units += c.len_utf16();
+    }
+    text.len()
+}
+
+/// Applies text edits (non-overlapping) to a text.
+fn apply(text: &str, edits: &Value) -> String {
+    let mut spans: Vec<(usize, usize, String)> = edits
+        .as_array()
+        .expect("edits")
+        .iter()
+        .map(|e| {
+            (
+                offset_of(text, &e["range"]["start"]),
+                offset_of(text, &e["range"]["end"]),
+                e["newText"].as_str().expect("newText").to_string(),
+            )
+        })
+        .collect();
+    spans.sort_by_key(|s| std::cmp::Reverse(s.0));
+    let mut out = text.to_string();
+    for (a, b, t) in spans {
+        out.replace_range(a..b, &t);
+    }
+    out
+}
+
+/// Diagnostics as lines for a snapshot: `line:col-line:col severity code message`.
+fn show_diagnostics(p: &Value) -> String {
+    let mut out = String::new();
+    for d in p["diagnostics"].as_array().expect("diagnostics") {
+        let r = &d["range"];
+        let sev = match d["severity"].as_u64() {
+            Some(1) => "error",
+            Some(2) => "warning",
+            _ => "?",
+        };
+        out.push_str(&format!(
+            "{}:{}-{}:{} {sev} {} {}\n",
+            r["start"]["line"].as_u64().expect("l") + 1,
+            r["start"]["character"].as_u64().expect("c") + 1,
+            r["end"]["line"].as_u64().expect("l") + 1,
+            r["end"]["character"].as_u64().expect("c") + 1,
+            d["code"].as_str().unwrap_or("-"),
+            d["message"].as_str().unwrap_or("").replace('\n', "\n    "),
+        ));
+        for rel in d["relatedInformation"].as_array().into_iter().flatten() {
+            let r = &rel["location"]["range"];
+            out.push_str(&format!(
+                "    related {}:{}: {}\n",
+                r["start"]["line"].as_u64().expect("l") + 1,
+                r["start"]["character"].as_u64().expect("c") + 1,
+                rel["message"].as_str().unwrap_or("")
+            ));
+        }
+    }
+    out
+}
+
+fn hover_text(v: &Value) -> String {
+    v["contents"]["value"]
+        .as_str()
+        .unwrap_or_else(|| panic!("no hover: {v}"))
+        .to_string()
+}
+
+fn gallery(name: &str) -> String {
+    std::fs::read_to_string(root().join("lang-examples").join(name)).expect("gallery program")
+}
+
+#[test]
+fn session_on_a_gallery_program() {
+    let text = gallery("monopodial-tree.lsy");
+    let uri = "file:///gallery/monopodial-tree.lsy";
+    let mut c = Client::start();
+
+    // Before initialize, a request is refused with the protocol's error.
+    let early = c.request_raw("textDocument/hover", json!({}));
+    assert_eq!(early["error"]["code"], -32002, "{early}");
+
+    let init = c.initialize();
+    let caps = &init["capabilities"];
+    for cap in [
+        "hoverProvider",
+        "definitionProvider",
+        "completionProvider",
+        "documentSymbolProvider",
+        "documentFormattingProvider",
+        "renameProvider",
+    ] {
+        assert!(
+            caps.get(cap).is_some_and(|v| !v.is_null()),
+            "{cap} missing: {caps}"
+        );
+    }
+    assert_eq!(init["serverInfo"]["name"], "lsyc");
+
+    // A gallery program: no diagnostics.
+    let d = c.open(uri, &text);
+    assert_eq!(d["uri"], uri);
+    assert_eq!(d["diagnostics"], json!([]), "{d}");
+
+    // Hover: a constant's value and comment, a letter module, a parameter, a
+    // turtle symbol.
+    let doc = |p: Value| json!({"textDocument": {"uri": uri}, "position": p});
+    let mut hovers = String::new();
+    for (needle, nth, what) in [
+        ("r2 ", 0, "constant at its declaration"),
+        ("r2,", 0, "constant in a rule"),
+        ("B(l", 0, "letter module"),
+        ("l * r1", 0, "rule parameter"),
+        ("&(a0)", 0, "turtle symbol"),
+        ("$C", 0, "roll to horizontal"),
+    ] {
+        let h = c.request("textDocument/hover", doc(pos(&text, needle, nth)));
+        hovers.push_str(&format!("--- {what} (`{needle}`)\n{}\n", hover_text(&h)));
+    }
+    insta::assert_snapshot!("lsp_hover_monopodial", hovers);
+
+    // Definition: the constant's declaration, from its use in a rule.
+    let def = c.request("textDocument/definition", doc(pos(&text, "r2,", 0)));
+    assert_eq!(def["uri"], uri);
+    assert_eq!(def["range"]["start"], pos(&text, "r2 =", 0), "{def}");
+    // A letter module's "definition" is the rule that rewrites it.
+    let def = c.request("textDocument/definition", doc(pos(&text, "C(l * r2", 0)));
+    assert_eq!(def["range"]["start"], pos(&text, "C(l, w)", 0), "{def}");
+
+    // Completion inside a rule: its parameters, the constants, the query
+    // modules with their signatures, turtle symbols and keywords.
+    let items = c.request("textDocument/completion", doc(pos(&text, "l * r2", 0)));
+    let labels: Vec<&str> = items
+        .as_array()
+        .expect("items")
+        .iter()
+        .map(|i| i["label"].as_str().expect("label"))
+        .collect();
+    for want in [
+        "l", "w", "r1", "wr", "A", "B", "?X", "?N_G", "+", "axiom", "sin",
+    ] {
+        assert!(
+            labels.contains(&want),
+            "completion lacks `{want}`: {labels:?}"
+        );
+    }
+    let qx = items
+        .as_array()
+        .expect("items")
+        .iter()
+        .find(|i| i["label"] == "?X")
+        .expect("?X");
+    assert_eq!(qx["detail"], "?X(found, id, delta, …)");
+    // After `?`, only query modules, replacing the `?` typed.
+    let mut typing = text.clone();
+    let at = typing.find("A(l * r1").expect("A");
+    typing.insert_str(at, "?N");
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 2}, "contentChanges": [{"text": typing}]}),
+    );
+    c.notification("textDocument/publishDiagnostics");
+    let items = c.request("textDocument/completion", doc(position_of(&typing, at + 2)));
+    let items = items.as_array().expect("items");
+    assert!(
+        items
+            .iter()
+            .all(|i| i["label"].as_str().is_some_and(|l| l.starts_with('?'))),
+        "{items:?}"
+    );
+    assert_eq!(
+        items[0]["textEdit"]["range"]["start"],
+        position_of(&typing, at)
+    );
+
+    // Back to the program, then break it: diagnostics with codes on the right lines.
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 3}, "contentChanges": [{"text": text}]}),
+    );
+    assert_eq!(
+        c.notification("textDocument/publishDiagnostics")["diagnostics"],
+        json!([])
+    );
+    let broken = text
+        .replace("B(l * r2, w * wr)]/(d)", "B(l * r3, w * wr)]/(d)")
+        .replace("C(l * r1, w * wr);\n    C", "C(l * r1);\n    C")
+        + "const unused = 1;\n";
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 4}, "contentChanges": [{"text": broken}]}),
+    );
+    let d = c.notification("textDocument/publishDiagnostics");
+    assert_eq!(d["version"], 4);
+    insta::assert_snapshot!("lsp_diagnostics_broken", show_diagnostics(&d));
+
+    // An incremental change: a syntax error typed into one line.
+    let at = broken.find("axiom A(100, 10);").expect("axiom") + "axiom".len();
+    let p = position_of(&broken, at);
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 5}, "contentChanges": [
+            {"range": {"start": p, "end": p}, "text": " ="}
+        ]}),
+    );
+    let d = c.notification("textDocument/publishDiagnostics");
+    let ds = d["diagnostics"].as_array().expect("diagnostics");
+    assert!(!ds.is_empty(), "{d}");
+    assert_eq!(ds[0]["code"], "E0201", "{d}");
+    assert_eq!(ds[0]["range"]["start"]["line"], p["line"], "{d}");
+
+    // Back to the gallery program: symbols and rename.
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 6}, "contentChanges": [{"text": text}]}),
+    );
+    c.notification("textDocument/publishDiagnostics");
+    let symbols = c.request(
+        "textDocument/documentSymbol",
+        json!({"textDocument": {"uri": uri}}),
+    );
+    insta::assert_snapshot!("lsp_symbols_monopodial", show_symbols(&symbols, 0));
+
+    let prep = c.request("textDocument/prepareRename", doc(pos(&text, "r2,", 0)));
+    assert_eq!(prep["placeholder"], "r2");
+    let edit = c.request(
+        "textDocument/rename",
+        json!({"textDocument": {"uri": uri}, "position": pos(&text, "r2,", 0), "newName": "q2"}),
+    );
+    let renamed = apply(&text, &edit["changes"][uri]);
+    // The declaration and its three uses; comments are left alone.
+    assert_eq!(renamed.matches("q2").count(), 4, "{renamed}");
+    assert_eq!(
+        renamed.matches("r2").count(),
+        text.matches("r2").count() - 4
+    );
+    assert!(renamed.contains("-D r2=0.9"), "{renamed}");
+    assert_eq!(
+        lsyc::frontend::run(&renamed, Vec::new(), &[])
+            .diagnostics
+            .len(),
+        0
+    );
+    // A module (here a letter) across the file.
+    let edit = c.request(
+        "textDocument/rename",
+        json!({"textDocument": {"uri": uri}, "position": pos(&text, "C(l * r2", 0), "newName": "K"}),
+    );
+    let renamed = apply(&text, &edit["changes"][uri]);
+    assert_eq!(renamed.matches("K(").count(), text.matches("C(").count());
+    // A rename that would let a parameter capture the constant is refused.
+    let refused = c.request_raw(
+        "textDocument/rename",
+        json!({"textDocument": {"uri": uri}, "position": pos(&text, "r2,", 0), "newName": "l"}),
+    );
+    assert!(refused.get("error").is_some(), "{refused}");
+    let refused = c.request_raw(
+        "textDocument/rename",
+        json!({"textDocument": {"uri": uri}, "position": pos(&text, "r2,", 0), "newName": "lsystem"}),
+    );
+    assert!(refused.get("error").is_some(), "{refused}");
+
+    // Broken messages and unknown methods: protocol errors, and the server goes on.
+    c.send_raw(b"{\"jsonrpc\": \"2.0\", \"id\": 99, \"method\"");
+    let e = c.recv();
+    assert_eq!(e["error"]["code"], -32700, "{e}");
+    assert_eq!(e["id"], Value::Null);
+    c.send_raw(b"[1, 2, 3]");
+    assert_eq!(c.recv()["error"]["code"], -32600);
+    let e = c.request_raw("lsyc/noSuchMethod", json!({}));
+    assert_eq!(e["error"]["code"], -32601, "{e}");
+    let e = c.request_raw("textDocument/hover", json!({"textDocument": 5}));
+    assert_eq!(e["error"]["code"], -32602, "{e}");
+    let e = c.request_raw("textDocument/hover", doc_of("file:///not/open.lsy"));
+    assert!(e.get("error").is_some(), "{e}");
+    // Still answering.
+    let h = c.request("textDocument/hover", doc(pos(&text, "r2,", 0)));
+    assert!(hover_text(&h).contains("const r2"));
+
+    // Shutdown, then exit: a clean end.
+    assert_eq!(c.request("shutdown", Value::Null), Value::Null);
+    let e = c.request_raw("textDocument/hover", doc(pos(&text, "r2,", 0)));
+    assert!(e.get("error").is_some(), "{e}");
+    c.notify("exit", Value::Null);
+    assert_eq!(c.wait(), Some(0));
+}
+
+fn doc_of(uri: &str) -> Value {
+    json!({"textDocument": {"uri": uri}, "position": {"line": 0, "character": 0}})
+}
+
+fn show_symbols(v: &Value, depth: usize) -> String {
+    let mut out = String::new();
+    for s in v.as_array().into_iter().flatten() {
+        out.push_str(&format!(
+            "{}{} [{}] {} line {}\n",
+            "  ".repeat(depth),
+            s["name"].as_str().unwrap_or("?"),
+            s["kind"],
+            s["detail"].as_str().unwrap_or(""),
+            s["selectionRange"]["start"]["line"].as_u64().unwrap_or(0) + 1
+        ));
+        out.push_str(&show_symbols(&s["children"], depth + 1));
+    }
+    out
+}
+
+#[test]
+fn formatting_gives_what_lsyc_fmt_prints() {
+    let mut c = Client::start();
+    c.initialize();
+    // A gallery scene, badly indented and spaced.
+    let canonical = gallery("palm.lsy");
+    let messy: String = canonical
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            let l = l.trim_start().replace(" -> ", "->").replace(", ", ",");
+            format!("{}{l}\n", " ".repeat(i % 7))
+        })
+        .collect();
+    assert_ne!(messy, canonical);
+    let dir = tempfile::tempdir().expect("tempdir");
+    let file = dir.path().join("messy.lsy");
+    std::fs::write(&file, &messy).expect("write");
+    let fmt = Command::new(env!("CARGO_BIN_EXE_lsyc"))
+        .arg("fmt")
+        .arg(&file)
+        .output()
+        .expect("lsyc fmt");
+    assert!(fmt.status.success());
+    let expected = String::from_utf8(fmt.stdout).expect("utf-8");
+
+    let uri = "file:///tmp/messy.lsy";
+    c.open(uri, &messy);
+    let opts = json!({"tabSize": 4, "insertSpaces": true});
+    let edits = c.request(
+        "textDocument/formatting",
+        json!({"textDocument": {"uri": uri}, "options": opts}),
+    );
+    assert!(!edits.as_array().expect("edits").is_empty());
+    assert_eq!(apply(&messy, &edits), expected);
+
+    // Already canonical: no edits.
+    let uri2 = "file:///tmp/palm.lsy";
+    c.open(uri2, &canonical);
+    let edits = c.request(
+        "textDocument/formatting",
+        json!({"textDocument": {"uri": uri2}, "options": opts}),
+    );
+    assert_eq!(edits, json!([]));
+
+    // A file that does not parse: no edits, no error, and the server goes on.
+    let uri3 = "file:///tmp/broken.lsy";
+    c.open(uri3, "lsystem A {\n  axiom F;\n  F -> F[+F;\n  oops (\n");
+    let edits = c.request(
+        "textDocument/formatting",
+        json!({"textDocument": {"uri": uri3}, "options": opts}),
+    );
+    assert!(edits.is_null() || edits == json!([]), "{edits}");
+    assert_eq!(c.request("shutdown", Value::Null), Value::Null);
+    c.notify("exit", Value::Null);
+    assert_eq!(c.wait(), Some(0));
+}
+
+#[test]
+fn positions_count_utf16_code_units() {
+    let mut c = Client::start();
+    c.initialize();
+    // `é` is one UTF-16 unit (two bytes), `𝄞` two units (four bytes).
+    let text = "const a = 1; /* é 𝄞 */ const b = nope;\nlsystem L { axiom F(a + b); }\n";
+    let d = c.open("file:///tmp/utf16.lsy", text);
+    let ds = d["diagnostics"].as_array().expect("diagnostics");
+    let e = ds
+        .iter()
+        .find(|d| d["code"] == "E0302")
+        .unwrap_or_else(|| panic!("{d}"));
+    assert_eq!(e["range"]["start"], pos(text, "nope", 0));
+    assert_eq!(e["range"]["start"]["character"], 34);
+    // Hover after the wide characters lands on the right name.
+    let h = c.request(
+        "textDocument/hover",
+        json!({"textDocument": {"uri": "file:///tmp/utf16.lsy"}, "position": pos(text, "b)", 0)}),
+    );
+    assert!(hover_text(&h).contains("const b"), "{h}");
+    drop(c);
+}
+
+#[test]
+fn scene_hover_definition_and_query_modules() {
+    let text = gallery("palm.lsy");
+    let uri = "file:///gallery/palm.lsy";
+    let mut c = Client::start();
+    c.initialize();
+    assert_eq!(c.open(uri, &text)["diagnostics"], json!([]));
+    let doc = |p: Value| json!({"textDocument": {"uri": uri}, "position": p});
+    let mut hovers = String::new();
+    for (needle, what) in [
+        ("?D_L(found, d, beta, _", "query module in a predecessor"),
+        ("found, d, beta, _", "query output"),
+        ("?X(D, w * 0.985)", "collision query"),
+        ("NEAR &&", "constant in a condition"),
+    ] {
+        let h = c.request("textDocument/hover", doc(pos(&text, needle, 0)));
+        hovers.push_str(&format!("--- {what} (`{needle}`)\n{}\n", hover_text(&h)));
+    }
+    insta::assert_snapshot!("lsp_hover_palm", hovers);
+    // `system Trunk;` in a guide goes to the lsystem.
+    let def = c.request(
+        "textDocument/definition",
+        doc(pos(&text, "system Trunk", 0)),
+    );
+    // the position of `Trunk` in `system Trunk`
+    let at = text.find("system Trunk").expect("system") + "system ".len();
+    let def2 = c.request("textDocument/definition", doc(position_of(&text, at)));
+    assert!(def.is_null() || def == def2);
+    assert_eq!(
+        def2["range"]["start"],
+        pos(&text, "Trunk(D, w)", 0),
+        "{def2}"
+    );
+    let symbols = c.request(
+        "textDocument/documentSymbol",
+        json!({"textDocument": {"uri": uri}}),
+    );
+    insta::assert_snapshot!("lsp_symbols_palm", show_symbols(&symbols, 0));
+}
+
+/// The VS Code extension's files are valid JSON, claim `.lsy`, start `lsyc
+/// lsp`, and the TextMate grammar knows every keyword and built-in function.
+#[test]
+fn editor_support_files_fit_the_language() {
+    let dir = root().join("editors/vscode");
+    let json = |name: &str| -> Value {
+        let text =
+            std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        serde_json::from_str(&text).unwrap_or_else(|e| panic!("{name}: {e}"))
+    };
+    let pkg = json("package.json");
+    assert_eq!(
+        pkg["contributes"]["languages"][0]["extensions"],
+        json!([".lsy"])
+    );
+    let grammar_path = pkg["contributes"]["grammars"][0]["path"]
+        .as_str()
+        .expect("grammar path");
+    let grammar = json(grammar_path.trim_start_matches("./"));
+    json("language-configuration.json");
+    let lock = json("package-lock.json");
+    assert_eq!(
+        lock["packages"][""]["dependencies"], pkg["dependencies"],
+        "package-lock.json is out of date: run `npm install --package-lock-only` in editors/vscode"
+    );
+    let client =
+        std::fs::read_to_string(dir.join(pkg["main"].as_str().expect("main"))).expect("client");
+    assert!(
+        client.contains("args: [\"lsp\"]"),
+        "the client does not start `lsyc lsp`"
+    );
+    let text = grammar.to_string();
+    let lexer_keywords: Vec<&str> = lsyc::lsp::words::KEYWORDS
+        .iter()
+        .map(|k| k.word)
+        .filter(|w| {
+            let lexed = lsyc::lexer::lex(w);
+            matches!(&lexed.tokens[..], [(_, t, _)] if t.is_keyword())
+        })
+        .collect();
+    assert!(lexer_keywords.len() > 20, "{lexer_keywords:?}");
+    for w in lexer_keywords {
+        assert!(
+            text.contains(w),
+            "the grammar does not highlight the keyword `{w}`"
+        );
+    }
+    for b in lsyc::builtins::BUILTINS {
+        assert!(
+            text.contains(&format!("|{}|", b.name))
+                || text.contains(&format!("({}|", b.name))
+                || text.contains(&format!("|{})", b.name)),
+            "the grammar does not know `{}`",
+            b.name
+        );
+    }
+}
+
+/// Over the gallery and the test corpus (valid, broken and hostile programs):
+/// every use the index finds lies in the text on character boundaries and
+/// names what is written there; every use of a declared thing goes to a
+/// declaration of the same name; hover, completion, symbols, prepareRename and
+/// formatting answer at every name without panicking; formatting's edits give
+/// `fmt`'s text whenever the file parses.
+#[test]
+fn every_file_every_name() {
+    use lsyc::lsp::index::Target;
+    use lsyc::lsp::{Analysis, complete, format, hover, outline, rename};
+    let files = crate::support::lsy_files(&["lang-examples", "tests/data"]);
+    assert!(files.len() > 60, "{}", files.len());
+    let mut names = 0;
+    for path in files {
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue; // invalid UTF-8 on purpose: an editor would not send it
+        };
+        if text.len() > 1 << 20 {
+            continue;
+        }
+        let rel = crate::support::rel(&path);
+        let a = Analysis::new(text.clone());
+        for o in &a.index.occurrences {
+            let (s, e) = (o.span.start as usize, o.span.end as usize);
+            assert!(
+                e <= text.len() && text.is_char_boundary(s) && text.is_char_boundary(e),
+                "{rel}: {o:?}"
+            );
+            let written = &text[s..e];
+            match &o.target {
+                Target::Symbol(id) => {
+                    let sym = &a.index.symbols[*id];
+                    assert_eq!(written, sym.name, "{rel}: {o:?}");
+                    if let Some(d) = sym.decl {
+                        assert_eq!(
+                            &text[d.range()],
+                            sym.name,
+                            "{rel}: declaration of {}",
+                            sym.name
+                        );
+                    }
+                    names += 1;
+                }
+                Target::Query(q) => assert_eq!(written, q, "{rel}"),
+                Target::Turtle(c) => assert_eq!(written, c.to_string(), "{rel}"),
+                Target::Cut => assert_eq!(written, "cut", "{rel}"),
+                Target::Function(f) => assert_eq!(written, f, "{rel}"),
+            }
+            assert!(hover::hover(&a, s).is_some(), "{rel}: no hover at {o:?}");
+            assert!(a.index.at(s).is_some(), "{rel}");
+            if matches!(o.target, Target::Symbol(_)) {
+                assert!(rename::prepare(&a, s).is_ok(), "{rel}: {o:?}");
+            }
+        }
+        // Completion anywhere (every 97th byte on a boundary) answers.
+        for off in (0..=text.len())
+            .step_by(97)
+            .filter(|&o| text.is_char_boundary(o))
+        {
+            complete::complete(&a, off);
+            hover::hover(&a, off);
+        }
+        outline::outline(&a);
+        let parsed = lsyc::parser::parse(&text);
+        match format::format(&text) {
+            Some(edits) => {
+                let want = lsyc::fmt::format_file(&parsed.file);
+                let edits = serde_json::to_value(edits).expect("json");
+                assert_eq!(apply(&text, &edits), want, "{rel}");
+            }
+            None => assert!(parsed.diagnostics.iter().any(|d| d.is_error()), "{rel}"),
+        }
+    }
+    assert!(names > 2000, "only {names} names indexed");
+}
