@@ -26,6 +26,7 @@ pub mod render;
 pub mod resolve;
 pub mod run;
 pub mod source;
+pub mod studio;
 pub mod span;
 pub mod trivia;
 pub mod turtle;

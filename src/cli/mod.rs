@@ -8,6 +8,7 @@ mod edit;
 mod fmt;
 mod infer;
 mod run;
+mod studio;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use lsyc::diagnostic::{self, Diagnostic, Format};
@@ -84,6 +85,11 @@ pub enum Command {
         after_help = "Examples:\n  lsyc edit palm.lsy --move frond4.v4=100,480 --pin trunk1\n  lsyc edit palm.lsy --by trunk3.v2=30,-5 --pin trunk2\n  lsyc edit palm.lsy --pin trunk1 --translate frond1=10,0 --rotate frond1=15 --write"
     )]
     Edit(edit::Args),
+    /// A live editor in the browser: edit, slide constants, step through growth, drag guides.
+    #[command(
+        after_help = "Examples:\n  lsyc studio lang-examples/palm.lsy\n  lsyc studio plant.lsy --port 0 --no-open"
+    )]
+    Studio(studio::Args),
 }
 
 /// Where diagnostics go and how they look.
@@ -221,6 +227,7 @@ pub fn main() -> ExitCode {
         Command::Run(args) => run::run(args, &reporter),
         Command::Infer(args) => infer::run(args, &reporter),
         Command::Edit(args) => edit::run(args, &reporter),
+        Command::Studio(args) => studio::run(args, &reporter),
     };
     ExitCode::from(status)
 }

@@ -35,6 +35,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("run", 12),
     ("edit", 12),
     ("infer", 12),
+    ("studio", 13),
 ];
 
 fn layer(module: &str) -> Option<u32> {
