@@ -184,7 +184,7 @@ fn disk(path: &Path) -> Json {
     match std::fs::read(path) {
         Ok(bytes) => {
             let src = crate::source::from_bytes(path.display().to_string(), &bytes);
-            json!({ "ok": true, "text": src.text, "version": version(&bytes) })
+            json!({ "ok": true, "name": path.display().to_string(), "text": src.text, "version": version(&bytes) })
         }
         Err(e) => json!({ "ok": false, "error": format!("cannot read `{}`: {e}", path.display()) }),
     }
