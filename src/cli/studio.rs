@@ -15,6 +15,11 @@ pub struct Args {
     #[arg(long, default_value_t = 7878)]
     pub port: u16,
 
+    /// Stop a run with an error before a step would hold more modules than this
+    /// (lower than `lsyc run`'s: every drawing goes to the browser).
+    #[arg(long, default_value_t = lsyc::studio::protocol::MAX_MODULES)]
+    pub max_modules: usize,
+
     /// Do not open a web browser.
     #[arg(long)]
     pub no_open: bool,
@@ -24,17 +29,23 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     if !args.file.exists()
         && let Err(e) = lsyc::source::write_atomic(&args.file, b"")
     {
-        reporter.error(&format!("cannot create `{}`: {e}", args.file.display()), None);
+        reporter.error(
+            &format!("cannot create `{}`: {e}", args.file.display()),
+            None,
+        );
         return 1;
     }
     if let Err(d) = lsyc::source::read(&args.file) {
         reporter.emit(&[d], &args.file.display().to_string(), "");
         return 1;
     }
-    let studio = match Studio::bind(&args.file, args.port) {
+    let studio = match Studio::bind(&args.file, args.port, args.max_modules) {
         Ok(s) => s,
         Err(e) => {
-            reporter.error(&e, Some("choose another port with --port, or --port 0 for any free one"));
+            reporter.error(
+                &e,
+                Some("choose another port with --port, or --port 0 for any free one"),
+            );
             return 1;
         }
     };
@@ -42,7 +53,10 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     let mut out = std::io::stdout();
     let _ = writeln!(out, "lsyc studio: {url}");
     let _ = out.flush();
-    reporter.info(&format!("editing {}; stop with Ctrl-C", args.file.display()));
+    reporter.info(&format!(
+        "editing {}; stop with Ctrl-C",
+        args.file.display()
+    ));
     if !args.no_open {
         // Opening a browser is a convenience: the address is printed either way.
         let _ = std::process::Command::new("xdg-open")

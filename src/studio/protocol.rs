@@ -22,6 +22,11 @@ use std::time::Instant;
 /// The most bytes of a derived string the page is sent.
 pub const STRING_LIMIT: usize = 200_000;
 
+/// The studio's default module limit (`lsyc studio --max-modules`): far below
+/// `lsyc run`'s, because every drawing goes to a browser as SVG and a run
+/// holds the worker until it ends; a step beyond it is error E0903.
+pub const MAX_MODULES: usize = 2_000_000;
+
 /// What every request that runs the program carries.
 #[derive(Clone, Debug, Default, Deserialize, PartialEq)]
 pub struct Program {
@@ -35,6 +40,10 @@ pub struct Program {
     /// Derivation steps (`-n`); the program's `derive` when absent.
     #[serde(default)]
     pub step: Option<u32>,
+    /// The module limit (the server's `--max-modules`; [`MAX_MODULES`] when
+    /// absent). Not the page's to choose.
+    #[serde(skip)]
+    pub max_modules: Option<usize>,
 }
 
 impl Program {
@@ -52,6 +61,10 @@ impl Program {
         Options {
             steps,
             seed: self.seed,
+            limits: crate::derive::Limits {
+                max_modules: self.max_modules.unwrap_or(MAX_MODULES),
+                ..crate::derive::Limits::default()
+            },
             ..Options::default()
         }
     }
@@ -320,8 +333,8 @@ pub fn derived_string(p: &Program) -> Result<(String, bool), Vec<Json>> {
     };
     let mut out = Vec::new();
     if has_scene(&fe.file) {
-        let r = run::run_scene(&fe.file, checked, None, &p.options(p.step))
-            .map_err(|d| fail(&[d]))?;
+        let r =
+            run::run_scene(&fe.file, checked, None, &p.options(p.step)).map_err(|d| fail(&[d]))?;
         for inst in &r.outcome.instances {
             let g = &r.scene.guides[inst.guide];
             out.extend_from_slice(format!("// {}\n", g.name).as_bytes());

@@ -38,6 +38,7 @@ pub struct Studio {
 
 struct State {
     path: PathBuf,
+    max_modules: usize,
     name: String,
     mailbox: Mutex<Option<Pending>>,
     ready: Condvar,
@@ -64,7 +65,8 @@ struct Envelope {
 
 impl Studio {
     /// Binds 127.0.0.1:`port` (0: any free port) to edit the file at `path`.
-    pub fn bind(path: &Path, port: u16) -> Result<Studio, String> {
+    /// `max_modules` bounds every run (see [`protocol::MAX_MODULES`]).
+    pub fn bind(path: &Path, port: u16, max_modules: usize) -> Result<Studio, String> {
         let server = tiny_http::Server::http(("127.0.0.1", port))
             .map_err(|e| format!("cannot listen on 127.0.0.1:{port}: {e}"))?;
         let port = server
@@ -74,6 +76,7 @@ impl Studio {
             .ok_or_else(|| "the server has no TCP address".to_string())?;
         let state = Arc::new(State {
             path: path.to_path_buf(),
+            max_modules,
             name: path.display().to_string(),
             mailbox: Mutex::new(None),
             ready: Condvar::new(),
@@ -244,11 +247,13 @@ fn api(state: &State, url: &str, body: &str) -> Result<Json, String> {
     let seq = serde_json::from_str::<Envelope>(body).map_err(bad)?.seq;
     match url {
         "/api/run" => {
-            let p: Program = serde_json::from_str(body).map_err(bad)?;
+            let mut p: Program = serde_json::from_str(body).map_err(bad)?;
+            p.max_modules = Some(state.max_modules);
             Ok(submit(state, seq, Job::Run(p)))
         }
         "/api/drag" => {
-            let d: Drag = serde_json::from_str(body).map_err(bad)?;
+            let mut d: Drag = serde_json::from_str(body).map_err(bad)?;
+            d.program.max_modules = Some(state.max_modules);
             Ok(submit(state, seq, Job::Drag(Box::new(d))))
         }
         "/api/const" => {
@@ -264,7 +269,8 @@ fn api(state: &State, url: &str, body: &str) -> Result<Json, String> {
             Ok(json!({ "ok": true, "source": text }))
         }
         "/api/string" => {
-            let p: Program = serde_json::from_str(body).map_err(bad)?;
+            let mut p: Program = serde_json::from_str(body).map_err(bad)?;
+            p.max_modules = Some(state.max_modules);
             Ok(match protocol::derived_string(&p) {
                 Ok((text, cut)) => json!({ "ok": true, "text": text, "cut": cut }),
                 Err(diagnostics) => json!({ "ok": false, "diagnostics": diagnostics }),

@@ -18,4 +18,5 @@ mod roundtrip;
 mod run;
 mod scene;
 mod sketch;
+mod studio;
 mod support;
