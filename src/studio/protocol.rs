@@ -423,6 +423,7 @@ impl DragSession {
                 edit::EditError::Input(m) | edit::EditError::Usage(m, _) => m,
             },
         )?;
+        let springs_ms = ms(start);
         let text = fmt::format_file(&file);
         let moved = Program {
             source: text.clone(),
@@ -440,6 +441,7 @@ impl DragSession {
             g.seeds = new.seeds;
         }
         let solved_ms = ms(start);
+        let check_ms = solved_ms - springs_ms;
         let outcome = self.runner.run().map_err(|d| d.message)?;
         let placeholder = env::Scene {
             name: String::new(),
@@ -457,7 +459,9 @@ impl DragSession {
         let guides = outlines(&r.scene);
         self.runner.scene = r.scene;
         let (svg, mut stats) = drawn.map_err(|d| d.message)?;
-        stats["solve_ms"] = Json::from(solved_ms);
+        let round = |v: f64| (v * 1e3).round() / 1e3;
+        stats["solve_ms"] = Json::from(round(springs_ms));
+        stats["check_ms"] = Json::from(round(check_ms));
         stats["total_ms"] = Json::from(ms(start));
         let recomputed = self
             .runner
