@@ -37,6 +37,8 @@ pub struct Studio {
 }
 
 struct State {
+    /// The addresses the page may be served from (`127.0.0.1:PORT`, `localhost:PORT`).
+    hosts: [String; 2],
     path: PathBuf,
     max_modules: usize,
     name: String,
@@ -75,6 +77,7 @@ impl Studio {
             .map(|a| a.port())
             .ok_or_else(|| "the server has no TCP address".to_string())?;
         let state = Arc::new(State {
+            hosts: [format!("127.0.0.1:{port}"), format!("localhost:{port}")],
             path: path.to_path_buf(),
             max_modules,
             name: path.display().to_string(),
@@ -203,7 +206,46 @@ pub fn version(bytes: &[u8]) -> String {
     format!("{h:016x}")
 }
 
+/// The value of a request's header.
+fn header<'a>(request: &'a tiny_http::Request, name: &str) -> Option<&'a str> {
+    request
+        .headers()
+        .iter()
+        .find(|h| h.field.as_str().as_str().eq_ignore_ascii_case(name))
+        .map(|h| h.value.as_str())
+}
+
+/// Why a request is refused, if it is: the studio answers only its own page.
+/// A `Host` other than its own address is a DNS-rebinding attempt; an
+/// `Origin` other than its own is another site's script; a POST that is not
+/// JSON could come from another site's form, which a browser sends without
+/// asking (JSON needs a preflight that the studio never grants).
+fn refused(state: &State, request: &tiny_http::Request) -> Option<&'static str> {
+    let host = header(request, "Host").unwrap_or("");
+    if !state.hosts.iter().any(|h| h == host) {
+        return Some("unknown host");
+    }
+    if let Some(origin) = header(request, "Origin")
+        && !state.hosts.iter().any(|h| origin == format!("http://{h}"))
+    {
+        return Some("another site's request");
+    }
+    let json = header(request, "Content-Type").is_some_and(|t| {
+        t.split(';')
+            .next()
+            .is_some_and(|m| m.trim() == "application/json")
+    });
+    if *request.method() == tiny_http::Method::Post && !json {
+        return Some("not a JSON request");
+    }
+    None
+}
+
 fn handle(state: &State, mut request: tiny_http::Request) {
+    if let Some(why) = refused(state, &request) {
+        let _ = request.respond(text_response(403, why));
+        return;
+    }
     let url = request.url().split('?').next().unwrap_or("/").to_string();
     let method = request.method().clone();
     if method == tiny_http::Method::Get {

@@ -279,12 +279,20 @@ fn serve(file: &Path) -> Server {
     Server { child, port }
 }
 
-/// One HTTP/1.1 request; returns the status and the body.
+/// One HTTP request as the page sends it; returns the status and the body.
 fn http(port: u16, method: &str, path: &str, body: &str) -> (u16, String) {
+    let headers = format!(
+        "Host: 127.0.0.1:{port}\r\nOrigin: http://127.0.0.1:{port}\r\nContent-Type: application/json\r\n"
+    );
+    raw(port, method, path, &headers, body)
+}
+
+/// One HTTP/1.0 request with the given header lines.
+fn raw(port: u16, method: &str, path: &str, headers: &str, body: &str) -> (u16, String) {
     let mut s = TcpStream::connect(("127.0.0.1", port)).expect("connects");
     write!(
         s,
-        "{method} {path} HTTP/1.0\r\nHost: 127.0.0.1\r\nConnection: close\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n{body}",
+        "{method} {path} HTTP/1.0\r\n{headers}Connection: close\r\nContent-Length: {}\r\n\r\n{body}",
         body.len()
     )
     .expect("sends");
@@ -403,6 +411,37 @@ fn save_writes_the_file_atomically() {
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .collect();
     assert_eq!(names, ["palm.lsy"], "no temporary file left");
+}
+
+#[test]
+fn other_sites_cannot_use_the_server() {
+    let (_dir, file) = scratch("palm.lsy");
+    let before = std::fs::read_to_string(&file).expect("reads");
+    let s = serve(&file);
+    let p = s.port;
+    let save = json!({ "text": "stolen" }).to_string();
+    let own = format!("Host: 127.0.0.1:{p}\r\n");
+    // Another site's form (text/plain, no preflight), another site's script,
+    // a rebound DNS name.
+    let attempts = [
+        format!("{own}Origin: http://evil.example\r\nContent-Type: text/plain\r\n"),
+        format!("{own}Origin: http://evil.example\r\nContent-Type: application/json\r\n"),
+        format!("{own}Content-Type: text/plain\r\n"),
+        "Host: evil.example\r\nContent-Type: application/json\r\n".to_string(),
+    ];
+    for headers in &attempts {
+        let (status, _) = raw(p, "POST", "/api/save", headers, &save);
+        assert_eq!(status, 403, "{headers}");
+    }
+    let (status, _) = raw(p, "GET", "/api/file", "Host: evil.example:80\r\n", "");
+    assert_eq!(status, 403);
+    assert_eq!(std::fs::read_to_string(&file).expect("reads"), before);
+    // The page itself (its own host, no Origin on a GET).
+    assert_eq!(raw(p, "GET", "/", &own, "").0, 200);
+    assert_eq!(
+        raw(p, "GET", "/", &format!("Host: localhost:{p}\r\n"), "").0,
+        200
+    );
 }
 
 #[test]
