@@ -113,6 +113,8 @@ impl Studio {
 
 /// The worker: takes the latest job, runs it, answers.
 fn work(state: &State) {
+    // The drag session outlives runs: a drag of the same program (text,
+    // constants, seed, step) goes on from its runner's cache.
     let mut session: Option<DragSession> = None;
     loop {
         let pending = {
@@ -130,10 +132,7 @@ fn work(state: &State) {
             }
         };
         let mut reply = match &pending.job {
-            Job::Run(p) => {
-                session = None;
-                serde_json::to_value(protocol::run(p, &state.name)).unwrap_or_default()
-            }
+            Job::Run(p) => serde_json::to_value(protocol::run(p, &state.name)).unwrap_or_default(),
             Job::Drag(d) => {
                 if !session.as_ref().is_some_and(|s| s.matches(&d.program)) {
                     session = DragSession::new(&d.program).ok();

@@ -408,11 +408,15 @@ function setupHandles() {
       drawHandles();
       return;
     }
-    const p = worldPoint(e);
-    if (!p) return;
+    const [guide, index] = vertex.split(/\.v(?=\d+$)/);
+    const at = state.guides.find((g) => g.name === guide)?.points[Number(index)];
+    if (!at) return;
     h.setPointerCapture(e.pointerId);
-    state.drag = { vertex, x: p.x, y: p.y, base: program(), moved: false, pointer: e.pointerId };
+    state.drag = { vertex, x: at[0], y: at[1], base: program(), moved: false, pointer: e.pointerId };
     h.classList.add("active");
+    // Starts the server's drag session (a full run) before the pointer moves,
+    // so that every move is an incremental one.
+    sendDrag(false);
   });
   ui.overlay.addEventListener("pointermove", (e) => {
     const d = state.drag;
