@@ -19,15 +19,38 @@ use lsyc::studio::protocol::{self, Drag, DragSession, Program};
 use std::hint::black_box;
 use std::time::Duration;
 
-/// (file, the vertex dragged, two places it is dragged to in turn)
-const SCENES: &[(&str, &str, [[f64; 2]; 2])] = &[
-    ("palm.lsy", "trunk3.v2", [[95.0, 336.0], [105.0, 332.0]]),
-    ("tree.lsy", "limbR1.v2", [[104.0, 102.0], [96.0, 98.0]]),
-    ("urban.lsy", "north.v2", [[130.0, 130.0], [124.0, 126.0]]),
+/// (file, the vertex dragged, two places it is dragged to in turn, the guides
+/// pinned: the base of the palm's trunk, the tree's trunk, the urban middle
+/// district, as a person holds them)
+type Case = (
+    &'static str,
+    &'static str,
+    [[f64; 2]; 2],
+    &'static [&'static str],
+);
+const SCENES: &[Case] = &[
+    (
+        "palm.lsy",
+        "trunk3.v2",
+        [[95.0, 336.0], [105.0, 332.0]],
+        &["trunk1"],
+    ),
+    (
+        "tree.lsy",
+        "limbR1.v2",
+        [[104.0, 102.0], [96.0, 98.0]],
+        &["trunk"],
+    ),
+    (
+        "urban.lsy",
+        "north.v2",
+        [[130.0, 130.0], [124.0, 126.0]],
+        &["middle"],
+    ),
 ];
 
 fn studio(c: &mut Criterion) {
-    for (file, vertex, places) in SCENES {
+    for (file, vertex, places, pins) in SCENES {
         let path = format!("{}/lang-examples/{file}", env!("CARGO_MANIFEST_DIR"));
         let text = std::fs::read_to_string(&path).expect("the gallery file");
         let p = Program {
@@ -60,7 +83,7 @@ fn studio(c: &mut Criterion) {
             vertex: vertex.to_string(),
             x: places[k][0],
             y: places[k][1],
-            pins: Vec::new(),
+            pins: pins.iter().map(|p| p.to_string()).collect(),
         };
         let warm = session.drag(&drag(0), file).expect("drags");
         eprintln!(

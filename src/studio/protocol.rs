@@ -418,11 +418,15 @@ impl DragSession {
             ops.push(edit::parse_pin(pin)?);
         }
         let mut file = self.file.clone();
-        edit::edit(&mut file, &self.checked, &ops, &edit::Options::default()).map_err(
-            |e| match e {
-                edit::EditError::Input(m) | edit::EditError::Usage(m, _) => m,
-            },
-        )?;
+        // Seeds go along with their guides (`--move-seeds`): a plant stays
+        // rooted in the guide a person drags.
+        let options = edit::Options {
+            scene: None,
+            move_seeds: true,
+        };
+        edit::edit(&mut file, &self.checked, &ops, &options).map_err(|e| match e {
+            edit::EditError::Input(m) | edit::EditError::Usage(m, _) => m,
+        })?;
         let springs_ms = ms(start);
         let text = fmt::format_file(&file);
         let moved = Program {

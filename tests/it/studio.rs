@@ -143,7 +143,7 @@ fn a_runtime_error_keeps_no_drawing_and_says_where() {
 }
 
 #[test]
-fn a_drag_writes_what_lsyc_edit_writes_and_draws_what_a_full_run_draws() {
+fn a_drag_writes_what_lsyc_edit_move_seeds_writes_and_draws_what_a_full_run_draws() {
     let rel = "lang-examples/palm.lsy";
     let text = read(rel);
     let p = program(&text);
@@ -171,6 +171,7 @@ fn a_drag_writes_what_lsyc_edit_writes_and_draws_what_a_full_run_draws() {
             "trunk3.v2=112.5,330",
             "--pin",
             "trunk1",
+            "--move-seeds",
         ])
         .output()
         .expect("runs");
