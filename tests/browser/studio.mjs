@@ -183,14 +183,14 @@ async function palm(browser, errors, timings) {
     const handles = await page.$$eval("[data-vertex]", (l) => l.map((e) => e.dataset.vertex));
     check(handles.includes("trunk3.v2") && handles.includes("frond4.v9"), `a handle per guide vertex (${handles.length})`);
 
-    // Pin the trunk's base, then drag the top of the trunk.
-    for (const v of ["trunk1.v0", "trunk1.v1"]) {
+    // Pin the lowest trunk guide, then drag the top of the trunk.
+    for (const v of ["trunk1.v0", "trunk1.v1", "trunk1.v2", "trunk1.v3"]) {
       const b = await page.locator(`[data-vertex="${v}"]`).first().boundingBox();
       await page.keyboard.down("Shift");
       await page.mouse.click(b.x + b.width / 2, b.y + b.height / 2);
       await page.keyboard.up("Shift");
     }
-    check((await page.$$(".handle.pinned")).length === 2, "shift-click pins two vertices");
+    check((await page.$$(".handle.pinned")).length === 4, "shift-click pins four vertices");
     const before = await drawing(page);
     const crownBefore = await page.$eval("[data-role=drawing] svg g[data-guide=frond4]", (g) => g.innerHTML);
     const h = page.locator('[data-vertex="trunk3.v2"]').last();
