@@ -28,6 +28,7 @@ pub mod resolve;
 pub mod run;
 pub mod source;
 pub mod span;
+pub mod studio;
 pub mod trivia;
 pub mod turtle;
 pub mod vm;

@@ -10,6 +10,7 @@ mod fmt;
 mod infer;
 mod lsp;
 mod run;
+mod studio;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use lsyc::diagnostic::{self, Diagnostic, Format};
@@ -104,6 +105,11 @@ pub enum Command {
         after_help = "Examples:\n  lsyc lsp       # started by an editor's LSP client; see editors/README.md"
     )]
     Lsp(lsp::Args),
+    /// A live editor in the browser: edit, slide constants, step through growth, drag guides.
+    #[command(
+        after_help = "Examples:\n  lsyc studio lang-examples/palm.lsy\n  lsyc studio plant.lsy --port 0 --no-open"
+    )]
+    Studio(studio::Args),
 }
 
 /// Where diagnostics go and how they look.
@@ -244,6 +250,7 @@ pub fn main() -> ExitCode {
         Command::Completions(args) => docs::completions(args, &reporter),
         Command::Man(args) => docs::man(args, &reporter),
         Command::Lsp(args) => lsp::run(args),
+        Command::Studio(args) => studio::run(args, &reporter),
     };
     ExitCode::from(status)
 }

@@ -36,6 +36,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("edit", 12),
     ("infer", 12),
     ("lsp", 12),
+    ("studio", 13),
 ];
 
 fn layer(module: &str) -> Option<u32> {

@@ -22,4 +22,5 @@ mod roundtrip;
 mod run;
 mod scene;
 mod sketch;
+mod studio;
 mod support;

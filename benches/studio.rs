@@ -1,0 +1,113 @@
+//! `lsyc studio`'s two latencies, server side, for the palm, the guided tree
+//! and the urban layout of the gallery (the files as they are):
+//! - **edit → drawing**: one edit of the text, answered as the page gets it:
+//!   parse, check, run the scene, write the SVG with its guide layers
+//!   (`protocol::run`, the path of `lsyc run -o x.svg --guides`);
+//! - **drag → redraw**: one move of a dragged guide vertex: the mass-spring
+//!   relaxation and write-back of `lsyc edit`, a check of the moved text, the
+//!   incremental scene runner (only the guides whose polygon changed and their
+//!   dependents run again), the SVG (`DragSession::drag`). Each iteration
+//!   moves the vertex to the other of two places, so every one is a real move.
+//!
+//! The browser adds its own time (the request, parsing and painting the SVG);
+//! `tests/browser/studio.mjs` prints the round trips it measured.
+//!
+//! `cargo bench --bench studio`.
+
+use criterion::{Criterion, SamplingMode, criterion_group};
+use lsyc::studio::protocol::{self, Drag, DragSession, Program};
+use std::hint::black_box;
+use std::time::Duration;
+
+/// (file, the vertex dragged, two places it is dragged to in turn, the guides
+/// pinned: the base of the palm's trunk, the tree's trunk, the urban middle
+/// district, as a person holds them)
+type Case = (
+    &'static str,
+    &'static str,
+    [[f64; 2]; 2],
+    &'static [&'static str],
+);
+const SCENES: &[Case] = &[
+    (
+        "palm.lsy",
+        "trunk3.v2",
+        [[95.0, 336.0], [105.0, 332.0]],
+        &["trunk1"],
+    ),
+    (
+        "tree.lsy",
+        "limbR1.v2",
+        [[104.0, 102.0], [96.0, 98.0]],
+        &["trunk"],
+    ),
+    (
+        "urban.lsy",
+        "north.v2",
+        [[130.0, 130.0], [124.0, 126.0]],
+        &["middle"],
+    ),
+];
+
+fn studio(c: &mut Criterion) {
+    for (file, vertex, places, pins) in SCENES {
+        let path = format!("{}/lang-examples/{file}", env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(&path).expect("the gallery file");
+        let p = Program {
+            source: text,
+            ..Program::default()
+        };
+        let first = protocol::run(&p, file);
+        assert!(first.ok, "{file}: {:?}", first.diagnostics);
+        let stats = first.stats.unwrap_or_default();
+        eprintln!(
+            "{file}: {} systems, {} modules, {} segments, {} elements; SVG {} bytes",
+            stats["systems"],
+            stats["modules"],
+            stats["segments"],
+            stats["elements"],
+            first.svg.map_or(0, |s| s.len())
+        );
+        let name = file.trim_end_matches(".lsy");
+        let mut g = c.benchmark_group(format!("studio/{name}"));
+        g.sampling_mode(SamplingMode::Flat)
+            .sample_size(10)
+            .warm_up_time(Duration::from_millis(500))
+            .measurement_time(Duration::from_secs(3));
+        g.bench_function("edit to drawing", |b| {
+            b.iter(|| black_box(protocol::run(black_box(&p), file)))
+        });
+        let mut session = DragSession::new(&p).expect("a scene");
+        let drag = |k: usize| Drag {
+            program: p.clone(),
+            vertex: vertex.to_string(),
+            x: places[k][0],
+            y: places[k][1],
+            pins: pins.iter().map(|p| p.to_string()).collect(),
+        };
+        // The first move runs every guide (the session's cache is empty); the
+        // second shows what a move recomputes.
+        session.drag(&drag(1), file).expect("drags");
+        let warm = session.drag(&drag(0), file).expect("drags");
+        eprintln!(
+            "{file}: dragging {vertex} recomputes {} of {} guides",
+            warm.recomputed.len(),
+            warm.guides.len()
+        );
+        let mut k = 0;
+        g.bench_function("drag to redraw", |b| {
+            b.iter(|| {
+                k ^= 1;
+                black_box(session.drag(&drag(k), file).expect("drags"))
+            })
+        });
+        g.finish();
+    }
+}
+
+criterion_group!(benches, studio);
+
+fn main() {
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

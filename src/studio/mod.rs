@@ -1,0 +1,17 @@
+//! `lsyc studio`: a live editor in the browser.
+//!
+//! Files, each named for what it owns:
+//! - `protocol` — the requests and replies, and running them through the
+//!   library as the command line does (no sockets, no files);
+//! - `server` — the HTTP server on 127.0.0.1, the worker thread that runs the
+//!   latest request, the file on disk;
+//! - `assets` — the page (HTML, JavaScript, CSS) compiled into the binary.
+//!
+//! The studio is the top layer: it calls `run`, `edit`, `env`, `fmt` and
+//! `frontend`, and nothing in the library calls it.
+
+pub mod assets;
+pub mod protocol;
+pub mod server;
+
+pub use server::Studio;
