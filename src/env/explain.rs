@@ -216,6 +216,10 @@ fn pending(prog: &Program, inst: &Instance) -> bool {
 /// The most steps a rerun gives a system cut short, to find how many it needs.
 const PROBE_STEPS: u32 = 2000;
 
+/// The most modules (all systems together) of a run whose systems cut short
+/// are rerun to find how many steps they need.
+const PROBE_MODULES: usize = 200_000;
+
 /// The warnings a finished run deserves (see the module note), in scene order.
 pub fn warnings(scene: &Scene, out: &Outcome, cfg: Config) -> Vec<Diagnostic> {
     let mut diags = Vec::new();
@@ -239,15 +243,18 @@ fn cut_short(scene: &Scene, out: &Outcome, cfg: Config, diags: &mut Vec<Diagnost
         return;
     }
     // Rerun with more steps for the programs cut short, to see when each
-    // system would have finished.
+    // system would have finished; not for a large scene, where the rerun
+    // would cost several times the run (the warning then gives no count).
+    let modules: usize = out.instances.iter().map(|i| i.string.syms.len()).sum();
     let mut more = scene.clone();
     for &(k, _) in &short {
         let p = scene.guides[out.instances[k].guide].program;
         let d = scene.programs[p].derive;
         more.programs[p].derive = d.max(PROBE_STEPS.min(d.saturating_mul(20).max(200)));
     }
-    let probe = execute(&more, cfg, &[], &mut Default::default())
-        .ok()
+    let probe = (modules <= PROBE_MODULES)
+        .then(|| execute(&more, cfg, &[], &mut Default::default()).ok())
+        .flatten()
         .map(|r| r.0);
     let mut told = vec![false; scene.programs.len()];
     for (k, nth) in short {
@@ -290,7 +297,9 @@ fn cut_short(scene: &Scene, out: &Outcome, cfg: Config, diags: &mut Vec<Diagnost
             Some((false, _, m)) => d.help(format!(
                 "it still had queries after {m} steps: its growth may not end by itself"
             )),
-            None => d,
+            None => d.help(
+                "raise its `derive` (each segment a query steers takes two steps: the query, then the segment)",
+            ),
         };
         diags.push(d);
     }
