@@ -364,17 +364,7 @@ impl Turtle<'_> {
                     cands.push((k + idx, w));
                 }
             }
-            let sum: f64 = cands.iter().map(|c| c.1).sum();
-            if sum > 0.0 {
-                let mut x = rng.uniform() * sum;
-                let mut pick = cands[cands.len() - 1].0;
-                for &(idx, w) in &cands {
-                    if x < w {
-                        pick = idx;
-                        break;
-                    }
-                    x -= w;
-                }
+            if let Some(pick) = rng.pick(&cands) {
                 chosen = Some(&rules[pick]);
             }
             self.cands = cands;

@@ -739,7 +739,6 @@ fn choose<'r>(
             }
         } else {
             weights.clear();
-            let mut sum = 0.0;
             for (idx, r) in rules[k..end].iter().enumerate() {
                 if bind(view, r, i, params, slots) && holds(chunk, r, slots, stack, rng)? {
                     let w = match r.weight {
@@ -747,21 +746,11 @@ fn choose<'r>(
                         None => 1.0,
                     };
                     if w > 0.0 {
-                        sum += w;
                         weights.push((k + idx, w));
                     }
                 }
             }
-            if sum > 0.0 {
-                let mut x = rng.uniform() * sum;
-                let mut pick = weights[weights.len() - 1].0;
-                for &(idx, w) in weights.iter() {
-                    if x < w {
-                        pick = idx;
-                        break;
-                    }
-                    x -= w;
-                }
+            if let Some(pick) = rng.pick(weights) {
                 let r = &rules[pick];
                 // Rebind: the slots hold the last candidate's context.
                 bind(view, r, i, params, slots);

@@ -179,6 +179,23 @@ impl Random {
         self.draw += 1;
         (mix(h) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
+
+    /// One of weighted candidates `(index, weight > 0)`, with probability in
+    /// proportion to its weight (one draw); `None` when the weights sum to 0.
+    pub fn pick(&mut self, cands: &[(usize, f64)]) -> Option<usize> {
+        let sum: f64 = cands.iter().map(|c| c.1).sum();
+        if sum <= 0.0 {
+            return None;
+        }
+        let mut x = self.uniform() * sum;
+        for &(idx, w) in cands {
+            if x < w {
+                return Some(idx);
+            }
+            x -= w;
+        }
+        cands.last().map(|c| c.0)
+    }
 }
 
 impl Chunk {
