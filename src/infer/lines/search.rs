@@ -192,31 +192,11 @@ fn cut(
         if len == 0 || i + len > n {
             return None;
         }
-        steps.clear();
-        let (mut draws, mut moves) = (0, 0);
+        shape_into(nodes, i, len, angles, &mut steps)?;
+        let draws = steps.iter().filter(|st| st.kind == Kind::Draw).count();
+        let moves = len - draws;
         let block = starts.len() as u32;
-        for (j, nd) in nodes.iter().enumerate().skip(i).take(len) {
-            match nd.kind {
-                Kind::Draw => draws += 1,
-                Kind::Move => moves += 1,
-            }
-            let local = nd.parent != ROOT && nd.parent as usize >= i;
-            let (from, turn) = if j == i {
-                (From::Start, 0)
-            } else if local {
-                (From::Local(nd.parent - i as u32), nd.turn)
-            } else if nd.parent == first.parent {
-                (From::Start, angles.norm(nd.turn - first.turn))
-            } else {
-                return None;
-            };
-            steps.push(Step {
-                kind: nd.kind,
-                from,
-                turn,
-            });
-            block_of[j] = block;
-        }
+        block_of[i..i + len].fill(block);
         let fits = match first.kind {
             Kind::Draw => draws == sizes.b && moves == sizes.c,
             Kind::Move => moves == sizes.s,
@@ -716,8 +696,21 @@ fn edge_grammars(
 
 /// The shape of a drawn copy of X one step down: its steps' sources and turns.
 fn shape_of(nodes: &[Node], start: usize, len: usize, angles: &Angles) -> Option<Vec<Step>> {
-    let first = nodes.get(start)?;
     let mut out = Vec::with_capacity(len);
+    shape_into(nodes, start, len, angles, &mut out)?;
+    Some(out)
+}
+
+/// `shape_of` into a reused buffer (cleared first).
+fn shape_into(
+    nodes: &[Node],
+    start: usize,
+    len: usize,
+    angles: &Angles,
+    out: &mut Vec<Step>,
+) -> Option<()> {
+    out.clear();
+    let first = nodes.get(start)?;
     for j in start..start + len {
         let nd = nodes.get(j)?;
         let local = nd.parent != ROOT && nd.parent as usize >= start;
@@ -736,7 +729,7 @@ fn shape_of(nodes: &[Node], start: usize, len: usize, angles: &Angles) -> Option
             turn,
         });
     }
-    Some(out)
+    Some(())
 }
 
 /// Whether `nodes[start..start + shape.len()]` has `shape` (as `shape_of`
