@@ -84,6 +84,7 @@ fn studio(c: &mut Criterion) {
             x: places[k][0],
             y: places[k][1],
             pins: pins.iter().map(|p| p.to_string()).collect(),
+            ..Drag::default()
         };
         // The first move runs every guide (the session's cache is empty); the
         // second shows what a move recomputes.

@@ -40,6 +40,10 @@ pub struct Program {
     /// Derivation steps (`-n`); the program's `derive` when absent.
     #[serde(default)]
     pub step: Option<u32>,
+    /// The camera of a 3D program (`--view AZ,EL`, degrees); the default
+    /// view when absent.
+    #[serde(default)]
+    pub view: Option<[f64; 2]>,
     /// The module limit (the server's `--max-modules`; [`MAX_MODULES`] when
     /// absent). Not the page's to choose.
     #[serde(skip)]
@@ -66,6 +70,13 @@ impl Program {
                 ..crate::derive::Limits::default()
             },
             ..Options::default()
+        }
+    }
+
+    fn picture(&self) -> Picture {
+        Picture {
+            view: self.view.filter(|v| v.iter().all(|a| a.is_finite())),
+            ..Picture::default()
         }
     }
 
@@ -109,10 +120,91 @@ pub struct RunReply {
     pub constants: Vec<Constant>,
     pub guides: Vec<GuideOutline>,
     pub is_scene: bool,
+    /// Whether the program draws in 3D (then the page orbits its view).
+    pub is_3d: bool,
     /// The source as `lsyc fmt` prints it (a drag or a slider writes this).
     pub formatted: Option<String>,
     /// Which guides a drag recomputed (the others came from the cache).
     pub recomputed: Vec<String>,
+    /// A scene's drawing: a hash of each guide's layer
+    /// (`<g class="guide-content" data-guide=…>`), by guide, so that the page
+    /// can say which layers it already shows.
+    pub layers: BTreeMap<String, String>,
+    /// Instead of `svg` (a drag whose request said which layers the page
+    /// has): the drawing's head, the layers that differ, and its tail.
+    pub patch: Option<Patch>,
+}
+
+/// A scene's drawing as the layers that changed: `head`, then every guide's
+/// layer in order (the page keeps the ones not sent), then `tail`, put
+/// together, are byte for byte the SVG `lsyc run -o x.svg --guides` writes.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct Patch {
+    /// Up to the first layer: the `<svg>` element with its view box, the
+    /// group of shared styles, the elements' `<defs>`.
+    pub head: String,
+    /// Every layer in drawing order: its guide and, if the page does not
+    /// have it yet, its text.
+    pub layers: Vec<(String, Option<String>)>,
+    /// After the last layer: the guide outlines, the links, the closing tags.
+    pub tail: String,
+}
+
+/// The opening of a guide's layer in a scene's SVG.
+const LAYER_START: &str = "<g class=\"guide-content\" data-guide=\"";
+
+/// A scene's SVG split into its head, its layers (the guide's name as the
+/// SVG writes it, XML-escaped, and the layer's text) and its tail; `None` if
+/// the text is not in that shape.
+pub fn split_layers(svg: &str) -> Option<(&str, Vec<(&str, &str)>, &str)> {
+    let first = svg.find(LAYER_START)?;
+    let mut layers = Vec::new();
+    let mut at = first;
+    while svg[at..].starts_with(LAYER_START) {
+        let name_start = at + LAYER_START.len();
+        let name_end = name_start + svg[name_start..].find('"')?;
+        // A layer holds paths and `<use>`s only: it ends at the next `</g>`.
+        let end = at + svg[at..].find("</g>\n")? + "</g>\n".len();
+        layers.push((&svg[name_start..name_end], &svg[at..end]));
+        at = end;
+    }
+    Some((&svg[..first], layers, &svg[at..]))
+}
+
+/// A stable hash of bytes (FNV-1a, 64 bits) as hex.
+pub fn hash(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bytes {
+        h ^= u64::from(*b);
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+/// The hash of every layer of a scene's SVG, by guide.
+fn layer_hashes(svg: &str) -> BTreeMap<String, String> {
+    split_layers(svg).map_or_else(BTreeMap::new, |(_, layers, _)| {
+        layers
+            .into_iter()
+            .map(|(name, text)| (name.to_string(), hash(text.as_bytes())))
+            .collect()
+    })
+}
+
+/// `svg` as a patch for a page that shows the layers `have` (guide → hash).
+fn patch(svg: &str, have: &BTreeMap<String, String>) -> Option<Patch> {
+    let (head, layers, tail) = split_layers(svg)?;
+    Some(Patch {
+        head: head.to_string(),
+        layers: layers
+            .into_iter()
+            .map(|(name, text)| {
+                let kept = have.get(name).is_some_and(|h| *h == hash(text.as_bytes()));
+                (name.to_string(), (!kept).then(|| text.to_string()))
+            })
+            .collect(),
+        tail: tail.to_string(),
+    })
 }
 
 /// Diagnostics as the CLI's JSON lines, with UTF-16 positions for the editor.
@@ -211,7 +303,10 @@ pub fn run(p: &Program, name: &str) -> RunReply {
             (svg, stats)
         })
     } else {
-        draw_system(&fe.file, checked, p, p.step)
+        draw_system(&fe.file, checked, p, p.step).map(|(svg, stats, is_3d)| {
+            reply.is_3d = is_3d;
+            (svg, stats)
+        })
     };
     let (svg, mut stats) = match drawn {
         Ok(v) => v,
@@ -226,13 +321,16 @@ pub fn run(p: &Program, name: &str) -> RunReply {
         let previous = if reply.is_scene {
             draw_scene(&fe.file, checked, p, Some(k - 1)).map(|(svg, ..)| svg)
         } else {
-            draw_system(&fe.file, checked, p, Some(k - 1)).map(|(svg, _)| svg)
+            draw_system(&fe.file, checked, p, Some(k - 1)).map(|(svg, ..)| svg)
         };
         reply.previous_svg = previous.ok();
     }
     stats["check_ms"] = Json::from(check_ms);
     stats["total_ms"] = Json::from(ms(start));
     reply.ok = true;
+    if reply.is_scene {
+        reply.layers = layer_hashes(&svg);
+    }
     reply.svg = Some(svg);
     reply.stats = Some(stats);
     reply
@@ -244,14 +342,14 @@ fn draw_system(
     checked: &Checked,
     p: &Program,
     steps: Option<u32>,
-) -> Result<(String, Json), Diagnostic> {
+) -> Result<(String, Json, bool), Diagnostic> {
     let derived = run::derive(file, checked, &p.options(steps), &|_, _| {})?;
     let start = Instant::now();
     let mut out = Vec::new();
     let drawn = run::write_output(
         &derived,
         run::Format::Svg,
-        Picture::default(),
+        p.picture(),
         p.seed,
         &mut out,
     )
@@ -260,6 +358,7 @@ fn draw_system(
     Ok((
         String::from_utf8_lossy(&out).into_owned(),
         serde_json::to_value(stats).unwrap_or_default(),
+        derived.prog.is_3d,
     ))
 }
 
@@ -281,17 +380,17 @@ fn draw_scene(
     steps: Option<u32>,
 ) -> Result<(String, Json, Vec<GuideOutline>), Diagnostic> {
     let r = run::run_scene(file, checked, None, &p.options(steps))?;
-    let (svg, stats) = scene_svg(&r, p.seed)?;
+    let (svg, stats) = scene_svg(&r, p)?;
     Ok((svg, stats, outlines(&r.scene)))
 }
 
-fn scene_svg(r: &SceneRun, seed: u64) -> Result<(String, Json), Diagnostic> {
+fn scene_svg(r: &SceneRun, p: &Program) -> Result<(String, Json), Diagnostic> {
     let mut out = Vec::new();
     let stats = run::write_scene(
         r,
         Some(run::Format::Svg),
-        Picture::default(),
-        seed,
+        p.picture(),
+        p.seed,
         true,
         &mut out,
     )
@@ -354,7 +453,7 @@ pub fn derived_string(p: &Program) -> Result<(String, bool), Vec<Json>> {
 }
 
 /// A drag of one guide vertex.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 pub struct Drag {
     #[serde(flatten)]
     pub program: Program,
@@ -365,6 +464,13 @@ pub struct Drag {
     /// Pinned vertices (`GUIDE.vN`) or guides (`GUIDE`), held while the rest relaxes.
     #[serde(default)]
     pub pins: Vec<String>,
+    /// Stiff springs between two vertices (`A.vI=B.vJ`, as `--stiff`).
+    #[serde(default)]
+    pub stiff: Vec<String>,
+    /// The layers the page shows (guide → hash, as `RunReply::layers`):
+    /// when given, the reply is a `patch` that leaves out the ones unchanged.
+    #[serde(default)]
+    pub have: Option<BTreeMap<String, String>>,
 }
 
 /// A scene being dragged: the program as it was when the drag began, and the
@@ -417,6 +523,9 @@ impl DragSession {
         for pin in &d.pins {
             ops.push(edit::parse_pin(pin)?);
         }
+        for pair in &d.stiff {
+            ops.push(edit::parse_stiff(pair)?);
+        }
         let mut file = self.file.clone();
         // Seeds go along with their guides (`--move-seeds`): a plant stays
         // rooted in the guide a person drags.
@@ -459,7 +568,7 @@ impl DragSession {
             derive_ms: ms(start) - solved_ms,
             limits: self.runner.cfg.limits,
         };
-        let drawn = scene_svg(&r, self.base.seed);
+        let drawn = scene_svg(&r, &self.base);
         let guides = outlines(&r.scene);
         self.runner.scene = r.scene;
         let (svg, mut stats) = drawn.map_err(|d| d.message)?;
@@ -476,9 +585,16 @@ impl DragSession {
             .filter(|(_, r)| **r)
             .map(|(g, _)| g.name.clone())
             .collect();
+        let layers = layer_hashes(&svg);
+        let (svg, patch) = match d.have.as_ref().and_then(|have| patch(&svg, have)) {
+            Some(p) => (None, Some(p)),
+            None => (Some(svg), None),
+        };
         Ok(RunReply {
             ok: true,
-            svg: Some(svg),
+            svg,
+            patch,
+            layers,
             diagnostics: diagnostics_json(&fe.diagnostics, name, &text),
             stats: Some(stats),
             constants: constants(&fe.file, checked),
@@ -489,4 +605,108 @@ impl DragSession {
             ..RunReply::default()
         })
     }
+}
+
+/// The formats the page can export the drawing to (`lsyc run -o x.EXT`).
+pub fn export_format(ext: &str) -> Option<(run::Format, &'static str)> {
+    Some(match ext {
+        "svg" => (run::Format::Svg, "image/svg+xml"),
+        "png" => (run::Format::Png, "image/png"),
+        "obj" => (run::Format::Obj, "text/plain"),
+        "glb" => (run::Format::Glb, "model/gltf-binary"),
+        _ => return None,
+    })
+}
+
+/// The program drawn as `lsyc run -o x.EXT` writes it (a scene with its
+/// guides, as `--guides`, in SVG and PNG), or what is wrong.
+pub fn export(p: &Program, ext: &str) -> Result<Vec<u8>, String> {
+    let (format, _) = export_format(ext).ok_or_else(|| format!("cannot export to .{ext}"))?;
+    let fe = p.frontend();
+    let Some(checked) = fe.checked.as_ref().filter(|_| !fe.has_errors()) else {
+        return Err("the program has errors; fix them before exporting".to_string());
+    };
+    let mut out = Vec::new();
+    let failed = |e: OutputError| output_diagnostic(e).message;
+    if has_scene(&fe.file) {
+        let r = run::run_scene(&fe.file, checked, None, &p.options(p.step))
+            .map_err(|d| d.message)?;
+        run::write_scene(&r, Some(format), p.picture(), p.seed, true, &mut out).map_err(failed)?;
+    } else {
+        let d = run::derive(&fe.file, checked, &p.options(p.step), &|_, _| {})
+            .map_err(|d| d.message)?;
+        run::write_output(&d, format, p.picture(), p.seed, &mut out).map_err(failed)?;
+    }
+    Ok(out)
+}
+
+/// The byte offset of UTF-16 offset `at` of `text` (clamped to the text).
+pub fn byte_offset(text: &str, at: usize) -> usize {
+    let mut units = 0;
+    for (i, c) in text.char_indices() {
+        if units >= at {
+            return i;
+        }
+        units += c.len_utf16();
+    }
+    text.len()
+}
+
+/// The language server's hover at UTF-16 offset `at` (`lsyc lsp`'s own
+/// answer): its Markdown text and the span it is about, in UTF-16 units.
+pub fn hover(source: &str, at: usize) -> Option<Json> {
+    let a = crate::lsp::analysis::Analysis::new(source.to_string());
+    let h = crate::lsp::hover::hover(&a, byte_offset(source, at))?;
+    let text = match h.contents {
+        lsp_types::HoverContents::Markup(m) => m.value,
+        lsp_types::HoverContents::Scalar(lsp_types::MarkedString::String(s)) => s,
+        lsp_types::HoverContents::Scalar(lsp_types::MarkedString::LanguageString(l)) => l.value,
+        lsp_types::HoverContents::Array(_) => return None,
+    };
+    let (from, to) = h.range.map_or((at, at), |r| {
+        (
+            utf16_offset(source, a.offset(r.start)),
+            utf16_offset(source, a.offset(r.end)),
+        )
+    });
+    Some(serde_json::json!({ "text": text, "from": from, "to": to }))
+}
+
+/// The language server's completions at UTF-16 offset `at` (`lsyc lsp`'s
+/// own list): label, kind, detail, documentation, the text to insert and
+/// the span it replaces (UTF-16 units).
+pub fn complete(source: &str, at: usize) -> Vec<Json> {
+    let a = crate::lsp::analysis::Analysis::new(source.to_string());
+    crate::lsp::complete::complete(&a, byte_offset(source, at))
+        .into_iter()
+        .map(|c| {
+            let (insert, from, to) = match &c.text_edit {
+                Some(lsp_types::CompletionTextEdit::Edit(e)) => (
+                    e.new_text.clone(),
+                    utf16_offset(source, a.offset(e.range.start)),
+                    utf16_offset(source, a.offset(e.range.end)),
+                ),
+                _ => (
+                    c.insert_text.clone().unwrap_or_else(|| c.label.clone()),
+                    at,
+                    at,
+                ),
+            };
+            let doc = match &c.documentation {
+                Some(lsp_types::Documentation::String(s)) => s.clone(),
+                Some(lsp_types::Documentation::MarkupContent(m)) => m.value.clone(),
+                None => String::new(),
+            };
+            serde_json::json!({
+                "label": c.label,
+                "kind": c.kind.map(|k| format!("{k:?}").to_lowercase()),
+                "detail": c.detail,
+                "doc": doc,
+                "insert": insert,
+                "sort": c.sort_text,
+                "from": from,
+                "to": to,
+            })
+        })
+        .collect()
 }

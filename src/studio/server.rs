@@ -5,7 +5,9 @@
 //! version); `POST /api/run` and `POST /api/drag` (through the worker);
 //! `POST /api/const` (a constant's value written into the source);
 //! `POST /api/string` (the derived string of a step); `POST /api/save` (the
-//! file written atomically).
+//! file written atomically); `POST /api/hover` and `POST /api/complete` (the
+//! language server's answers at a place in the text); `POST /api/export`
+//! (the drawing as SVG, PNG, OBJ or GLB).
 //!
 //! Runs and drags go to one worker thread through a one-place mailbox: a
 //! newer request replaces a waiting older one (which is answered
@@ -197,12 +199,7 @@ fn disk(path: &Path) -> Json {
 
 /// A stable hash of bytes (FNV-1a, 64 bits) as hex.
 pub fn version(bytes: &[u8]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in bytes {
-        h ^= u64::from(*b);
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    format!("{h:016x}")
+    protocol::hash(bytes)
 }
 
 /// The value of a request's header.
@@ -275,11 +272,42 @@ fn handle(state: &State, mut request: tiny_http::Request) {
         let _ = request.respond(text_response(400, "the body is not UTF-8 text"));
         return;
     }
+    if url == "/api/export" {
+        let _ = request.respond(export(state, &body));
+        return;
+    }
     let reply = match api(state, &url, &body) {
         Ok(v) => v,
         Err(e) => json!({ "ok": false, "error": e }),
     };
     let _ = request.respond(json_response(&reply));
+}
+
+/// `POST /api/export`: the drawing as `lsyc run -o x.EXT` writes it (the
+/// bytes, or a JSON error with status 400).
+fn export(state: &State, body: &str) -> tiny_http::Response<std::io::Cursor<Vec<u8>>> {
+    #[derive(Deserialize)]
+    struct Export {
+        #[serde(flatten)]
+        program: Program,
+        format: String,
+    }
+    let fail = |e: String| json_response(&json!({ "ok": false, "error": e })).with_status_code(400);
+    let mut e: Export = match serde_json::from_str(body) {
+        Ok(e) => e,
+        Err(e) => return fail(format!("a request the studio does not understand: {e}")),
+    };
+    e.program.max_modules = Some(state.max_modules);
+    let Some((_, kind)) = protocol::export_format(&e.format) else {
+        return fail(format!("cannot export to .{}", e.format));
+    };
+    match protocol::export(&e.program, &e.format) {
+        Ok(bytes) => with_headers(
+            tiny_http::Response::from_data(bytes),
+            &[("Content-Type", kind), ("Cache-Control", "no-store")],
+        ),
+        Err(e) => fail(e),
+    }
 }
 
 /// Answers one POST of the API.
@@ -315,6 +343,20 @@ fn api(state: &State, url: &str, body: &str) -> Result<Json, String> {
             Ok(match protocol::derived_string(&p) {
                 Ok((text, cut)) => json!({ "ok": true, "text": text, "cut": cut }),
                 Err(diagnostics) => json!({ "ok": false, "diagnostics": diagnostics }),
+            })
+        }
+        "/api/hover" | "/api/complete" => {
+            #[derive(Deserialize)]
+            struct At {
+                source: String,
+                /// A position in the text, in UTF-16 units (the editor's).
+                at: usize,
+            }
+            let a: At = serde_json::from_str(body).map_err(bad)?;
+            Ok(if url == "/api/hover" {
+                json!({ "ok": true, "hover": protocol::hover(&a.source, a.at) })
+            } else {
+                json!({ "ok": true, "items": protocol::complete(&a.source, a.at) })
             })
         }
         "/api/save" => {

@@ -158,6 +158,7 @@ fn a_drag_writes_what_lsyc_edit_move_seeds_writes_and_draws_what_a_full_run_draw
             x,
             y,
             pins: vec!["trunk1".to_string()],
+            ..Drag::default()
         };
         last = Some(session.drag(&d, rel).expect("drags"));
     }
@@ -209,6 +210,7 @@ fn a_drag_of_a_vertex_that_does_not_exist_is_an_error() {
         x: 0.0,
         y: 0.0,
         pins: Vec::new(),
+        ..Drag::default()
     };
     let e = session.drag(&d, "palm.lsy").expect_err("no such guide");
     assert!(e.contains("trunk9"), "{e}");

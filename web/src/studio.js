@@ -3,7 +3,8 @@
 // Every run happens on the server (POST /api/…, JSON); the page only draws
 // what comes back, the latest request winning.
 import { EditorView, basicSetup } from "codemirror";
-import { keymap } from "@codemirror/view";
+import { keymap, hoverTooltip } from "@codemirror/view";
+import { autocompletion } from "@codemirror/autocomplete";
 import { setDiagnostics } from "@codemirror/lint";
 import { lsy } from "./lsy.js";
 
@@ -18,6 +19,12 @@ const ui = {
   stepValue: $("[data-role=step-value]"),
   showString: $("[data-role=show-string]"),
   exportSvg: $("[data-role=export-svg]"),
+  exportPng: $("[data-role=export-png]"),
+  exportObj: $("[data-role=export-obj]"),
+  exportGlb: $("[data-role=export-glb]"),
+  orbit: $("[data-role=orbit]"),
+  viewAngle: $("[data-role=view-angle]"),
+  resetView: $("[data-role=reset-view]"),
   exportLsy: $("[data-role=export-lsy]"),
   fit: $("[data-role=fit]"),
   banner: $("[data-role=disk-changed]"),
@@ -44,8 +51,17 @@ const state = {
   step: null,
   maxStep: 0,
   svgText: null,
+  /// A scene's layers on the page: guide → hash of its layer's SVG text.
+  layers: {},
   guides: [],
   pins: new Set(),
+  /// Stiff springs, as `A.vI=B.vJ`; `stiffFrom` is the first end chosen.
+  stiff: [],
+  stiffFrom: null,
+  /// A 3D program's camera (azimuth, elevation in degrees), as `--view`.
+  is3d: false,
+  isScene: false,
+  view: [30, 20],
   constants: [],
   /// Text and version of the file as last loaded or saved.
   savedText: "",
@@ -75,8 +91,8 @@ async function post(path, body) {
 /// one waiting; a newer request replaces the waiting one.
 const lane = { inFlight: false, waiting: null };
 
-function send(path, body, onReply) {
-  const job = { path, body: { ...body, seq: ++state.seq }, onReply, sent: 0 };
+function send(path, body, onReply, fresh = null) {
+  const job = { path, body: { ...body, seq: ++state.seq }, onReply, fresh, sent: 0 };
   if (lane.inFlight) {
     lane.waiting = job;
     return;
@@ -88,6 +104,9 @@ function start(job) {
   lane.inFlight = true;
   state.busy++;
   job.sent = performance.now();
+  // What depends on the page's drawing is read when the request leaves, after
+  // the reply before it was drawn.
+  if (job.fresh) job.body = { ...job.body, ...job.fresh() };
   post(job.path, job.body)
     .then((reply) => {
       if (!reply.superseded && reply.seq >= state.applied) {
@@ -111,6 +130,7 @@ function program(extra = {}) {
     defines: { ...state.defines },
     seed: state.seed,
     step: state.step,
+    view: state.view,
     ...extra,
   };
 }
@@ -134,6 +154,8 @@ function createEditor(text) {
     extensions: [
       basicSetup,
       lsy,
+      autocompletion({ override: [completions] }),
+      hoverTooltip(hover, { hoverTime: 300 }),
       keymap.of([{ key: "Mod-s", preventDefault: true, run: () => (save(), true) }]),
       EditorView.updateListener.of((u) => {
         if (u.docChanged) {
@@ -143,6 +165,78 @@ function createEditor(text) {
       }),
     ],
   });
+}
+
+// ---- hover and completion: the language server's answers ----
+
+/// Markdown as the language server writes it (fenced code, `code`, text) into DOM.
+function markdown(text) {
+  const dom = document.createElement("div");
+  dom.className = "hover";
+  text.split(/```[a-z]*\n?/).forEach((part, i) => {
+    if (!part.trim()) return;
+    if (i % 2 === 1) {
+      const pre = document.createElement("pre");
+      pre.textContent = part.replace(/\n$/, "");
+      dom.append(pre);
+      return;
+    }
+    for (const para of part.trim().split(/\n\n+/)) {
+      const p = document.createElement("p");
+      para.split(/(`[^`]*`)/).forEach((bit) => {
+        if (bit.startsWith("`") && bit.endsWith("`") && bit.length > 1) {
+          const c = document.createElement("code");
+          c.textContent = bit.slice(1, -1);
+          p.append(c);
+        } else {
+          p.append(bit.replace(/\*\*|__/g, ""));
+        }
+      });
+      dom.append(p);
+    }
+  });
+  return dom;
+}
+
+async function hover(view, pos) {
+  const source = view.state.doc.toString();
+  let reply;
+  try {
+    reply = await post("/api/hover", { source, at: pos });
+  } catch {
+    return null;
+  }
+  const h = reply.ok && reply.hover;
+  if (!h || view.state.doc.toString() !== source) return null;
+  return {
+    pos: h.from,
+    end: h.to,
+    above: true,
+    create: () => ({ dom: markdown(h.text) }),
+  };
+}
+
+const KINDS = { function: "function", variable: "variable", constant: "constant", keyword: "keyword", module: "class", class: "class", property: "property", field: "property", snippet: "text", text: "text" };
+
+async function completions(ctx) {
+  const word = ctx.matchBefore(/[?\w]*/);
+  if (!ctx.explicit && (!word || word.from === word.to)) return null;
+  const source = ctx.state.doc.toString();
+  const reply = await post("/api/complete", { source, at: ctx.pos });
+  if (!reply.ok || !reply.items.length || ctx.aborted) return null;
+  const from = Math.min(...reply.items.map((c) => c.from));
+  return {
+    from,
+    to: ctx.pos,
+    options: reply.items.map((c) => ({
+      label: c.label,
+      detail: c.detail || undefined,
+      type: KINDS[c.kind] || "text",
+      apply: c.insert,
+      info: c.doc ? () => markdown(c.doc) : undefined,
+    })),
+    validFor: /^[?\w]*$/,
+  };
 }
 
 function markDirty() {
@@ -163,6 +257,10 @@ function applyRun(reply, ms, body) {
   showDiagnostics(reply.diagnostics || []);
   if (reply.ok) {
     const first = showDrawing(reply.svg, reply.previous_svg);
+    state.layers = reply.layers || {};
+    state.is3d = !!reply.is_3d;
+    state.isScene = !!reply.is_scene;
+    showView();
     state.guides = reply.guides || [];
     drawHandles();
     if (body.step === null && reply.stats) {
@@ -295,6 +393,19 @@ function showDrawing(text, previousText) {
   return first;
 }
 
+/// A 3D program's camera: re-drawn on the server as `--view AZ,EL` draws it.
+function setView(v) {
+  state.view = [Math.round(v[0] * 10) / 10, Math.round(v[1] * 10) / 10];
+  showView();
+  run();
+}
+
+function showView() {
+  const on = state.is3d && !state.isScene;
+  ui.orbit.hidden = !on;
+  ui.viewAngle.value = `view ${state.view[0]}°, ${state.view[1]}°`;
+}
+
 function applyPan() {
   const p = state.pan;
   ui.stage.style.transform = `translate(${p.x}px, ${p.y}px) scale(${p.scale})`;
@@ -332,12 +443,20 @@ function setupPanZoom() {
   let panning = null;
   ui.view.addEventListener("pointerdown", (e) => {
     if (e.target.closest(".handle") || e.button !== 0) return;
-    panning = { x: e.clientX, y: e.clientY, px: state.pan.x, py: state.pan.y };
+    const orbit = state.is3d && !state.isScene && !e.shiftKey;
+    panning = { x: e.clientX, y: e.clientY, px: state.pan.x, py: state.pan.y, orbit, view: [...state.view] };
     ui.view.setPointerCapture(e.pointerId);
     ui.view.classList.add("panning");
   });
   ui.view.addEventListener("pointermove", (e) => {
     if (!panning) return;
+    if (panning.orbit) {
+      // Half a degree per pixel; the elevation stops short of the poles.
+      const az = panning.view[0] - (e.clientX - panning.x) * 0.5;
+      const el = Math.max(-89, Math.min(89, panning.view[1] + (e.clientY - panning.y) * 0.5));
+      setView([((az % 360) + 360) % 360, el]);
+      return;
+    }
     state.pan.x = panning.px + e.clientX - panning.x;
     state.pan.y = panning.py + e.clientY - panning.y;
     applyPan();
@@ -374,18 +493,63 @@ function drawHandles() {
       c.setAttribute("cy", String(-y));
       c.setAttribute("r", String(handleRadius()));
       if (state.pins.has(name)) c.classList.add("pinned");
+      if (state.stiffFrom === name) c.classList.add("stiff-from");
+      c.dataset.pinned = state.pins.has(name) ? "true" : "false";
       if (name === active) {
         c.classList.add("active");
         c.setAttribute("cx", String(state.drag.x));
         c.setAttribute("cy", String(-state.drag.y));
       }
       const title = document.createElementNS(SVG_NS, "title");
-      title.textContent = `${name} (${x}, ${y}) — drag to move, shift-click to pin`;
+      title.textContent = `${name} (${x}, ${y}) — drag to move, shift-click to pin, alt-click two vertices for a stiff spring`;
       c.append(title);
       circles.push(c);
     });
   }
-  ui.overlay.replaceChildren(...circles);
+  const at = (v) => {
+    const [guide, index] = v.split(/\.v(?=\d+$)/);
+    return state.guides.find((g) => g.name === guide)?.points[Number(index)];
+  };
+  const springs = [];
+  for (const pair of state.stiff) {
+    const [a, b] = pair.split("=").map(at);
+    if (!a || !b) continue;
+    const l = document.createElementNS(SVG_NS, "line");
+    l.setAttribute("class", "stiff");
+    l.dataset.stiff = pair;
+    l.setAttribute("x1", String(a[0]));
+    l.setAttribute("y1", String(-a[1]));
+    l.setAttribute("x2", String(b[0]));
+    l.setAttribute("y2", String(-b[1]));
+    springs.push(l);
+  }
+  ui.overlay.replaceChildren(...springs, ...circles);
+}
+
+/// `--pin GUIDE.vN` on or off.
+function togglePin(vertex) {
+  if (state.pins.has(vertex)) state.pins.delete(vertex);
+  else state.pins.add(vertex);
+  drawHandles();
+}
+
+/// `--stiff A.vI=B.vJ`: the first vertex chosen, then the second adds the
+/// spring (or removes it if it was there); choosing the first again cancels.
+function chooseStiff(vertex) {
+  const a = state.stiffFrom;
+  if (a === null) {
+    state.stiffFrom = vertex;
+  } else if (a === vertex) {
+    state.stiffFrom = null;
+  } else {
+    const pair = `${a}=${vertex}`;
+    const back = `${vertex}=${a}`;
+    const had = state.stiff.filter((p) => p === pair || p === back);
+    state.stiff = state.stiff.filter((p) => p !== pair && p !== back);
+    if (!had.length) state.stiff.push(pair);
+    state.stiffFrom = null;
+  }
+  drawHandles();
 }
 
 function worldPoint(e) {
@@ -403,9 +567,11 @@ function setupHandles() {
     e.stopPropagation();
     const vertex = h.dataset.vertex;
     if (e.shiftKey) {
-      if (state.pins.has(vertex)) state.pins.delete(vertex);
-      else state.pins.add(vertex);
-      drawHandles();
+      togglePin(vertex);
+      return;
+    }
+    if (e.altKey) {
+      chooseStiff(vertex);
       return;
     }
     const [guide, index] = vertex.split(/\.v(?=\d+$)/);
@@ -451,6 +617,7 @@ function sendDrag(final) {
     x: d.x,
     y: d.y,
     pins: [...state.pins].filter((p) => p !== d.vertex),
+    stiff: [...state.stiff],
   };
   send("/api/drag", body, (reply, ms) => {
     if (!reply.ok) {
@@ -458,8 +625,21 @@ function sendDrag(final) {
       if (final) state.drag = null;
       return;
     }
+    const t0 = performance.now();
+    if (reply.patch) {
+      if (!applyPatch(reply.patch)) {
+        // The page's drawing is not the one the patch was made for.
+        state.layers = {};
+        if (final) state.drag = null;
+        run();
+        return;
+      }
+    } else {
+      showDrawing(reply.svg, null);
+    }
+    state.layers = reply.layers || {};
+    ms += performance.now() - t0;
     state.timings.drag.push(ms);
-    showDrawing(reply.svg, null);
     state.guides = reply.guides;
     if (final) {
       state.drag = null;
@@ -468,8 +648,52 @@ function sendDrag(final) {
       drawHandles();
     }
     const again = reply.recomputed ? ` · recomputed ${reply.recomputed.length} of ${reply.guides.length} guides` : "";
-    setStatus(statsLine(reply.stats, ms) + again, false);
+    const sent = reply.patch ? ` · sent ${reply.patch.layers.filter(([, t]) => t !== null).length} of ${reply.patch.layers.length} layers` : "";
+    setStatus(statsLine(reply.stats, ms) + again + sent, false);
+  }, () => ({ have: { ...state.layers } }));
+}
+
+/// Applies a drag's patch to the drawing on the page: the new head's view box
+/// and styles, the layers sent in place of theirs, the new outlines and
+/// links. The result is the drawing the whole SVG would give. Returns false
+/// if the drawing on the page does not have the patch's layers.
+function applyPatch(patch) {
+  const svg = ui.drawing.querySelector(":scope > svg:not(.previous)");
+  const top = svg && svg.querySelector(":scope > g");
+  if (!top || ui.drawing.querySelector(":scope > svg.previous")) return false;
+  const old = [...top.querySelectorAll(":scope > g.guide-content")];
+  if (old.length === 0 || old.length !== patch.layers.length) return false;
+  const sent = patch.layers.map(([, text]) => text || "").join("");
+  const fresh = parseSvg(patch.head + sent + patch.tail);
+  const freshTop = fresh && fresh.querySelector(":scope > g");
+  if (!freshTop) return false;
+  const freshLayers = [...freshTop.querySelectorAll(":scope > g.guide-content")];
+  // The tail: everything after the last layer (outlines, links).
+  const tail = [];
+  for (let n = freshLayers.length ? freshLayers[freshLayers.length - 1].nextSibling : null; n; n = n.nextSibling) tail.push(n);
+  if (!freshLayers.length) {
+    const defsEnd = freshTop.querySelector(":scope > defs");
+    for (let n = defsEnd ? defsEnd.nextSibling : freshTop.firstChild; n; n = n.nextSibling) tail.push(n);
+  }
+  let k = 0;
+  patch.layers.forEach(([, text], i) => {
+    if (text !== null) old[i].replaceWith(freshLayers[k++]);
   });
+  svg.setAttribute("viewBox", fresh.getAttribute("viewBox"));
+  for (const a of freshTop.attributes) top.setAttribute(a.name, a.value);
+  const defs = freshTop.querySelector(":scope > defs");
+  const oldDefs = top.querySelector(":scope > defs");
+  if (defs && oldDefs) oldDefs.replaceWith(defs);
+  const lastLayer = old.length ? top.querySelectorAll(":scope > g.guide-content")[old.length - 1] : null;
+  while (lastLayer && lastLayer.nextSibling) lastLayer.nextSibling.remove();
+  top.append(...tail);
+  state.svgText = null;
+  const box = viewBox(svg);
+  place(svg, box);
+  place(ui.overlay, box);
+  ui.overlay.setAttribute("viewBox", `${box.x} ${box.y} ${box.w} ${box.h}`);
+  ui.drawing.classList.remove("stale");
+  return true;
 }
 
 // ---- constants ----
@@ -637,9 +861,26 @@ async function pollDisk() {
   }
 }
 
-function download(name, type, text) {
+/// The drawing as `lsyc run -o NAME.EXT` writes it, made on the server.
+async function exportAs(ext) {
+  const r = await fetch("/api/export", {
+    method: "POST",
+    headers: { "Content-Type": "application/json" },
+    body: JSON.stringify({ ...program(), format: ext }),
+  });
+  if (!r.ok) {
+    const e = await r.json().catch(() => ({}));
+    setStatus(e.error || `cannot export .${ext}`, true);
+    return;
+  }
+  const blob = await r.blob();
+  download(`${baseName()}.${ext}`, blob.type, blob);
+  setStatus(`exported ${baseName()}.${ext} (${blob.size.toLocaleString("en")} bytes)`, false);
+}
+
+function download(name, type, data) {
   const a = document.createElement("a");
-  a.href = URL.createObjectURL(new Blob([text], { type }));
+  a.href = URL.createObjectURL(data instanceof Blob ? data : new Blob([data], { type }));
   a.download = name;
   a.click();
   setTimeout(() => URL.revokeObjectURL(a.href), 1000);
@@ -664,9 +905,10 @@ async function main() {
     state.seed = Math.max(0, Math.floor(Number(ui.seed.value) || 0));
     run();
   });
-  ui.exportSvg.addEventListener("click", () => {
-    if (state.svgText) download(`${baseName()}.svg`, "image/svg+xml", state.svgText);
-  });
+  for (const [button, ext] of [[ui.exportSvg, "svg"], [ui.exportPng, "png"], [ui.exportObj, "obj"], [ui.exportGlb, "glb"]]) {
+    button.addEventListener("click", () => exportAs(ext));
+  }
+  ui.resetView.addEventListener("click", () => setView([30, 20]));
   ui.exportLsy.addEventListener("click", () => download(`${baseName()}.lsy`, "text/plain", getSource()));
   ui.reload.addEventListener("click", () => {
     const d = state.pendingDisk;
@@ -700,6 +942,8 @@ window.lsycStudio = {
   },
   timings: state.timings,
   state,
+  togglePin,
+  chooseStiff,
 };
 
 main();
