@@ -200,6 +200,201 @@ fn a_drag_writes_what_lsyc_edit_move_seeds_writes_and_draws_what_a_full_run_draw
     );
 }
 
+/// A page's drawing after a patch: the head, each layer sent or kept from
+/// the drawing before, the tail.
+fn patched(before: &str, patch: &protocol::Patch) -> String {
+    let (_, old, _) = protocol::split_layers(before).expect("layers");
+    let mut out = patch.head.clone();
+    assert_eq!(old.len(), patch.layers.len());
+    for ((name, sent), (old_name, old_text)) in patch.layers.iter().zip(old) {
+        assert_eq!(name, old_name);
+        out.push_str(sent.as_deref().unwrap_or(old_text));
+    }
+    out.push_str(&patch.tail);
+    out
+}
+
+#[test]
+fn a_drag_sends_only_the_layers_that_changed_and_they_make_the_full_drawing() {
+    let rel = "lang-examples/tree.lsy";
+    let text = read(rel);
+    let p = program(&text);
+    let first = protocol::run(&p, rel);
+    let full = first.svg.expect("a drawing");
+    assert_eq!(first.layers.len(), 10, "one hash per guide layer");
+    let mut session = DragSession::new(&p).expect("a scene");
+    let mut shown = full.clone();
+    let mut have = first.layers.clone();
+    for (x, y) in [(104.0, 102.0), (96.0, 98.0), (100.5, 99.0)] {
+        let d = Drag {
+            program: p.clone(),
+            vertex: "limbR1.v2".to_string(),
+            x,
+            y,
+            pins: vec!["trunk".to_string()],
+            have: Some(have.clone()),
+            ..Drag::default()
+        };
+        let reply = session.drag(&d, rel).expect("drags");
+        assert!(reply.svg.is_none(), "a patch instead of the whole drawing");
+        let patch = reply.patch.expect("a patch");
+        let sent: Vec<&str> = patch
+            .layers
+            .iter()
+            .filter(|(_, t)| t.is_some())
+            .map(|(n, _)| n.as_str())
+            .collect();
+        assert!(
+            !sent.is_empty() && sent.len() < 10,
+            "some layers, not all: {sent:?}"
+        );
+        assert!(!sent.contains(&"trunk"), "the pinned trunk is kept: {sent:?}");
+        shown = patched(&shown, &patch);
+        // What the page shows is what a full run of the dragged text draws.
+        let dir = tempfile::tempdir().expect("tempdir");
+        let moved = dir.path().join("tree.lsy");
+        std::fs::write(&moved, reply.formatted.as_deref().expect("text")).expect("writes");
+        assert_eq!(shown, cli_svg(&moved, &["--guides"]));
+        have = reply.layers;
+    }
+    // A page that says it has nothing gets every layer.
+    let d = Drag {
+        program: p.clone(),
+        vertex: "limbR1.v2".to_string(),
+        x: 101.0,
+        y: 99.0,
+        pins: vec!["trunk".to_string()],
+        have: Some(Default::default()),
+        ..Drag::default()
+    };
+    let patch = session.drag(&d, rel).expect("drags").patch.expect("a patch");
+    assert!(patch.layers.iter().all(|(_, t)| t.is_some()));
+}
+
+#[test]
+fn a_stiff_spring_is_what_lsyc_edit_stiff_writes() {
+    let rel = "lang-examples/palm.lsy";
+    let p = program(&read(rel));
+    let mut session = DragSession::new(&p).expect("a scene");
+    let d = Drag {
+        program: p.clone(),
+        vertex: "trunk3.v2".to_string(),
+        x: 112.5,
+        y: 330.0,
+        pins: vec!["trunk1".to_string()],
+        stiff: vec!["trunk3.v2=frond1.v4".to_string()],
+        ..Drag::default()
+    };
+    let reply = session.drag(&d, rel).expect("drags");
+    let out = lsyc()
+        .args([
+            "edit",
+            rel,
+            "--move",
+            "trunk3.v2=112.5,330",
+            "--pin",
+            "trunk1",
+            "--stiff",
+            "trunk3.v2=frond1.v4",
+            "--move-seeds",
+        ])
+        .output()
+        .expect("runs");
+    assert!(out.status.success(), "{out:?}");
+    assert_eq!(
+        reply.formatted.as_deref(),
+        Some(String::from_utf8_lossy(&out.stdout).as_ref())
+    );
+    let loose = Drag {
+        stiff: Vec::new(),
+        ..d.clone()
+    };
+    let mut other = DragSession::new(&p).expect("a scene");
+    let loose = other.drag(&loose, rel).expect("drags");
+    assert_ne!(loose.formatted, reply.formatted, "the spring changes the relaxation");
+    let bad = Drag {
+        stiff: vec!["trunk3.v2".to_string()],
+        ..d
+    };
+    assert!(session.drag(&bad, rel).is_err());
+}
+
+#[test]
+fn hover_and_completion_are_the_language_servers() {
+    let text = read("lang-examples/monopodial-tree.lsy");
+    // On a use of `r2` (UTF-16 offsets; the file has non-ASCII comments).
+    let byte = text.rfind("r2").expect("a use of r2");
+    let at = protocol::utf16_offset(&text, byte) + 1;
+    let h = protocol::hover(&text, at).expect("a hover");
+    let a = lsyc::lsp::analysis::Analysis::new(text.clone());
+    let want = lsyc::lsp::hover::hover(&a, byte + 1).expect("the server's hover");
+    let lsp_types::HoverContents::Markup(m) = want.contents else {
+        panic!("markdown")
+    };
+    assert_eq!(h["text"], json!(m.value));
+    assert!(m.value.contains("r2"), "{}", m.value);
+    let (from, to) = (h["from"].as_u64().unwrap(), h["to"].as_u64().unwrap());
+    assert_eq!(to - from, 2, "the span of `r2`");
+    assert_eq!(protocol::byte_offset(&text, from as usize), byte);
+    assert!(protocol::hover(&text, 0).is_none() || protocol::hover("", 0).is_none());
+    // Completion after `r` at the end of a rule: the constants starting with it.
+    let cut = text.find("const r2").expect("r2") + "const r2 = 0.6;\n".len();
+    let items = protocol::complete(&text, protocol::utf16_offset(&text, cut));
+    let all = lsyc::lsp::complete::complete(&a, cut);
+    assert_eq!(items.len(), all.len());
+    let labels: Vec<&str> = items.iter().filter_map(|i| i["label"].as_str()).collect();
+    assert!(labels.contains(&"lsystem"), "{labels:?}");
+}
+
+#[test]
+fn an_export_is_what_lsyc_run_writes() {
+    let rel = "lang-examples/monopodial-tree.lsy";
+    let p = Program {
+        view: Some([60.0, 10.0]),
+        ..program(&read(rel))
+    };
+    let dir = tempfile::tempdir().expect("tempdir");
+    for ext in ["svg", "png", "obj", "glb"] {
+        let bytes = protocol::export(&p, ext).expect("exports");
+        let out = dir.path().join(format!("x.{ext}"));
+        let status = lsyc()
+            .arg("run")
+            .arg(rel)
+            .arg("-o")
+            .arg(&out)
+            .args(["--view", "60,10"])
+            .output()
+            .expect("runs");
+        assert!(status.status.success(), "{status:?}");
+        let mut want = std::fs::read(&out).expect("wrote");
+        if ext == "obj" {
+            // The command line names its `.mtl` beside the file; a download has none.
+            let text = String::from_utf8(want).expect("text");
+            want = text
+                .lines()
+                .filter(|l| !l.starts_with("mtllib "))
+                .flat_map(|l| [l, "\n"])
+                .collect::<String>()
+                .into_bytes();
+        }
+        assert!(bytes == want, ".{ext}: {} bytes, not {}", bytes.len(), want.len());
+    }
+    assert!(protocol::export(&p, "gif").is_err());
+    assert!(protocol::export(&program("lsystem A {"), "svg").is_err());
+    // The page's drawing of a 3D program in that view is `--view`'s.
+    let reply = protocol::run(&p, rel);
+    assert!(reply.is_3d);
+    assert_eq!(
+        reply.svg.as_deref(),
+        Some(cli_svg(&root().join(rel), &["--view", "60,10"]).as_str())
+    );
+    let scene = protocol::export(&program(&read("lang-examples/palm.lsy")), "svg").expect("svg");
+    assert_eq!(
+        String::from_utf8_lossy(&scene),
+        cli_svg(&root().join("lang-examples/palm.lsy"), &["--guides"])
+    );
+}
+
 #[test]
 fn a_drag_of_a_vertex_that_does_not_exist_is_an_error() {
     let p = program(&read("lang-examples/palm.lsy"));
