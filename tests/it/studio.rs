@@ -740,7 +740,7 @@ fn studio_in_a_browser() {
         );
     }
     let dir = tempfile::tempdir().expect("tempdir");
-    for f in ["monopodial-tree.lsy", "palm.lsy"] {
+    for f in ["monopodial-tree.lsy", "palm.lsy", "tree.lsy"] {
         std::fs::copy(root().join("lang-examples").join(f), dir.path().join(f)).expect("copies");
     }
     let out = Command::new("node")
@@ -758,12 +758,19 @@ fn studio_in_a_browser() {
     );
     assert!(out.status.success(), "the browser tests failed:\n{log}");
     assert!(log.contains("ok: no console errors"), "{log}");
-    for shot in ["gallery.png", "gallery-step.png", "palm.png"] {
+    let shots = [
+        "gallery.png",
+        "gallery-step.png",
+        "palm.png",
+        "tree.png",
+        "studio-hover.png",
+    ];
+    for shot in shots {
         let len = std::fs::metadata(dir.path().join(shot)).map_or(0, |m| m.len());
         assert!(len > 10_000, "screenshot {shot}: {len} bytes");
     }
     if let Ok(keep) = std::env::var("LSYC_STUDIO_SCREENSHOTS") {
-        for shot in ["gallery.png", "gallery-step.png", "palm.png"] {
+        for shot in shots {
             let _ = std::fs::copy(dir.path().join(shot), Path::new(&keep).join(shot));
         }
     }

@@ -73,7 +73,9 @@ const state = {
   pan: { x: 0, y: 0, scale: 1 },
   drag: null,
   busy: 0,
-  timings: { edit: [], drag: [] },
+  /// Round trips of runs and drags (request to drawing on the page), and
+  /// the page's own part of a drag's redraw (parsing and patching the layers).
+  timings: { edit: [], drag: [], page: [] },
 };
 
 // ---- the server ----
@@ -638,8 +640,10 @@ function sendDrag(final) {
       showDrawing(reply.svg, null);
     }
     state.layers = reply.layers || {};
-    ms += performance.now() - t0;
+    const own = performance.now() - t0;
+    ms += own;
     state.timings.drag.push(ms);
+    state.timings.page.push(own);
     state.guides = reply.guides;
     if (final) {
       state.drag = null;
