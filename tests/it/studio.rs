@@ -758,6 +758,7 @@ fn studio_in_a_browser() {
     );
     assert!(out.status.success(), "the browser tests failed:\n{log}");
     assert!(log.contains("ok: no console errors"), "{log}");
+    eprintln!("{log}");
     let shots = [
         "gallery.png",
         "gallery-step.png",
