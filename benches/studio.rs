@@ -6,8 +6,10 @@
 //! - **drag → redraw**: one move of a dragged guide vertex: the mass-spring
 //!   relaxation and write-back of `lsyc edit`, a check of the moved text, the
 //!   incremental scene runner (only the guides whose polygon changed and their
-//!   dependents run again), the SVG (`DragSession::drag`). Each iteration
-//!   moves the vertex to the other of two places, so every one is a real move.
+//!   dependents run again), the SVG, and the reply as the page gets it: JSON
+//!   with only the guide layers that changed (`DragSession::drag` with the
+//!   page's layer hashes). Each iteration moves the vertex to the other of two
+//!   places, so every one is a real move.
 //!
 //! The browser adds its own time (the request, parsing and painting the SVG);
 //! `tests/browser/studio.mjs` prints the round trips it measured.
@@ -78,28 +80,37 @@ fn studio(c: &mut Criterion) {
             b.iter(|| black_box(protocol::run(black_box(&p), file)))
         });
         let mut session = DragSession::new(&p).expect("a scene");
-        let drag = |k: usize| Drag {
+        let drag = |k: usize, have: &std::collections::BTreeMap<String, String>| Drag {
             program: p.clone(),
             vertex: vertex.to_string(),
             x: places[k][0],
             y: places[k][1],
             pins: pins.iter().map(|p| p.to_string()).collect(),
+            have: Some(have.clone()),
             ..Drag::default()
         };
         // The first move runs every guide (the session's cache is empty); the
         // second shows what a move recomputes.
-        session.drag(&drag(1), file).expect("drags");
-        let warm = session.drag(&drag(0), file).expect("drags");
+        let first = session.drag(&drag(1, &first.layers), file).expect("drags");
+        let warm = session.drag(&drag(0, &first.layers), file).expect("drags");
+        let patch = warm.patch.as_ref().expect("a patch");
+        let sent = patch.layers.iter().filter(|(_, t)| t.is_some()).count();
         eprintln!(
-            "{file}: dragging {vertex} recomputes {} of {} guides",
+            "{file}: dragging {vertex} recomputes {} of {} guides, sends {sent} of {} layers ({} bytes of JSON)",
             warm.recomputed.len(),
-            warm.guides.len()
+            warm.guides.len(),
+            patch.layers.len(),
+            serde_json::to_string(&warm).map_or(0, |j| j.len())
         );
         let mut k = 0;
+        let mut have = warm.layers.clone();
         g.bench_function("drag to redraw", |b| {
             b.iter(|| {
                 k ^= 1;
-                black_box(session.drag(&drag(k), file).expect("drags"))
+                let reply = session.drag(&drag(k, &have), file).expect("drags");
+                let json = serde_json::to_string(&reply).expect("json");
+                have = reply.layers;
+                black_box(json)
             })
         });
         g.finish();
