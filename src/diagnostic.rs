@@ -110,6 +110,7 @@ codes! {
     TooMuchDrawing = "E0908", "interpretation that would draw more than the module limit";
     DrawingTooLarge = "E0909", "a drawing with coordinates too large to write";
     DecomposeTooDeep = "E0910", "decomposition rules that expand into each other too deeply";
+    Cancelled = "E0911", "a run stopped because a newer request replaced it (`lsyc studio`)";
     Unused = "W0101", "a declaration that nothing uses";
     UnusedParameter = "W0102", "a rule parameter that nothing uses";
     NeverProduced = "W0201", "a rule whose predecessor never appears";

@@ -25,6 +25,7 @@ fuzz_target!(|data: &[u8]| {
             limits: derive::Limits {
                 max_modules: 20_000,
                 max_bytes: 1 << 22,
+                cancel: None,
             },
             system: None,
         };

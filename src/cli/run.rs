@@ -148,6 +148,7 @@ fn run_inner(args: &Args, reporter: &Reporter) -> Result<(), u8> {
         limits: Limits {
             max_modules: args.max_modules,
             max_bytes: args.max_memory.saturating_mul(1 << 20),
+            cancel: None,
         },
         system: args.system.clone(),
     };

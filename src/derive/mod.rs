@@ -50,6 +50,10 @@ impl ModString {
 pub struct Limits {
     pub max_modules: usize,
     pub max_bytes: usize,
+    /// When set (by another thread), the next derivation step stops with
+    /// `DeriveError::Cancelled`: `lsyc studio` stops a run that a newer edit
+    /// replaced. `None` everywhere else.
+    pub cancel: Option<&'static std::sync::atomic::AtomicBool>,
 }
 
 impl Default for Limits {
@@ -57,6 +61,7 @@ impl Default for Limits {
         Limits {
             max_modules: 250_000_000,
             max_bytes: 4 << 30,
+            cancel: None,
         }
     }
 }
@@ -105,6 +110,9 @@ pub enum DeriveError {
         depth: usize,
         span: crate::span::Span,
     },
+    /// The run was stopped from outside before step `step` (`Limits::cancel`).
+    #[error("the run was stopped before step {step}: a newer request replaced it")]
+    Cancelled { step: u32 },
     /// More steps were asked for than `MAX_STEPS`.
     #[error("{steps} derivation steps were asked for; the most is {limit}")]
     TooManySteps { steps: u64, limit: u32 },
@@ -222,6 +230,8 @@ impl DeriveError {
                     .primary(*span, "this `decompose` rule keeps producing modules that decompose again")
                     .help("decomposition must end in modules that no `decompose` rule matches; end the recursion with a condition on a parameter that decreases")
             }
+            DeriveError::Cancelled { .. } => Diagnostic::error(Code::Cancelled, msg)
+                .primary(prog.name_span, "this lsystem was being derived"),
             DeriveError::TooManySteps { limit, .. } => Diagnostic::error(Code::TooManySteps, msg)
                 .primary(prog.name_span, "this lsystem would be derived that often")
                 .help(format!("ask for at most {limit} steps with -n")),
@@ -371,6 +381,9 @@ pub fn step(
     seed: u64,
     limits: Limits,
 ) -> Result<ModString, DeriveError> {
+    if limits.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+        return Err(DeriveError::Cancelled { step });
+    }
     let out = match &prog.d0l {
         Some(table) => d0l_step(table, s, step, limits)?,
         None => parametric_step(prog, s, step, seed, limits)?,

@@ -17,6 +17,7 @@ use crate::{edit, fmt, frontend};
 use serde::{Deserialize, Serialize};
 use serde_json::Value as Json;
 use std::collections::BTreeMap;
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 /// The most bytes of a derived string the page is sent.
@@ -48,6 +49,21 @@ pub struct Program {
     /// absent). Not the page's to choose.
     #[serde(skip)]
     pub max_modules: Option<usize>,
+    /// Set by the server when a newer request replaces this one: the
+    /// derivation stops at its next step (error E0911). Not the page's.
+    #[serde(skip)]
+    pub cancel: Cancel,
+}
+
+/// A flag that stops a run between derivation steps (`derive::Limits::cancel`).
+/// Two programs are the same whatever their flags.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Cancel(pub Option<&'static AtomicBool>);
+
+impl PartialEq for Cancel {
+    fn eq(&self, _: &Cancel) -> bool {
+        true
+    }
 }
 
 impl Program {
@@ -67,6 +83,7 @@ impl Program {
             seed: self.seed,
             limits: crate::derive::Limits {
                 max_modules: self.max_modules.unwrap_or(MAX_MODULES),
+                cancel: self.cancel.0,
                 ..crate::derive::Limits::default()
             },
             ..Options::default()

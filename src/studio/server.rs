@@ -23,7 +23,7 @@ use serde::Deserialize;
 use serde_json::{Value as Json, json};
 use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::sync::{Arc, Condvar, Mutex};
 
@@ -48,6 +48,12 @@ struct State {
     ready: Condvar,
     /// The highest sequence number a request has carried.
     latest: AtomicU64,
+    /// The sequence number of the edit's run the worker is running, or 0 (a
+    /// newer request stops a run; a drag is not stopped, its runner's cache
+    /// must stay whole).
+    running_run: AtomicU64,
+    /// The flag that stops the run in progress between derivation steps.
+    cancel: &'static AtomicBool,
 }
 
 enum Job {
@@ -86,6 +92,9 @@ impl Studio {
             mailbox: Mutex::new(None),
             ready: Condvar::new(),
             latest: AtomicU64::new(0),
+            running_run: AtomicU64::new(0),
+            // One flag for the life of the process (a studio serves until it ends).
+            cancel: Box::leak(Box::new(AtomicBool::new(false))),
         });
         Ok(Studio {
             server,
@@ -125,6 +134,10 @@ fn work(state: &State) {
             };
             loop {
                 if let Some(p) = slot.take() {
+                    // Under the mailbox's lock, as `submit` sets them.
+                    state.cancel.store(false, Ordering::SeqCst);
+                    let run = if matches!(p.job, Job::Run(_)) { p.seq } else { 0 };
+                    state.running_run.store(run, Ordering::SeqCst);
                     break p;
                 }
                 slot = match state.ready.wait(slot) {
@@ -146,6 +159,7 @@ fn work(state: &State) {
                 }
             }
         };
+        state.running_run.store(0, Ordering::SeqCst);
         if pending.seq < state.latest.load(Ordering::SeqCst) {
             reply = superseded(pending.seq);
         }
@@ -173,6 +187,11 @@ fn submit(state: &State, seq: u64, job: Job) -> Json {
                 return superseded(seq);
             }
             let _ = old.reply.send(superseded(old.seq));
+        }
+        // An edit's run in progress is older: stop it at its next step.
+        let running = state.running_run.load(Ordering::SeqCst);
+        if running != 0 && running < seq {
+            state.cancel.store(true, Ordering::SeqCst);
         }
         *slot = Some(Pending {
             seq,
@@ -318,6 +337,7 @@ fn api(state: &State, url: &str, body: &str) -> Result<Json, String> {
         "/api/run" => {
             let mut p: Program = serde_json::from_str(body).map_err(bad)?;
             p.max_modules = Some(state.max_modules);
+            p.cancel = protocol::Cancel(Some(state.cancel));
             Ok(submit(state, seq, Job::Run(p)))
         }
         "/api/drag" => {

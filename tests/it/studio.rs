@@ -594,6 +594,42 @@ fn a_newer_run_supersedes_an_older_one() {
 }
 
 #[test]
+fn a_newer_edit_stops_a_run_in_progress() {
+    let (_dir, file) = scratch("monopodial-tree.lsy");
+    let s = serve(&file);
+    // A million cheap steps: over a minute in a debug build if left to run.
+    let slow = "lsystem A {\n    derive 1000000;\n    axiom A(0);\n    A(x) -> A(x + 1);\n}\n";
+    let port = s.port;
+    let started = std::time::Instant::now();
+    let first =
+        std::thread::spawn(move || post(port, "/api/run", &json!({ "seq": 20, "source": slow })));
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let second = post(
+        port,
+        "/api/run",
+        &json!({ "seq": 21, "source": "lsystem A { axiom F; }" }),
+    );
+    let first = first.join().expect("answers");
+    let took = started.elapsed();
+    assert_eq!(first["superseded"], true, "{first}");
+    assert_eq!(second["seq"], 21);
+    assert_eq!(second["ok"], true, "{second}");
+    assert!(
+        took < std::time::Duration::from_secs(20),
+        "the old run was stopped, not waited for: {took:?}"
+    );
+    // The run stops between steps with E0911 when the flag is set.
+    static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
+    let p = Program {
+        cancel: protocol::Cancel(Some(&STOP)),
+        ..program(slow)
+    };
+    let reply = protocol::run(&p, "slow.lsy");
+    assert!(!reply.ok);
+    assert_eq!(reply.diagnostics[0]["code"], "E0911", "{:?}", reply.diagnostics);
+}
+
+#[test]
 fn save_writes_the_file_atomically() {
     let (dir, file) = scratch("palm.lsy");
     let s = serve(&file);

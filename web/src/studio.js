@@ -90,12 +90,16 @@ async function post(path, body) {
 }
 
 /// One lane of requests (runs and drags share it): at most one in flight and
-/// one waiting; a newer request replaces the waiting one.
-const lane = { inFlight: false, waiting: null };
+/// one waiting; a newer request replaces the waiting one. An edit's run is
+/// sent at once when the one in flight is an edit's run too: the server
+/// stops the older run between derivation steps and answers it `superseded`,
+/// so typing never waits for a stale run to end.
+const lane = { inFlight: 0, current: null, waiting: null };
 
 function send(path, body, onReply, fresh = null) {
   const job = { path, body: { ...body, seq: ++state.seq }, onReply, fresh, sent: 0 };
-  if (lane.inFlight) {
+  const preempt = path === "/api/run" && lane.current && lane.current.path === "/api/run" && !lane.waiting;
+  if (lane.inFlight && !preempt) {
     lane.waiting = job;
     return;
   }
@@ -103,7 +107,8 @@ function send(path, body, onReply, fresh = null) {
 }
 
 function start(job) {
-  lane.inFlight = true;
+  lane.inFlight++;
+  lane.current = job;
   state.busy++;
   job.sent = performance.now();
   // What depends on the page's drawing is read when the request leaves, after
@@ -119,7 +124,9 @@ function start(job) {
     .catch((e) => setStatus(`the studio's server did not answer: ${e}`, true))
     .finally(() => {
       state.busy--;
-      lane.inFlight = false;
+      lane.inFlight--;
+      if (lane.current === job) lane.current = null;
+      if (lane.inFlight > 0) return;
       const next = lane.waiting;
       lane.waiting = null;
       if (next) start(next);
