@@ -25,6 +25,8 @@ const CLI_ONLY: &[Code] = &[
     Code::DrawingTooLarge,
     // Runaway decomposition: tests/it/plants.rs.
     Code::DecomposeTooDeep,
+    // A run a newer request stopped: tests/it/studio.rs.
+    Code::Cancelled,
     // Only `lsyc run` needs an lsystem: tests/it/hostile.rs.
     Code::NoLsystem,
     // Warnings of a scene's run: tests/it/guided.rs.
