@@ -170,10 +170,13 @@ pub struct Patch {
 /// The opening of a guide's layer in a scene's SVG.
 const LAYER_START: &str = "<g class=\"guide-content\" data-guide=\"";
 
+/// A scene's SVG in parts: its head, its layers (guide, text), its tail.
+pub type Layers<'a> = (&'a str, Vec<(&'a str, &'a str)>, &'a str);
+
 /// A scene's SVG split into its head, its layers (the guide's name as the
 /// SVG writes it, XML-escaped, and the layer's text) and its tail; `None` if
 /// the text is not in that shape.
-pub fn split_layers(svg: &str) -> Option<(&str, Vec<(&str, &str)>, &str)> {
+pub fn split_layers(svg: &str) -> Option<Layers<'_>> {
     let first = svg.find(LAYER_START)?;
     let mut layers = Vec::new();
     let mut at = first;
@@ -363,14 +366,8 @@ fn draw_system(
     let derived = run::derive(file, checked, &p.options(steps), &|_, _| {})?;
     let start = Instant::now();
     let mut out = Vec::new();
-    let drawn = run::write_output(
-        &derived,
-        run::Format::Svg,
-        p.picture(),
-        p.seed,
-        &mut out,
-    )
-    .map_err(output_diagnostic)?;
+    let drawn = run::write_output(&derived, run::Format::Svg, p.picture(), p.seed, &mut out)
+        .map_err(output_diagnostic)?;
     let stats = run::Stats::new(&derived, &drawn, ms(start));
     Ok((
         String::from_utf8_lossy(&out).into_owned(),
@@ -646,8 +643,8 @@ pub fn export(p: &Program, ext: &str) -> Result<Vec<u8>, String> {
     let mut out = Vec::new();
     let failed = |e: OutputError| output_diagnostic(e).message;
     if has_scene(&fe.file) {
-        let r = run::run_scene(&fe.file, checked, None, &p.options(p.step))
-            .map_err(|d| d.message)?;
+        let r =
+            run::run_scene(&fe.file, checked, None, &p.options(p.step)).map_err(|d| d.message)?;
         run::write_scene(&r, Some(format), p.picture(), p.seed, true, &mut out).map_err(failed)?;
     } else {
         let d = run::derive(&fe.file, checked, &p.options(p.step), &|_, _| {})

@@ -136,7 +136,11 @@ fn work(state: &State) {
                 if let Some(p) = slot.take() {
                     // Under the mailbox's lock, as `submit` sets them.
                     state.cancel.store(false, Ordering::SeqCst);
-                    let run = if matches!(p.job, Job::Run(_)) { p.seq } else { 0 };
+                    let run = if matches!(p.job, Job::Run(_)) {
+                        p.seq
+                    } else {
+                        0
+                    };
                     state.running_run.store(run, Ordering::SeqCst);
                     break p;
                 }

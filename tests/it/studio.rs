@@ -248,7 +248,10 @@ fn a_drag_sends_only_the_layers_that_changed_and_they_make_the_full_drawing() {
             !sent.is_empty() && sent.len() < 10,
             "some layers, not all: {sent:?}"
         );
-        assert!(!sent.contains(&"trunk"), "the pinned trunk is kept: {sent:?}");
+        assert!(
+            !sent.contains(&"trunk"),
+            "the pinned trunk is kept: {sent:?}"
+        );
         shown = patched(&shown, &patch);
         // What the page shows is what a full run of the dragged text draws.
         let dir = tempfile::tempdir().expect("tempdir");
@@ -267,7 +270,11 @@ fn a_drag_sends_only_the_layers_that_changed_and_they_make_the_full_drawing() {
         have: Some(Default::default()),
         ..Drag::default()
     };
-    let patch = session.drag(&d, rel).expect("drags").patch.expect("a patch");
+    let patch = session
+        .drag(&d, rel)
+        .expect("drags")
+        .patch
+        .expect("a patch");
     assert!(patch.layers.iter().all(|(_, t)| t.is_some()));
 }
 
@@ -311,7 +318,10 @@ fn a_stiff_spring_is_what_lsyc_edit_stiff_writes() {
     };
     let mut other = DragSession::new(&p).expect("a scene");
     let loose = other.drag(&loose, rel).expect("drags");
-    assert_ne!(loose.formatted, reply.formatted, "the spring changes the relaxation");
+    assert_ne!(
+        loose.formatted, reply.formatted,
+        "the spring changes the relaxation"
+    );
     let bad = Drag {
         stiff: vec!["trunk3.v2".to_string()],
         ..d
@@ -377,7 +387,12 @@ fn an_export_is_what_lsyc_run_writes() {
                 .collect::<String>()
                 .into_bytes();
         }
-        assert!(bytes == want, ".{ext}: {} bytes, not {}", bytes.len(), want.len());
+        assert!(
+            bytes == want,
+            ".{ext}: {} bytes, not {}",
+            bytes.len(),
+            want.len()
+        );
     }
     assert!(protocol::export(&p, "gif").is_err());
     assert!(protocol::export(&program("lsystem A {"), "svg").is_err());
@@ -626,7 +641,11 @@ fn a_newer_edit_stops_a_run_in_progress() {
     };
     let reply = protocol::run(&p, "slow.lsy");
     assert!(!reply.ok);
-    assert_eq!(reply.diagnostics[0]["code"], "E0911", "{:?}", reply.diagnostics);
+    assert_eq!(
+        reply.diagnostics[0]["code"], "E0911",
+        "{:?}",
+        reply.diagnostics
+    );
 }
 
 #[test]
