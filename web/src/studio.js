@@ -674,18 +674,20 @@ function applyPatch(patch) {
   if (!top || ui.drawing.querySelector(":scope > svg.previous")) return false;
   const old = [...top.querySelectorAll(":scope > g.guide-content")];
   if (old.length === 0 || old.length !== patch.layers.length) return false;
-  const sent = patch.layers.map(([, text]) => text || "").join("");
-  const fresh = parseSvg(patch.head + sent + patch.tail);
+  // The head and tail are small: parsed as a document of their own. The
+  // layers, which are most of the bytes, are parsed once, straight into this
+  // document (as markup inside an SVG element), not parsed and then copied.
+  const fresh = parseSvg(patch.head + patch.tail);
   const freshTop = fresh && fresh.querySelector(":scope > g");
   if (!freshTop) return false;
-  const freshLayers = [...freshTop.querySelectorAll(":scope > g.guide-content")];
-  // The tail: everything after the last layer (outlines, links).
+  const holder = document.createElementNS(SVG_NS, "g");
+  holder.innerHTML = patch.layers.map(([, text]) => text || "").join("");
+  const freshLayers = [...holder.children];
+  if (freshLayers.length !== patch.layers.filter(([, t]) => t !== null).length) return false;
+  // The tail: everything after the defs (outlines, links).
   const tail = [];
-  for (let n = freshLayers.length ? freshLayers[freshLayers.length - 1].nextSibling : null; n; n = n.nextSibling) tail.push(n);
-  if (!freshLayers.length) {
-    const defsEnd = freshTop.querySelector(":scope > defs");
-    for (let n = defsEnd ? defsEnd.nextSibling : freshTop.firstChild; n; n = n.nextSibling) tail.push(n);
-  }
+  const defsEnd = freshTop.querySelector(":scope > defs");
+  for (let n = defsEnd ? defsEnd.nextSibling : freshTop.firstChild; n; n = n.nextSibling) tail.push(n);
   let k = 0;
   patch.layers.forEach(([, text], i) => {
     if (text !== null) old[i].replaceWith(freshLayers[k++]);
