@@ -185,11 +185,12 @@ impl SegmentGrid {
     }
 
     fn col(&self, x: f64) -> usize {
-        (((x - self.min.x) * self.inv.x).floor().max(0.0) as usize).min(self.nx - 1)
+        // The cast truncates, which is the floor here (the value is not negative).
+        (((x - self.min.x) * self.inv.x).max(0.0) as usize).min(self.nx - 1)
     }
 
     fn row(&self, y: f64) -> usize {
-        (((y - self.min.y) * self.inv.y).floor().max(0.0) as usize).min(self.ny - 1)
+        (((y - self.min.y) * self.inv.y).max(0.0) as usize).min(self.ny - 1)
     }
 
     /// The cells whose boxes meet the box of `a`–`b` widened by a margin, or
