@@ -5,14 +5,18 @@
 //!
 //! Owns: finding the old list in the new one, the parts (grids over earlier
 //! lists, each with the current index of each of its segments) and when parts
-//! are merged (a part at least half the size of the one before it is merged
-//! into it, so there are few parts and each segment is indexed again only a
-//! few times). Every search returns what `SegmentGrid` over the whole current
-//! list returns (ties to the lowest index), so the parts change speed, never
-//! answers. Must not know guides or systems.
+//! are merged: at most [`MAX_PARTS`] (every search asks each part), and a part
+//! at least a quarter of the size of the one before it is merged into it, so
+//! that the part indexed anew at each step stays small. Every search returns
+//! what `SegmentGrid` over the whole current list returns (ties to the lowest
+//! index), so the parts change speed, never answers. Must not know guides or
+//! systems.
 
 use super::segments::SegmentGrid;
 use glam::DVec2;
+
+/// The most grids the segments are kept in.
+pub const MAX_PARTS: usize = 3;
 
 /// A grid over some of the current segments; `ids[i]` is the current index
 /// of the grid's segment `i` (increasing).
@@ -124,9 +128,10 @@ impl GrowingGrid {
         if !fresh.is_empty() {
             self.parts.push(Part::over(&self.segs, fresh));
         }
-        // A part at least half the size of the one before it joins it.
+        // Too many parts, or a part at least a quarter of the size of the one
+        // before it: the last two become one.
         while let [.., a, b] = &self.parts[..]
-            && b.ids.len() * 2 >= a.ids.len()
+            && (self.parts.len() > MAX_PARTS || b.ids.len() * 4 >= a.ids.len())
         {
             let ids = merge(&a.ids, &b.ids);
             self.parts.truncate(self.parts.len() - 2);
@@ -191,6 +196,40 @@ impl GrowingGrid {
 
     /// `SegmentGrid::ray` over the current segments.
     pub fn ray(&self, p: DVec2, dir: DVec2, limit: f64) -> Option<(f64, usize)> {
+        if self.parts.len() < 2 {
+            return self.ray_within(p, dir, limit);
+        }
+        // A part with few segments far apart would walk the ray far to its own
+        // first hit: ask every part within a short reach first, and only
+        // when nothing is hit there, twice as far (the nearest hit within a
+        // reach is the nearest of all).
+        let cell = self
+            .parts
+            .iter()
+            .map(|x| x.grid.stride())
+            .fold(f64::INFINITY, f64::min);
+        // Beyond the farthest corner of every box, a longer reach finds nothing more.
+        let far = self
+            .parts
+            .iter()
+            .filter(|x| x.grid.cells() > 0)
+            .map(|x| {
+                let (lo, hi) = x.grid.bounds();
+                (p - lo).abs().max((p - hi).abs()).length()
+            })
+            .fold(0.0, f64::max);
+        let mut reach = 4.0 * cell;
+        while reach.is_finite() && reach < limit && reach < far {
+            if let Some(hit) = self.ray_within(p, dir, reach) {
+                return Some(hit);
+            }
+            reach *= 2.0;
+        }
+        self.ray_within(p, dir, limit)
+    }
+
+    /// The first hit not farther than `limit`, asking every part.
+    fn ray_within(&self, p: DVec2, dir: DVec2, limit: f64) -> Option<(f64, usize)> {
         let mut best: Option<(f64, usize)> = None;
         for part in &self.parts {
             // Hits at the best distance so far still count (a lower index wins).

@@ -248,6 +248,17 @@ impl SegmentGrid {
         self.nx * self.ny
     }
 
+    /// The side of a cell along its shortest axis of more than one cell
+    /// (infinite for one cell).
+    pub fn stride(&self) -> f64 {
+        self.stride
+    }
+
+    /// The corners of the box of the segments (`min > max` when there are none).
+    pub fn bounds(&self) -> (DVec2, DVec2) {
+        (self.min, self.max)
+    }
+
     /// The indexed segments, in their order.
     pub fn segs(&self) -> &[(DVec2, DVec2)] {
         &self.segs
