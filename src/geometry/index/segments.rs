@@ -297,6 +297,14 @@ impl SegmentGrid {
             _ => Some(x),
         };
         if self.nx * self.ny == 1 {
+            // Boxes apart: no segment is met (as `crossing` decides it first).
+            if p.x.max(q.x) < self.min.x
+                || self.max.x < p.x.min(q.x)
+                || p.y.max(q.y) < self.min.y
+                || self.max.y < p.y.min(q.y)
+            {
+                return None;
+            }
             return self
                 .items
                 .iter()
