@@ -6,6 +6,9 @@
 //! messages), then draw every guide's systems through the centre rule (counting
 //! what is kept). Parsing and checking are outside the timed region.
 //!
+//! The same layout at `-D SIZE=3`, ten times the paper's scale (over 850,000
+//! segments), times how the run grows with the scene.
+//!
 //! Also the guided tree of the paper (Fig. 1, `lang-examples/tree.lsy`: about
 //! 15,000 elements, segments and leaves; the paper took 2 s for it).
 //!
@@ -25,8 +28,11 @@ use std::time::Duration;
 /// The size of the benchmark's layout (the gallery picture uses the file's 0.25).
 const SIZE: &str = "SIZE=0.95";
 
+/// Ten times the paper's scale (the side of every district ×3.16).
+const SIZE_X10: &str = "SIZE=3";
+
 /// Times one scene of a gallery file, whole, as `lsyc run` runs it.
-fn scene(c: &mut Criterion, group: &str, file: &str, overrides: &[&str]) {
+fn scene(c: &mut Criterion, group: &str, file: &str, overrides: &[&str], samples: usize) {
     let path = format!("{}/lang-examples/{file}", env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(&path).expect("the gallery file");
     let parsed: Vec<Override> = overrides
@@ -57,7 +63,7 @@ fn scene(c: &mut Criterion, group: &str, file: &str, overrides: &[&str]) {
     );
     let mut g = c.benchmark_group(group);
     g.sampling_mode(SamplingMode::Flat)
-        .sample_size(10)
+        .sample_size(samples)
         .measurement_time(Duration::from_secs(8));
     g.bench_function("whole scene, all threads", |b| {
         b.iter(|| black_box(whole()))
@@ -73,14 +79,19 @@ fn scene(c: &mut Criterion, group: &str, file: &str, overrides: &[&str]) {
 }
 
 fn urban(c: &mut Criterion) {
-    scene(c, "urban", "urban.lsy", &[SIZE]);
+    scene(c, "urban", "urban.lsy", &[SIZE], 10);
+}
+
+/// Ten times the paper's city: over 850,000 street segments.
+fn urban_x10(c: &mut Criterion) {
+    scene(c, "urban x10", "urban.lsy", &[SIZE_X10], 10);
 }
 
 fn tree(c: &mut Criterion) {
-    scene(c, "tree", "tree.lsy", &[]);
+    scene(c, "tree", "tree.lsy", &[], 10);
 }
 
-criterion_group!(benches, urban, tree);
+criterion_group!(benches, urban, urban_x10, tree);
 
 fn main() {
     eprintln!(

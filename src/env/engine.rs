@@ -195,7 +195,9 @@ struct Reservation {
 }
 
 /// A system's drawing: its segments (and elements' axes) in a grid, and the
-/// query modules met, with the turtle there.
+/// query modules met, with the turtle there. When the string changes, the grid
+/// is kept until the system is drawn again: growth inserts segments into the
+/// drawing, and only those are indexed anew (`Grid::update`).
 struct Drawing {
     grid: Grid,
     queries: Vec<(usize, u8, State)>,
@@ -206,6 +208,8 @@ struct Live {
     guide: usize,
     run: GuideRun,
     probes: Vec<Option<Drawing>>,
+    /// The grid of the system's last drawing, while it is to be drawn again.
+    stale: Vec<Option<Grid>>,
     /// Answer this system's queries in this step.
     fresh: Vec<bool>,
     /// The system's string holds only modules without rules (no query, no
@@ -512,6 +516,7 @@ fn start(scene: &Scene, cfg: Config, unit: &[usize]) -> Result<Vec<Live>, Diagno
             guide: g,
             run: GuideRun::default(),
             probes: Vec::new(),
+            stale: Vec::new(),
             fresh: Vec::new(),
             settled: Vec::new(),
             reserved: Vec::new(),
@@ -579,6 +584,7 @@ impl Live {
     fn add(&mut self, inst: Instance) {
         self.run.instances.push(inst);
         self.probes.push(None);
+        self.stale.push(None);
         self.fresh.push(true);
         self.settled.push(false);
     }
@@ -588,7 +594,7 @@ impl Live {
 fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<bool, Diagnostic> {
     type Job<'a> = (
         &'a mut Instance,
-        &'a mut Option<Drawing>,
+        (&'a mut Option<Drawing>, &'a mut Option<Grid>),
         &'a mut bool,
         &'a mut bool,
     );
@@ -601,7 +607,7 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
             .run
             .instances
             .iter_mut()
-            .zip(&mut l.probes)
+            .zip(l.probes.iter_mut().zip(&mut l.stale))
             .zip(&mut l.fresh)
             .zip(&mut l.settled)
         {
@@ -631,7 +637,7 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
             if string != inst.string {
                 inst.string = string;
                 inst.changed = t;
-                *probe = None;
+                outdate(probe.0, probe.1);
             }
             *fresh = true;
             *settled = inst.string.syms.iter().all(|&x| inert(prog, x));
@@ -661,27 +667,44 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
 fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagnostic> {
     let mut jobs = Vec::new();
     for l in live.iter_mut() {
-        for (inst, probe) in l.run.instances.iter().zip(&mut l.probes) {
+        for (inst, (probe, stale)) in l
+            .run
+            .instances
+            .iter()
+            .zip(l.probes.iter_mut().zip(&mut l.stale))
+        {
             if probe.is_none() {
-                jobs.push((inst, probe));
+                jobs.push((inst, probe, stale));
             }
         }
     }
     let results: Vec<Result<(), Diagnostic>> = jobs
         .into_par_iter()
-        .map(|(inst, probe)| {
+        .map(|(inst, probe, stale)| {
             let prog = &scene.programs[scene.guides[inst.guide].program];
             let mut p = Probe::default();
             turtle::interpret_limited(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut p)
                 .map_err(|e| e.diagnostic(prog))?;
+            let grid = match stale.take() {
+                Some(g) => g.update(p.segments),
+                None => Grid::new(p.segments),
+            };
             *probe = Some(Drawing {
-                grid: Grid::new(p.segments),
+                grid,
                 queries: p.queries,
             });
             Ok(())
         })
         .collect();
     results.into_iter().collect()
+}
+
+/// Marks a system's drawing as out of date, keeping its grid for the next
+/// drawing to update.
+fn outdate(probe: &mut Option<Drawing>, stale: &mut Option<Grid>) {
+    if let Some(d) = probe.take() {
+        *stale = Some(d.grid);
+    }
 }
 
 /// Settles the reservations of guide `l` made in the step before `t`.
@@ -913,7 +936,7 @@ fn write_answers(
     }
     if queries_interpreted(prog) {
         // Its drawing may read the answers: draw it again when needed.
-        l.probes[k] = None;
+        outdate(&mut l.probes[k], &mut l.stale[k]);
     }
     inst.steps < prog.derive
 }

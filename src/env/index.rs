@@ -1,12 +1,14 @@
 //! The spatial index of the segments drawn in a guide, as the environment
-//! asks it: one `Grid` (the crate's `geometry::index::SegmentGrid`) per
-//! system, and `Layers`, the grids of all systems of a guide searched as one.
+//! asks it: one `Grid` (the crate's `geometry::index::GrowingGrid`, kept from
+//! step to step while the system grows) per system, and `Layers`, the grids of
+//! all systems of a guide searched as one.
 //!
 //! Owns: numbering segments across systems and merging the per-grid answers
 //! (the lowest id wins ties). Must not index or search segments itself.
 
+pub use crate::geometry::index::GrowingGrid as Grid;
 pub use crate::geometry::index::segments::{
-    MAX_CELLS_PER_AXIS, SCAN_BELOW_SEGMENTS, SegmentGrid as Grid, TOUCH, touches,
+    MAX_CELLS_PER_AXIS, SCAN_BELOW_SEGMENTS, TOUCH, touches,
 };
 use glam::DVec2;
 

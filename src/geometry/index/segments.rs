@@ -185,11 +185,12 @@ impl SegmentGrid {
     }
 
     fn col(&self, x: f64) -> usize {
-        (((x - self.min.x) * self.inv.x).floor().max(0.0) as usize).min(self.nx - 1)
+        // The cast truncates, which is the floor here (the value is not negative).
+        (((x - self.min.x) * self.inv.x).max(0.0) as usize).min(self.nx - 1)
     }
 
     fn row(&self, y: f64) -> usize {
-        (((y - self.min.y) * self.inv.y).floor().max(0.0) as usize).min(self.ny - 1)
+        (((y - self.min.y) * self.inv.y).max(0.0) as usize).min(self.ny - 1)
     }
 
     /// The cells whose boxes meet the box of `a`–`b` widened by a margin, or
@@ -247,6 +248,17 @@ impl SegmentGrid {
         self.nx * self.ny
     }
 
+    /// The side of a cell along its shortest axis of more than one cell
+    /// (infinite for one cell).
+    pub fn stride(&self) -> f64 {
+        self.stride
+    }
+
+    /// The corners of the box of the segments (`min > max` when there are none).
+    pub fn bounds(&self) -> (DVec2, DVec2) {
+        (self.min, self.max)
+    }
+
     /// The indexed segments, in their order.
     pub fn segs(&self) -> &[(DVec2, DVec2)] {
         &self.segs
@@ -285,6 +297,14 @@ impl SegmentGrid {
             _ => Some(x),
         };
         if self.nx * self.ny == 1 {
+            // Boxes apart: no segment is met (as `crossing` decides it first).
+            if p.x.max(q.x) < self.min.x
+                || self.max.x < p.x.min(q.x)
+                || p.y.max(q.y) < self.min.y
+                || self.max.y < p.y.min(q.y)
+            {
+                return None;
+            }
             return self
                 .items
                 .iter()
