@@ -1185,3 +1185,132 @@ fn apply_cut(prog: &Program, s: ModString) -> ModString {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn program(text: &str) -> Program {
+        let fe = crate::frontend::run(text, vec![], &[]);
+        assert!(!fe.has_errors(), "{:?}", fe.diagnostics);
+        let checked = fe.checked.as_ref().expect("checked");
+        crate::compile::compile(&fe.file, checked, None).expect("compiles")
+    }
+
+    /// The definition a step must agree with: every module rewritten in
+    /// order, one chunk for the whole string.
+    fn reference_step(prog: &Program, s: &ModString, step: u32, seed: u64) -> ModString {
+        let (_, offsets) = param_offsets(prog, s, true);
+        let view = View {
+            prog,
+            s,
+            offsets,
+            growth: growth(prog),
+        };
+        let unlimited = Limits {
+            max_modules: usize::MAX,
+            max_bytes: usize::MAX,
+        };
+        let out = rewrite_chunk(
+            &view,
+            0,
+            &s.syms,
+            0,
+            step,
+            seed,
+            unlimited,
+            &AtomicUsize::new(0),
+        )
+        .expect("rewrites");
+        ModString {
+            syms: out.syms,
+            params: out.params,
+        }
+    }
+
+    /// Conditions (one that fails and leaves the module as it is), weights
+    /// with random draws before and after the choice, context with an ignore
+    /// list, fixed rules and modules without rules, over strings of several
+    /// chunks: the counted-then-filled step equals the in-order rewrite on 1
+    /// and 2 threads.
+    #[test]
+    fn counted_steps_equal_the_in_order_rewrite() {
+        let prog = program(
+            "lsystem Mixed {
+                ignore + -;
+                axiom A(1) B(2) + A(3) C(0);
+                A(x) : x < 1000 -> A(x + 1) [ + B(x * 0.5) ] A(x + uniform(1, 2)) - C(x);
+                A(x) : x > 100 -> F(x);
+                B(y) < B(z) : z > 1 -> B(y + z);
+                B(z) ->(0.5) B(z + rand()) F(z);
+                B(z) ->(0.5) C(z / 2);
+                C(c) : c < 3 -> C(c + 1) F(2 * c);
+            }",
+        );
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let two = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let seed = 11;
+        let mut s = axiom(&prog, &[], seed).unwrap();
+        let mut k = 0;
+        while s.len() < 4 * CHUNK {
+            k += 1;
+            assert!(k < 40, "the test string stopped growing");
+            let want = reference_step(&prog, &s, k, seed);
+            let a = one.install(|| step(&prog, &s, k, seed, Limits::default())).unwrap();
+            let b = two.install(|| step(&prog, &s, k, seed, Limits::default())).unwrap();
+            assert_eq!(a, want, "step {k}, one thread");
+            assert_eq!(b, want, "step {k}, two threads");
+            s = a;
+        }
+    }
+
+    /// An expression error in a late chunk and another in an early chunk:
+    /// the early one is reported, on any thread count.
+    #[test]
+    fn the_first_failing_module_is_reported() {
+        let prog = program(
+            "lsystem Fails {
+                axiom A(0) B(3) C(4);
+                A(x) -> A(x + 1);
+                B(x) -> B(1 / (x - 3));
+                C(x) -> C(1 / (x - 4));
+            }",
+        );
+        let start = axiom(&prog, &[], 0).unwrap();
+        let (a, b, c) = (start.syms[0], start.syms[1], start.syms[2]);
+        let alone = |sym: Sym, x: f64| ModString {
+            syms: vec![sym],
+            params: vec![x],
+        };
+        let err_b = step(&prog, &alone(b, 3.0), 1, 0, Limits::default()).unwrap_err();
+        let err_c = step(&prog, &alone(c, 4.0), 1, 0, Limits::default()).unwrap_err();
+        assert_ne!(err_b, err_c, "the two errors differ");
+        let n = 3 * CHUNK;
+        let mut s = ModString::default();
+        for i in 0..n {
+            let (sym, x) = match i {
+                5 => (c, 4.0),
+                _ if i == n - 5 => (b, 3.0),
+                _ => (a, 0.0),
+            };
+            s.syms.push(sym);
+            s.params.push(x);
+        }
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let err = pool
+                .install(|| step(&prog, &s, 1, 0, Limits::default()))
+                .unwrap_err();
+            assert_eq!(err, err_c, "{threads} threads");
+        }
+    }
+}
