@@ -892,7 +892,11 @@ fn fill_chunk(
                 let r = &prog.rules[sym as usize][c.rule as usize];
                 // The slots as choosing bound them (the match succeeded then).
                 bind(view, r, base + j, params, &mut slots);
-                (&plan.flat[sym as usize][c.rule as usize], &slots[..], c.draws)
+                (
+                    &plan.flat[sym as usize][c.rule as usize],
+                    &slots[..],
+                    c.draws,
+                )
             }
         };
         let n = flat.syms.len();
@@ -903,7 +907,10 @@ fn fill_chunk(
         k += n;
         let mut rng = Random::new(seed, step, (base + j) as u64);
         rng.draw = draws;
-        for (slot, a) in out_params[q..q + flat.args.len()].iter_mut().zip(&flat.args) {
+        for (slot, a) in out_params[q..q + flat.args.len()]
+            .iter_mut()
+            .zip(&flat.args)
+        {
             match code.eval(*a, args, &mut rng, &mut stack) {
                 Ok(v) => *slot = v,
                 Err(_) => return false,
@@ -1262,8 +1269,12 @@ mod tests {
             k += 1;
             assert!(k < 40, "the test string stopped growing");
             let want = reference_step(&prog, &s, k, seed);
-            let a = one.install(|| step(&prog, &s, k, seed, Limits::default())).unwrap();
-            let b = two.install(|| step(&prog, &s, k, seed, Limits::default())).unwrap();
+            let a = one
+                .install(|| step(&prog, &s, k, seed, Limits::default()))
+                .unwrap();
+            let b = two
+                .install(|| step(&prog, &s, k, seed, Limits::default()))
+                .unwrap();
             assert_eq!(a, want, "step {k}, one thread");
             assert_eq!(b, want, "step {k}, two threads");
             s = a;
