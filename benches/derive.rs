@@ -3,10 +3,14 @@
 //!
 //! - `koch_1_9b`: the D0L Koch curve of ABOP fig. 1.9b (`F -> FF-F-F-F-FF`,
 //!   axiom `F-F-F-F`) to depth 8;
-//! - `monopodial_2_6`: the parametric monopodial tree of ABOP fig. 2.6 to depth 20.
+//! - `monopodial_2_6`: the parametric monopodial tree of ABOP fig. 2.6 to depth 20;
+//! - `row_of_trees`: the parametric row of trees of ABOP §1.10.3
+//!   (`F(x) -> F(x*p)+F(x*h)--F(x*h)+F(x*q)`, axiom `F(1)`) to depth 11. Each
+//!   step multiplies the `F`s by four, so depth 11 (9.8 M modules, 4.2 M
+//!   parameters) is the size of the tree at depth 20; depth 19 would be 2.7·10¹¹.
 //!
-//! lsyc runs from the gallery programs in `lang-examples/`; symbios gets the same
-//! rules in its own syntax. Before timing, both engines derive each system once
+//! lsyc runs from the gallery programs in `lang-examples/` (the row of trees from
+//! the program text below); symbios gets the same rules in its own syntax. Before timing, both engines derive each system once
 //! and the two strings are compared module by module (symbol names, and parameter
 //! values for the tree), so the throughput figures count the same work.
 //!
@@ -93,13 +97,32 @@ fn peak_during<T>(f: impl FnOnce() -> T) -> (T, usize) {
 
 const KOCH_DEPTH: u32 = 8;
 const TREE_DEPTH: u32 = 20;
+const ROW_DEPTH: u32 = 11;
+
+/// The row of trees of ABOP §1.10.3, in lsyc.
+const ROW_OF_TREES: &str = "
+const c = 1;
+const p = 0.3;
+const q = c - p;
+const h = (p * q) ^ 0.5;
+
+lsystem RowOfTrees {
+    angle 86;
+    axiom F(1);
+    F(x) -> F(x * p) + F(x * h) - - F(x * h) + F(x * q);
+}
+";
 
 // ---------------------------------------------------------------- lsyc
 
 fn lsyc_program(file: &str) -> Program {
     let path = format!("{}/lang-examples/{file}", env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(&path).expect("gallery program");
-    let fe = lsyc::frontend::run(&text, vec![], &[]);
+    lsyc_program_text(&path, &text)
+}
+
+fn lsyc_program_text(path: &str, text: &str) -> Program {
+    let fe = lsyc::frontend::run(text, vec![], &[]);
     assert!(!fe.has_errors(), "{path}: {:?}", fe.diagnostics);
     let checked = fe.checked.as_ref().expect("checked");
     compile::compile(&fe.file, checked, None).expect("compiles")
@@ -146,6 +169,26 @@ fn symbios_tree() -> symbios::System {
         .unwrap();
     // The gallery program's axiom (the book's A(1, 10) with lengths scaled by 100).
     sys.set_axiom("A(100, 10)").unwrap();
+    sys
+}
+
+fn symbios_row() -> symbios::System {
+    let mut sys = symbios::System::new();
+    sys.max_capacity = SYMBIOS_CAPACITY;
+    // The constants as lsyc computes them (q = c - p, h = (p q)^0.5), printed
+    // exactly.
+    let (p, q) = (0.3f64, 1.0f64 - 0.3);
+    let h = (p * q).powf(0.5);
+    for d in [
+        format!("#define p {p:?}"),
+        format!("#define q {q:?}"),
+        format!("#define h {h:?}"),
+    ] {
+        sys.add_directive(&d).unwrap();
+    }
+    sys.add_rule("F(x) -> F(x*p) + F(x*h) - - F(x*h) + F(x*q)")
+        .unwrap();
+    sys.set_axiom("F(1)").unwrap();
     sys
 }
 
@@ -235,8 +278,13 @@ fn verify_and_report(
 
 // ---------------------------------------------------------------- benches
 
-fn compare(c: &mut Criterion, name: &str, file: &str, depth: u32, make: fn() -> symbios::System) {
-    let prog = lsyc_program(file);
+fn compare(
+    c: &mut Criterion,
+    name: &str,
+    prog: Program,
+    depth: u32,
+    make: fn() -> symbios::System,
+) {
     let n = verify_and_report(name, &prog, depth, make);
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
@@ -277,20 +325,31 @@ fn compare(c: &mut Criterion, name: &str, file: &str, depth: u32, make: fn() -> 
 }
 
 fn koch(c: &mut Criterion) {
-    compare(c, "koch_1_9b", "koch-curve-b.lsy", KOCH_DEPTH, symbios_koch);
+    let prog = lsyc_program("koch-curve-b.lsy");
+    compare(c, "koch_1_9b", prog, KOCH_DEPTH, symbios_koch);
 }
 
 fn monopodial(c: &mut Criterion) {
     compare(
         c,
         "monopodial_2_6",
-        "monopodial-tree.lsy",
+        lsyc_program("monopodial-tree.lsy"),
         TREE_DEPTH,
         symbios_tree,
     );
 }
 
-criterion_group!(benches, koch, monopodial);
+fn row_of_trees(c: &mut Criterion) {
+    compare(
+        c,
+        "row_of_trees",
+        lsyc_program_text("row of trees", ROW_OF_TREES),
+        ROW_DEPTH,
+        symbios_row,
+    );
+}
+
+criterion_group!(benches, koch, monopodial, row_of_trees);
 
 fn main() {
     eprintln!(

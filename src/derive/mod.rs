@@ -567,6 +567,128 @@ struct ChunkOut {
     params: Vec<f64>,
 }
 
+/// How a symbol rewrites, as far as is known before a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Kind {
+    /// No rule: the module is copied.
+    Keep,
+    /// One rule that always applies and binds only the predecessor's parameters.
+    Fixed,
+    /// Conditions, weights or context decide, module by module.
+    Choose,
+}
+
+/// What the counting pass reads per symbol: its arity and, unless it must
+/// choose, how many modules and parameters one of it becomes.
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    arity: u32,
+    mods: u32,
+    params: u32,
+    kind: Kind,
+}
+
+/// A rule's successor flattened: its symbols (padded to `PAD` when it fits, so
+/// they are copied as one fixed-size block) and the code of its parameters.
+struct Flat {
+    syms: Vec<Sym>,
+    block: Option<[Sym; PAD]>,
+    args: Vec<crate::vm::Code>,
+}
+
+impl Flat {
+    fn new(r: &CompiledRule) -> Flat {
+        let syms: Vec<Sym> = r.succ.iter().map(|e| e.sym).collect();
+        let block = (syms.len() <= PAD).then(|| {
+            let mut b = [0 as Sym; PAD];
+            b[..syms.len()].copy_from_slice(&syms);
+            b
+        });
+        Flat {
+            syms,
+            block,
+            args: r.succ.iter().flat_map(|e| e.args.iter().copied()).collect(),
+        }
+    }
+}
+
+/// The step's plan: an entry per symbol and the flattened rules.
+struct Plan {
+    table: Vec<Entry>,
+    /// `flat[sym][k]`: rule k of the symbol.
+    flat: Vec<Vec<Flat>>,
+}
+
+impl Plan {
+    fn new(prog: &Program) -> Plan {
+        let table = prog
+            .rules
+            .iter()
+            .enumerate()
+            .map(|(s, rules)| {
+                let arity = prog.symbols.arity(s as Sym) as u32;
+                match rules.as_slice() {
+                    [] => Entry {
+                        arity,
+                        mods: 1,
+                        params: arity,
+                        kind: Kind::Keep,
+                    },
+                    [r] if r.cond.is_none()
+                        && r.weight.is_none()
+                        && r.left.is_empty()
+                        && r.right.is_empty() =>
+                    {
+                        Entry {
+                            arity,
+                            mods: r.succ.len() as u32,
+                            params: r.succ.iter().map(|e| e.args.len() as u32).sum(),
+                            kind: Kind::Fixed,
+                        }
+                    }
+                    _ => Entry {
+                        arity,
+                        mods: 0,
+                        params: 0,
+                        kind: Kind::Choose,
+                    },
+                }
+            })
+            .collect();
+        let flat = prog
+            .rules
+            .iter()
+            .map(|rules| rules.iter().map(Flat::new).collect())
+            .collect();
+        Plan { table, flat }
+    }
+}
+
+/// A module's choice, recorded by the counting pass for the filling pass: the
+/// rule (or `NO_RULE`) and how many numbers choosing drew.
+#[derive(Clone, Copy, Debug)]
+struct Choice {
+    rule: u32,
+    draws: u32,
+}
+
+const NO_RULE: u32 = u32::MAX;
+
+/// One chunk's counts: parameters in; modules and parameters out.
+#[derive(Clone, Copy, Debug, Default)]
+struct Counts {
+    params_in: usize,
+    mods: usize,
+    params: usize,
+    choose: bool,
+}
+
+/// A parametric step, counted then filled in place: a first pass sums what
+/// every module becomes (choosing a rule where conditions, weights or context
+/// decide, and recording the choice); the limits are checked on the exact
+/// totals; then every chunk writes its share of the output directly. On an
+/// expression error the step is rewritten again in module order, so the error
+/// reported is the first in the string on any thread count.
 fn parametric_step(
     prog: &Program,
     s: &ModString,
@@ -574,62 +696,299 @@ fn parametric_step(
     seed: u64,
     limits: Limits,
 ) -> Result<ModString, DeriveError> {
-    let (starts, offsets) = param_offsets(prog, s, prog.has_context);
+    let plan = Plan::new(prog);
+    let table = &plan.table;
+    let mut counts: Vec<Counts> = s
+        .syms
+        .par_chunks(CHUNK)
+        .map(|c| {
+            let mut n = Counts::default();
+            for &x in c {
+                let e = &table[x as usize];
+                n.params_in += e.arity as usize;
+                n.mods += e.mods as usize;
+                n.params += e.params as usize;
+                n.choose |= e.kind == Kind::Choose;
+            }
+            n
+        })
+        .collect();
+    let mut starts = Vec::with_capacity(counts.len());
+    let mut acc = 0usize;
+    for c in &counts {
+        starts.push(acc);
+        acc += c.params_in;
+    }
+    let offsets = if prog.has_context {
+        param_offsets(prog, s, true).1
+    } else {
+        Vec::new()
+    };
     let view = View {
         prog,
         s,
         offsets,
-        growth: growth(prog),
+        growth: Vec::new(),
     };
-    let produced = AtomicUsize::new(0);
-    let parts: Vec<Result<ChunkOut, DeriveError>> = s
+    // Choices, for the chunks that have modules to choose for.
+    let choices: Vec<Result<Vec<Choice>, ()>> = s
         .syms
         .par_chunks(CHUNK)
+        .zip(counts.par_iter_mut())
         .enumerate()
-        .map(|(ci, chunk)| {
-            rewrite_chunk(
+        .map(|(ci, (chunk, n))| {
+            if !n.choose {
+                return Ok(Vec::new());
+            }
+            choose_chunk(&view, &plan, ci * CHUNK, chunk, starts[ci], step, seed, n)
+        })
+        .collect();
+    if choices.iter().any(Result::is_err) {
+        return Err(first_error(&view, step, seed));
+    }
+    let choices: Vec<Vec<Choice>> = choices.into_iter().map(|c| c.unwrap_or_default()).collect();
+    let total = counts
+        .iter()
+        .try_fold(0usize, |a, c| a.checked_add(c.mods))
+        .unwrap_or(usize::MAX);
+    let total_params = counts
+        .iter()
+        .try_fold(0usize, |a, c| a.checked_add(c.params))
+        .unwrap_or(usize::MAX);
+    // The message does not give the count, as it did not when the limit was
+    // checked on running totals: it stays the same across versions.
+    check_limits(step, total, total_params, limits, false)?;
+    let mut syms = vec![0 as Sym; total];
+    let mut params = vec![0.0; total_params];
+    let mut parts = Vec::with_capacity(counts.len());
+    let (mut rs, mut rp): (&mut [Sym], &mut [f64]) = (&mut syms, &mut params);
+    for c in &counts {
+        let (a, b) = rs.split_at_mut(c.mods);
+        rs = b;
+        let (pa, pb) = rp.split_at_mut(c.params);
+        rp = pb;
+        parts.push((a, pa));
+    }
+    let failed = s
+        .syms
+        .par_chunks(CHUNK)
+        .zip(parts.into_par_iter())
+        .zip(choices.par_iter())
+        .enumerate()
+        .map(|(ci, ((chunk, (out_syms, out_params)), choices))| {
+            fill_chunk(
                 &view,
+                &plan,
                 ci * CHUNK,
                 chunk,
                 starts[ci],
+                choices,
                 step,
                 seed,
-                limits,
-                &produced,
+                out_syms,
+                out_params,
             )
         })
-        .collect();
-    let mut outs = Vec::with_capacity(parts.len());
-    for p in parts {
-        outs.push(p?);
+        .any(|ok| !ok);
+    if failed {
+        return Err(first_error(&view, step, seed));
     }
-    let total: usize = outs.iter().map(|o| o.syms.len()).sum();
-    let total_params: usize = outs.iter().map(|o| o.params.len()).sum();
-    // Whether a chunk stopped early on the running total depends on timing, so
-    // this check does not print its exact count either: the message is the same
-    // on every run.
-    check_limits(step, total, total_params, limits, false)?;
-    // Join the chunks' outputs in parallel, each into its own slice.
-    let mut syms = vec![0 as Sym; total];
-    let mut params = vec![0.0; total_params];
-    let mut sym_slices = Vec::with_capacity(outs.len());
-    let mut param_slices = Vec::with_capacity(outs.len());
-    let (mut rs, mut rp): (&mut [Sym], &mut [f64]) = (&mut syms, &mut params);
-    for o in &outs {
-        let (a, b) = rs.split_at_mut(o.syms.len());
-        sym_slices.push(a);
-        rs = b;
-        let (a, b) = rp.split_at_mut(o.params.len());
-        param_slices.push(a);
-        rp = b;
-    }
-    outs.par_iter()
-        .zip(sym_slices.into_par_iter().zip(param_slices.into_par_iter()))
-        .for_each(|(o, (ss, ps))| {
-            ss.copy_from_slice(&o.syms);
-            ps.copy_from_slice(&o.params);
-        });
     Ok(ModString { syms, params })
+}
+
+/// Chooses the rule of every module of a chunk whose symbol must choose, and
+/// adds what the choices produce to `n`. `Err` on an expression error.
+#[allow(clippy::too_many_arguments)]
+fn choose_chunk(
+    view: &View,
+    plan: &Plan,
+    base: usize,
+    chunk: &[Sym],
+    param_start: usize,
+    step: u32,
+    seed: u64,
+    n: &mut Counts,
+) -> Result<Vec<Choice>, ()> {
+    let prog = view.prog;
+    let mut out = Vec::new();
+    let mut p = param_start;
+    let mut slots: Vec<f64> = Vec::new();
+    let mut stack: Vec<f64> = Vec::new();
+    let mut weights: Vec<(usize, f64)> = Vec::new();
+    for (j, &sym) in chunk.iter().enumerate() {
+        let e = &plan.table[sym as usize];
+        let arity = e.arity as usize;
+        if e.kind != Kind::Choose {
+            p += arity;
+            continue;
+        }
+        let params = &view.s.params[p..p + arity];
+        p += arity;
+        let i = base + j;
+        let mut rng = Random::new(seed, step, i as u64);
+        let rules = &prog.rules[sym as usize];
+        let chosen = choose(
+            view,
+            rules,
+            i,
+            params,
+            &mut slots,
+            &mut stack,
+            &mut rng,
+            &mut weights,
+        )
+        .map_err(|_| ())?;
+        match chosen {
+            Some(k) => {
+                let f = &plan.flat[sym as usize][k];
+                n.mods += f.syms.len();
+                n.params += f.args.len();
+                out.push(Choice {
+                    rule: k as u32,
+                    draws: rng.draw,
+                });
+            }
+            None => {
+                n.mods += 1;
+                n.params += arity;
+                out.push(Choice {
+                    rule: NO_RULE,
+                    draws: 0,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Writes a chunk's output into its slices; false on an expression error.
+#[allow(clippy::too_many_arguments)]
+fn fill_chunk(
+    view: &View,
+    plan: &Plan,
+    base: usize,
+    chunk: &[Sym],
+    param_start: usize,
+    choices: &[Choice],
+    step: u32,
+    seed: u64,
+    out_syms: &mut [Sym],
+    out_params: &mut [f64],
+) -> bool {
+    let prog = view.prog;
+    let code = &prog.chunk;
+    let in_params = &view.s.params;
+    let mut p = param_start;
+    let (mut k, mut q) = (0usize, 0usize);
+    let mut next_choice = choices.iter();
+    let mut slots: Vec<f64> = Vec::new();
+    let mut stack: Vec<f64> = Vec::new();
+    for (j, &sym) in chunk.iter().enumerate() {
+        let e = &plan.table[sym as usize];
+        let arity = e.arity as usize;
+        let params = &in_params[p..p + arity];
+        p += arity;
+        let (flat, args, draws) = match e.kind {
+            Kind::Keep => {
+                keep(sym, params, out_syms, out_params, &mut k, &mut q);
+                continue;
+            }
+            Kind::Fixed => (&plan.flat[sym as usize][0], params, 0),
+            Kind::Choose => {
+                let Some(c) = next_choice.next() else {
+                    return false;
+                };
+                if c.rule == NO_RULE {
+                    keep(sym, params, out_syms, out_params, &mut k, &mut q);
+                    continue;
+                }
+                let r = &prog.rules[sym as usize][c.rule as usize];
+                // The slots as choosing bound them (the match succeeded then).
+                bind(view, r, base + j, params, &mut slots);
+                (
+                    &plan.flat[sym as usize][c.rule as usize],
+                    &slots[..],
+                    c.draws,
+                )
+            }
+        };
+        let n = flat.syms.len();
+        match &flat.block {
+            Some(b) if k + PAD <= out_syms.len() => out_syms[k..k + PAD].copy_from_slice(b),
+            _ => out_syms[k..k + n].copy_from_slice(&flat.syms),
+        }
+        k += n;
+        let mut rng = Random::new(seed, step, (base + j) as u64);
+        rng.draw = draws;
+        for (slot, a) in out_params[q..q + flat.args.len()]
+            .iter_mut()
+            .zip(&flat.args)
+        {
+            match code.eval(*a, args, &mut rng, &mut stack) {
+                Ok(v) => *slot = v,
+                Err(_) => return false,
+            }
+        }
+        q += flat.args.len();
+    }
+    true
+}
+
+/// Copies a module that no rule rewrites.
+#[inline(always)]
+fn keep(
+    sym: Sym,
+    params: &[f64],
+    out_syms: &mut [Sym],
+    out_params: &mut [f64],
+    k: &mut usize,
+    q: &mut usize,
+) {
+    out_syms[*k] = sym;
+    *k += 1;
+    match params {
+        [] => {}
+        [a] => out_params[*q] = *a,
+        _ => out_params[*q..*q + params.len()].copy_from_slice(params),
+    }
+    *q += params.len();
+}
+
+/// The error of a step that failed: the step rewritten chunk by chunk in
+/// module order, up to the first expression that fails.
+fn first_error(view: &View, step: u32, seed: u64) -> DeriveError {
+    let prog = view.prog;
+    let (starts, _) = param_offsets(prog, view.s, false);
+    let view = View {
+        prog,
+        s: view.s,
+        offsets: if prog.has_context {
+            param_offsets(prog, view.s, true).1
+        } else {
+            Vec::new()
+        },
+        growth: growth(prog),
+    };
+    let unlimited = Limits {
+        max_modules: usize::MAX,
+        max_bytes: usize::MAX,
+    };
+    let produced = AtomicUsize::new(0);
+    for (ci, chunk) in view.s.syms.chunks(CHUNK).enumerate() {
+        if let Err(e) = rewrite_chunk(
+            &view,
+            ci * CHUNK,
+            chunk,
+            starts[ci],
+            step,
+            seed,
+            unlimited,
+            &produced,
+        ) {
+            return e;
+        }
+    }
+    unreachable!("a step that failed fails again when rewritten in order")
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -697,7 +1056,7 @@ fn rewrite_chunk(
                 &mut weights,
             )
             .map_err(vm)?;
-            match chosen {
+            match chosen.map(|k| &rules[k]) {
                 Some(r) => {
                     emit(
                         prog,
@@ -728,18 +1087,19 @@ fn rewrite_chunk(
     Ok(out)
 }
 
-/// The rule that rewrites module `i`, with its parameters bound in `slots`.
+/// The index of the rule that rewrites module `i`, with its parameters bound
+/// in `slots`.
 #[allow(clippy::too_many_arguments)]
-fn choose<'r>(
+fn choose(
     view: &View,
-    rules: &'r [CompiledRule],
+    rules: &[CompiledRule],
     i: usize,
     params: &[f64],
     slots: &mut Vec<f64>,
     stack: &mut Vec<f64>,
     rng: &mut Random,
     weights: &mut Vec<(usize, f64)>,
-) -> Result<Option<&'r CompiledRule>, VmError> {
+) -> Result<Option<usize>, VmError> {
     let chunk = &view.prog.chunk;
     let mut k = 0;
     while k < rules.len() {
@@ -748,7 +1108,7 @@ fn choose<'r>(
         if rules[k].weight.is_none() {
             let r = &rules[k];
             if bind(view, r, i, params, slots) && holds(chunk, r, slots, stack, rng)? {
-                return Ok(Some(r));
+                return Ok(Some(k));
             }
         } else {
             weights.clear();
@@ -767,7 +1127,7 @@ fn choose<'r>(
                 let r = &rules[pick];
                 // Rebind: the slots hold the last candidate's context.
                 bind(view, r, i, params, slots);
-                return Ok(Some(r));
+                return Ok(Some(pick));
             }
         }
         k = end;
@@ -844,4 +1204,137 @@ fn apply_cut(prog: &Program, s: ModString) -> ModString {
         out.params.extend_from_slice(params);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn program(text: &str) -> Program {
+        let fe = crate::frontend::run(text, vec![], &[]);
+        assert!(!fe.has_errors(), "{:?}", fe.diagnostics);
+        let checked = fe.checked.as_ref().expect("checked");
+        crate::compile::compile(&fe.file, checked, None).expect("compiles")
+    }
+
+    /// The definition a step must agree with: every module rewritten in
+    /// order, one chunk for the whole string.
+    fn reference_step(prog: &Program, s: &ModString, step: u32, seed: u64) -> ModString {
+        let (_, offsets) = param_offsets(prog, s, true);
+        let view = View {
+            prog,
+            s,
+            offsets,
+            growth: growth(prog),
+        };
+        let unlimited = Limits {
+            max_modules: usize::MAX,
+            max_bytes: usize::MAX,
+        };
+        let out = rewrite_chunk(
+            &view,
+            0,
+            &s.syms,
+            0,
+            step,
+            seed,
+            unlimited,
+            &AtomicUsize::new(0),
+        )
+        .expect("rewrites");
+        ModString {
+            syms: out.syms,
+            params: out.params,
+        }
+    }
+
+    /// Conditions (one that fails and leaves the module as it is), weights
+    /// with random draws before and after the choice, context with an ignore
+    /// list, fixed rules and modules without rules, over strings of several
+    /// chunks: the counted-then-filled step equals the in-order rewrite on 1
+    /// and 2 threads.
+    #[test]
+    fn counted_steps_equal_the_in_order_rewrite() {
+        let prog = program(
+            "lsystem Mixed {
+                ignore + -;
+                axiom A(1) B(2) + A(3) C(0);
+                A(x) : x < 1000 -> A(x + 1) [ + B(x * 0.5) ] A(x + uniform(1, 2)) - C(x);
+                A(x) : x > 100 -> F(x);
+                B(y) < B(z) : z > 1 -> B(y + z);
+                B(z) ->(0.5) B(z + rand()) F(z);
+                B(z) ->(0.5) C(z / 2);
+                C(c) : c < 3 -> C(c + 1) F(2 * c);
+            }",
+        );
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let two = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let seed = 11;
+        let mut s = axiom(&prog, &[], seed).unwrap();
+        let mut k = 0;
+        while s.len() < 4 * CHUNK {
+            k += 1;
+            assert!(k < 40, "the test string stopped growing");
+            let want = reference_step(&prog, &s, k, seed);
+            let a = one
+                .install(|| step(&prog, &s, k, seed, Limits::default()))
+                .unwrap();
+            let b = two
+                .install(|| step(&prog, &s, k, seed, Limits::default()))
+                .unwrap();
+            assert_eq!(a, want, "step {k}, one thread");
+            assert_eq!(b, want, "step {k}, two threads");
+            s = a;
+        }
+    }
+
+    /// An expression error in a late chunk and another in an early chunk:
+    /// the early one is reported, on any thread count.
+    #[test]
+    fn the_first_failing_module_is_reported() {
+        let prog = program(
+            "lsystem Fails {
+                axiom A(0) B(3) C(4);
+                A(x) -> A(x + 1);
+                B(x) -> B(1 / (x - 3));
+                C(x) -> C(1 / (x - 4));
+            }",
+        );
+        let start = axiom(&prog, &[], 0).unwrap();
+        let (a, b, c) = (start.syms[0], start.syms[1], start.syms[2]);
+        let alone = |sym: Sym, x: f64| ModString {
+            syms: vec![sym],
+            params: vec![x],
+        };
+        let err_b = step(&prog, &alone(b, 3.0), 1, 0, Limits::default()).unwrap_err();
+        let err_c = step(&prog, &alone(c, 4.0), 1, 0, Limits::default()).unwrap_err();
+        assert_ne!(err_b, err_c, "the two errors differ");
+        let n = 3 * CHUNK;
+        let mut s = ModString::default();
+        for i in 0..n {
+            let (sym, x) = match i {
+                5 => (c, 4.0),
+                _ if i == n - 5 => (b, 3.0),
+                _ => (a, 0.0),
+            };
+            s.syms.push(sym);
+            s.params.push(x);
+        }
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let err = pool
+                .install(|| step(&prog, &s, 1, 0, Limits::default()))
+                .unwrap_err();
+            assert_eq!(err, err_c, "{threads} threads");
+        }
+    }
 }

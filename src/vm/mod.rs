@@ -109,27 +109,62 @@ pub struct Code {
 }
 
 /// A shortcut for a common expression shape; `None` runs the instructions.
+/// Shapes are recognised after constant folding, so `l * r2` with a constant
+/// `r2` is `LoadOp`, and `x > 3` a comparison the same way.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub enum Fast {
     #[default]
     None,
     Const(f64),
     Load(u16),
-    /// `$n op c` with op one of + - * and c a constant.
+    /// `$n op c`: op is arithmetic (+ - * /, and / only by a constant that is
+    /// not 0) or a comparison; c a constant.
     LoadOp(u16, Op, f64),
+    /// `c op $n`, with the same ops (/ only when it cannot fail: never here).
+    ConstOp(f64, Op, u16),
+    /// `$a op $b`, op one of + - * or a comparison.
+    LoadLoad(u16, Op, u16),
+}
+
+/// Whether `op` is one of the binary ops the shortcuts compute (none of them
+/// can fail except by giving a value that is not finite).
+fn plain_binary(op: Op) -> bool {
+    matches!(
+        op,
+        Op::Add | Op::Sub | Op::Mul | Op::Eq | Op::Ne | Op::Lt | Op::Le | Op::Gt | Op::Ge
+    )
+}
+
+/// `a op b` for the ops of `plain_binary` and `/`; comparisons give 0 or 1.
+#[inline(always)]
+fn apply(op: Op, a: f64, b: f64) -> f64 {
+    match op {
+        Op::Add => a + b,
+        Op::Sub => a - b,
+        Op::Mul => a * b,
+        Op::Div => a / b,
+        Op::Eq => f64::from(a == b),
+        Op::Ne => f64::from(a != b),
+        Op::Lt => f64::from(a < b),
+        Op::Le => f64::from(a <= b),
+        Op::Gt => f64::from(a > b),
+        Op::Ge => f64::from(a >= b),
+        _ => unreachable!("not a shortcut op"),
+    }
 }
 
 impl Code {
     /// The code of instructions `start..end` of `chunk`, with its shortcut.
     pub fn new(chunk: &Chunk, start: u32, end: u32) -> Code {
-        let fast = match &chunk.code[start as usize..end as usize] {
-            [Op::Const(v)] => Fast::Const(*v),
-            [Op::Load(n)] => Fast::Load(*n),
-            [
-                Op::Load(n),
-                Op::Const(c),
-                op @ (Op::Add | Op::Sub | Op::Mul),
-            ] => Fast::LoadOp(*n, *op, *c),
+        let fast = match chunk.code[start as usize..end as usize] {
+            [Op::Const(v)] => Fast::Const(v),
+            [Op::Load(n)] => Fast::Load(n),
+            [Op::Load(n), Op::Const(c), op] if plain_binary(op) => Fast::LoadOp(n, op, c),
+            // Division by a constant: the constant is not 0 (else it fails at
+            // run time, with its span: the loop handles that).
+            [Op::Load(n), Op::Const(c), Op::Div] if c != 0.0 => Fast::LoadOp(n, Op::Div, c),
+            [Op::Const(c), Op::Load(n), op] if plain_binary(op) => Fast::ConstOp(c, op, n),
+            [Op::Load(a), Op::Load(b), op] if plain_binary(op) => Fast::LoadLoad(a, op, b),
             _ => Fast::None,
         };
         Code { start, end, fast }
@@ -215,6 +250,8 @@ impl Chunk {
     }
 
     /// Evaluates one expression. `stack` is scratch space reused between calls.
+    /// The common shapes are computed here, inline; others run the loop.
+    #[inline(always)]
     pub fn eval(
         &self,
         code: Code,
@@ -222,26 +259,34 @@ impl Chunk {
         rng: &mut Random,
         stack: &mut Vec<f64>,
     ) -> Result<f64, VmError> {
-        match code.fast {
-            Fast::None => {}
+        let load = |n: u16| params.get(n as usize).copied().unwrap_or(0.0);
+        let v = match code.fast {
+            Fast::None => return self.run(code, params, rng, stack),
             Fast::Const(v) => return Ok(v),
-            Fast::Load(n) => return Ok(params.get(n as usize).copied().unwrap_or(0.0)),
-            Fast::LoadOp(n, op, c) => {
-                let a = params.get(n as usize).copied().unwrap_or(0.0);
-                let v = match op {
-                    Op::Add => a + c,
-                    Op::Sub => a - c,
-                    _ => a * c,
-                };
-                if v.is_finite() {
-                    return Ok(v);
-                }
-                return Err(VmError {
-                    fault: Fault::NotFinite,
-                    span: self.spans[code.end as usize - 1],
-                });
-            }
+            Fast::Load(n) => return Ok(load(n)),
+            Fast::LoadOp(n, op, c) => apply(op, load(n), c),
+            Fast::ConstOp(c, op, n) => apply(op, c, load(n)),
+            Fast::LoadLoad(a, op, b) => apply(op, load(a), load(b)),
+        };
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(VmError {
+                fault: Fault::NotFinite,
+                span: self.spans[code.end as usize - 1],
+            })
         }
+    }
+
+    /// Runs the instructions of one expression.
+    #[inline(never)]
+    fn run(
+        &self,
+        code: Code,
+        params: &[f64],
+        rng: &mut Random,
+        stack: &mut Vec<f64>,
+    ) -> Result<f64, VmError> {
         stack.clear();
         let mut pc = code.start as usize;
         let end = code.end as usize;
