@@ -464,10 +464,14 @@ fn progress_bar(steps: Option<u32>) -> Option<indicatif::ProgressBar> {
     if !std::io::stderr().is_terminal() {
         return None;
     }
-    let bar = indicatif::ProgressBar::new(u64::from(steps.unwrap_or(0)));
-    if let Ok(style) =
-        indicatif::ProgressStyle::with_template("deriving {bar:30} step {pos}/{len} {msg}")
-    {
+    // Without `-n` the step count is the program's `derive`, known only once it
+    // is compiled: the bar then counts steps without a total.
+    let (len, template) = match steps {
+        Some(n) => (u64::from(n), "deriving {bar:30} step {pos}/{len} {msg}"),
+        None => (0, "deriving step {pos} {msg}"),
+    };
+    let bar = indicatif::ProgressBar::new(len);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
         bar.set_style(style);
     }
     Some(bar)
