@@ -79,6 +79,7 @@ fn target_text(a: &Analysis, t: &Target) -> Option<String> {
         Target::Symbol(id) => Some(symbol_text(a, a.index.symbols.get(*id)?)),
         Target::Query(q) => Some(query_text(q)),
         Target::Turtle(c) => words::turtle(*c).map(turtle_text),
+        Target::Word(w) => words::word(w).map(|k| format!("```lsy\n{}\n```\n\n{}", k.word, k.doc)),
         Target::Cut => words::turtle('%').map(|w| format!("```lsy\ncut\n```\n\n{}", w.meaning)),
         Target::Function(f) => Some(match builtins::lookup(f) {
             Some(b) => {

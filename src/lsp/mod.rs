@@ -8,6 +8,7 @@
 //! not grow one. The protocol types are lsp-types'; the message types and
 //! their framing lsp-server's (docs/lsp.md says why and where we differ).
 
+pub mod actions;
 pub mod analysis;
 pub mod complete;
 pub mod format;
