@@ -728,7 +728,7 @@ fn every_file_every_name() {
                 Target::Query(q) => assert_eq!(written, q, "{rel}"),
                 Target::Turtle(c) => assert_eq!(written, c.to_string(), "{rel}"),
                 Target::Cut => assert_eq!(written, "cut", "{rel}"),
-                Target::Function(f) => assert_eq!(written, f, "{rel}"),
+                Target::Function(f) | Target::Word(f) => assert_eq!(written, f, "{rel}"),
             }
             assert!(hover::hover(&a, s).is_some(), "{rel}: no hover at {o:?}");
             assert!(a.index.at(s).is_some(), "{rel}");
@@ -756,4 +756,194 @@ fn every_file_every_name() {
         }
     }
     assert!(names > 2000, "only {names} names indexed");
+}
+
+fn lsyc_check(text: &str) -> (bool, String) {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("fixed.lsy");
+    std::fs::write(&path, text).expect("write");
+    let out = Command::new(env!("CARGO_BIN_EXE_lsyc"))
+        .args(["check", path.to_str().expect("utf-8")])
+        .output()
+        .expect("run lsyc check");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Programs with one problem each whose diagnostic carries a fix: the server
+/// offers it as a quick fix on the diagnostic's line, and the program the edit
+/// gives is one `lsyc check` accepts (and the server then reports no error).
+#[test]
+fn quick_fixes_give_programs_lsyc_check_accepts() {
+    const CASES: &[(&str, &str, &str)] = &[
+        (
+            "a constant misspelt",
+            "const len = 2;\nlsystem A {\n    axiom F(lne);\n}\n",
+            "replace with `len`",
+        ),
+        (
+            "a parameter misspelt",
+            "lsystem A {\n    axiom A(1);\n    A(size) -> F(sise) A(size);\n}\n",
+            "replace with `size`",
+        ),
+        (
+            "a function misspelt",
+            "lsystem A {\n    axiom F(sqtr(4));\n}\n",
+            "replace with `sqrt`",
+        ),
+        (
+            "a query module misspelt",
+            "lsystem A {\n    axiom A ?Q;\n    A > ?P(x, y, _) -> F(x + y);\n}\n",
+            "replace with `?P`",
+        ),
+        (
+            "an element property by another name",
+            "element Leaf {\n    path \"M0 0 L0 10\";\n    colour \"green\";\n}\nlsystem A {\n    axiom F Leaf;\n}\n",
+            "replace with `fill`",
+        ),
+        (
+            "a guide's lsystem misspelt",
+            "lsystem Trunk {\n    axiom F;\n}\nscene S {\n    guide g {\n        polygon (0, 0) (10, 0) (10, 10);\n        system Trnk;\n        seed (1, 1);\n    }\n}\n",
+            "replace with `Trunk`",
+        ),
+        (
+            "a link's guide misspelt",
+            "lsystem T {\n    axiom F;\n}\nscene S {\n    guide stem {\n        polygon (0, 0) (10, 0) (10, 10);\n        system T;\n        seed (1, 1);\n    }\n    guide crown {\n        polygon (0, 10) (10, 10) (10, 20);\n        system T;\n    }\n    link stem.edge(1) -> crwon.edge(0) {\n        tokens 1;\n    }\n}\n",
+            "replace with `crown`",
+        ),
+        (
+            "cpfg's #define",
+            "#define N 5\nlsystem A {\n    derive N;\n    axiom F;\n}\n",
+            "write it as a constant",
+        ),
+        (
+            "cpfg's #ignore",
+            "lsystem A {\n    #ignore: + -\n    axiom B F A;\n    B < A -> F;\n}\n",
+            "write `ignore …;`",
+        ),
+        (
+            "cpfg's #consider",
+            "lsystem A {\n    #consider: A B;\n    axiom B F A;\n    B < A -> F;\n}\n",
+            "write `consider …;`",
+        ),
+        (
+            "ω: as in the books",
+            "lsystem A {\n    ω: F;\n    F -> F F;\n}\n",
+            "write `axiom`",
+        ),
+        (
+            "ignore with a colon",
+            "lsystem A {\n    axiom B F A;\n    ignore: F;\n    B < A -> F;\n}\n",
+            "write `ignore`",
+        ),
+        (
+            "= for ==",
+            "lsystem A {\n    axiom A(1);\n    A(x) : x = 1 -> A(x + 1);\n}\n",
+            "replace with `==`",
+        ),
+        (
+            "cpfg's : *",
+            "lsystem A {\n    axiom A;\n    A : * -> F A;\n}\n",
+            "remove `: *`",
+        ),
+        (
+            "a missing ;",
+            "lsystem A {\n    axiom A\n    A -> F A;\n}\n",
+            "insert `;`",
+        ),
+        (
+            "the arrow →",
+            "lsystem A {\n    axiom A;\n    A → F A;\n}\n",
+            "replace with `->`",
+        ),
+        (
+            "endlsystem",
+            "lsystem A {\n    axiom A;\n    A -> F A;\n    endlsystem\n}\n",
+            "remove it",
+        ),
+        (
+            "a section label (a warning)",
+            "lsystem A {\n    axiom A;\n    A -> B;\n    decomposition: B -> F F;\n}\n",
+            "write `decompose`",
+        ),
+    ];
+    let mut c = Client::start();
+    c.initialize();
+    let mut report = String::new();
+    for (n, (what, text, title)) in CASES.iter().enumerate() {
+        let uri = format!("file:///fix/{n}.lsy");
+        let diags = c.open(&uri, text);
+        // The first error, or the warning when there is no error.
+        let all = diags["diagnostics"].as_array().expect("diagnostics");
+        let first = all
+            .iter()
+            .find(|d| d["severity"] == 1)
+            .or(all.first())
+            .unwrap_or_else(|| panic!("{what}: no diagnostic"))
+            .clone();
+        // Asked at the diagnostic's range, as an editor does for the cursor.
+        let actions = c.request(
+            "textDocument/codeAction",
+            json!({
+                "textDocument": {"uri": uri},
+                "range": first["range"],
+                "context": {"diagnostics": [first], "only": ["quickfix"]},
+            }),
+        );
+        let actions = actions.as_array().expect("actions");
+        let action = actions
+            .iter()
+            .find(|a| a["title"] == *title)
+            .unwrap_or_else(|| panic!("{what}: no `{title}` among {actions:?}"));
+        assert_eq!(action["kind"], "quickfix", "{what}");
+        assert_eq!(
+            action["diagnostics"][0]["code"], first["code"],
+            "{what}: the fix names its diagnostic"
+        );
+        let edits = &action["edit"]["changes"][&uri];
+        let fixed = apply(text, edits);
+        let (ok, stderr) = lsyc_check(&fixed);
+        assert!(ok, "{what}: after `{title}`:\n{fixed}\n{stderr}");
+        c.notify(
+            "textDocument/didChange",
+            json!({"textDocument": {"uri": uri, "version": 2},
+                   "contentChanges": [{"text": fixed}]}),
+        );
+        let after = c.notification("textDocument/publishDiagnostics");
+        assert!(
+            after["diagnostics"]
+                .as_array()
+                .expect("diagnostics")
+                .iter()
+                .all(|d| d["severity"] != 1),
+            "{what}: {after}"
+        );
+        report.push_str(&format!(
+            "--- {what}: {} `{title}`\n{fixed}",
+            first["code"].as_str().unwrap_or("-")
+        ));
+    }
+    // Nothing is offered where the diagnostic has no concrete fix, nor when
+    // the client asks only for other kinds of actions.
+    let uri = "file:///fix/none.lsy";
+    let text = "lsystem A {\n    axiom F(zzzz);\n}\n";
+    let d = c.open(uri, text);
+    let first = d["diagnostics"][0].clone();
+    assert_eq!(first["code"], "E0302", "{d}");
+    let none = c.request(
+        "textDocument/codeAction",
+        json!({"textDocument": {"uri": uri}, "range": first["range"],
+               "context": {"diagnostics": [first]}}),
+    );
+    assert_eq!(none, json!([]));
+    let refactor = c.request(
+        "textDocument/codeAction",
+        json!({"textDocument": {"uri": "file:///fix/0.lsy"},
+               "range": {"start": {"line": 0, "character": 0}, "end": {"line": 9, "character": 0}},
+               "context": {"diagnostics": [], "only": ["refactor"]}}),
+    );
+    assert!(refactor.is_null() || refactor == json!([]), "{refactor}");
+    insta::assert_snapshot!("lsp_quick_fixes", report);
 }
