@@ -13,6 +13,7 @@ use crate::ast::{
     Expr, ExprKind, File, GuideStmt, Item, LinkStmt, Lsystem, ModName, Module, PropValue, Scene,
     SceneStmt, Stmt,
 };
+use super::words;
 use crate::span::Span;
 use std::collections::HashMap;
 
@@ -480,7 +481,10 @@ impl Builder {
                             }
                             LinkStmt::Tokens(e) | LinkStmt::Heading(e) => self.expr(e, &[]),
                             LinkStmt::Setting(k, e) => {
-                                self.occ(k.span, Target::Word(k.name.clone()), false);
+                                // An unknown setting is the checker's error (E0805).
+                                if words::is_link_setting(&k.name) {
+                                    self.occ(k.span, Target::Word(k.name.clone()), false);
+                                }
                                 match link_word(e) {
                                     Some(w @ ("middle" | "closest")) if k.name == "aim" => {
                                         self.occ(e.span, Target::Word(w.to_string()), false)

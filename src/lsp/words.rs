@@ -296,6 +296,11 @@ pub fn keyword(word: &str) -> Option<&'static Keyword> {
     KEYWORDS.iter().find(|k| k.word == word)
 }
 
+/// Whether a name is one of the named settings a link takes (`aim`, `take`).
+pub fn is_link_setting(name: &str) -> bool {
+    matches!(name, "aim" | "take")
+}
+
 /// The text of a word written where a name could be (`Target::Word`): the
 /// module `tropism(e)` in a string, a link setting or its value.
 pub fn word(word: &str) -> Option<&'static Keyword> {

@@ -671,6 +671,16 @@ fn editor_support_files_fit_the_language() {
             "the grammar does not highlight the keyword `{w}`"
         );
     }
+    // Words a link takes that are names to the lexer (`aim middle;`).
+    for k in lsyc::lsp::words::KEYWORDS {
+        if k.context == lsyc::lsp::words::Context::Link {
+            assert!(
+                text.contains(k.word),
+                "the grammar does not know the link word `{}`",
+                k.word
+            );
+        }
+    }
     for b in lsyc::builtins::BUILTINS {
         assert!(
             text.contains(&format!("|{}|", b.name))
