@@ -957,3 +957,99 @@ fn quick_fixes_give_programs_lsyc_check_accepts() {
     assert!(refactor.is_null() || refactor == json!([]), "{refactor}");
     insta::assert_snapshot!("lsp_quick_fixes", report);
 }
+
+/// Over the gallery and the test corpus, in every file the checker accepts
+/// (so it resolved every name): every name token has a definition answer,
+/// except these classes, which have nowhere to go:
+/// - words of the language (`tropism(e)`, `aim`, `take`, `continue`,
+///   `middle`, `closest`) and built-in functions: hover explains them;
+/// - letter modules no rule rewrites (`F`, or a letter that is only written
+///   in strings): declared by use, with no declaration or rule to show;
+/// - the parameters of a `module` declaration and of a module declared in an
+///   lsystem, and element property keys: names with no uses;
+/// - `_`, which binds nothing.
+#[test]
+fn every_resolved_name_has_a_definition() {
+    use lsyc::lexer::{Token, lex};
+    use lsyc::lsp::index::{Kind, Target};
+    use lsyc::lsp::{Analysis, hover};
+    let files = crate::support::lsy_files(&["lang-examples", "tests/data"]);
+    let (mut checked, mut defined, mut excluded) = (0, 0, 0);
+    let mut unexplained = Vec::new();
+    for path in files {
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue;
+        };
+        let a = Analysis::new(text.clone());
+        if a.diagnostics.iter().any(|d| d.is_error()) {
+            continue;
+        }
+        checked += 1;
+        let rel = crate::support::rel(&path);
+        // Names that declare nothing other names use: `module` parameters
+        // and element property keys.
+        let mut unused_decl = std::collections::HashSet::new();
+        for item in &a.file.items.stmts {
+            match &item.node {
+                lsyc::ast::Item::Module(m) => {
+                    unused_decl.extend(m.params.iter().map(|p| p.span.start));
+                }
+                lsyc::ast::Item::Lsystem(l) => {
+                    for st in &l.body.stmts {
+                        if let lsyc::ast::Stmt::Module(m) = &st.node {
+                            unused_decl.extend(m.params.iter().map(|p| p.span.start));
+                        }
+                    }
+                }
+                lsyc::ast::Item::Element(e) => {
+                    unused_decl.extend(e.props.stmts.iter().map(|p| p.node.key.span.start));
+                }
+                _ => {}
+            }
+        }
+        for (start, tok, end) in lex(&text).tokens {
+            let Token::Ident(name) = tok else { continue };
+            if name == "_" || unused_decl.contains(&(start as u32)) {
+                excluded += 1;
+                continue;
+            }
+            // Every letter of a run the resolver split is its own module.
+            for off in start..end {
+                if !text.is_char_boundary(off) {
+                    continue;
+                }
+                let Some(o) = a.index.at(off).filter(|o| o.span.start as usize == off) else {
+                    if off == start {
+                        unexplained.push(format!("{rel}:{start}: `{name}` is not indexed"));
+                    }
+                    continue;
+                };
+                match &o.target {
+                    Target::Symbol(id) => {
+                        let sym = &a.index.symbols[*id];
+                        if !sym.definition().is_empty() {
+                            defined += 1;
+                        } else if sym.kind == Kind::Letter && lsyc::resolve::is_letter(&sym.name) {
+                            excluded += 1;
+                        } else {
+                            unexplained.push(format!("{rel}:{off}: `{}` has no definition", sym.name));
+                        }
+                    }
+                    Target::Word(_) | Target::Function(_) => {
+                        assert!(hover::hover(&a, off).is_some(), "{rel}:{off}");
+                        excluded += 1;
+                    }
+                    other => unexplained.push(format!("{rel}:{off}: `{name}` is {other:?}")),
+                }
+            }
+        }
+    }
+    assert!(
+        unexplained.is_empty(),
+        "{} names:\n{}",
+        unexplained.len(),
+        unexplained.join("\n")
+    );
+    assert!(checked > 40, "{checked} files");
+    assert!(defined > 2000 && excluded > 100, "{defined} defined, {excluded} excluded");
+}
