@@ -1053,3 +1053,246 @@ fn every_resolved_name_has_a_definition() {
     assert!(checked > 40, "{checked} files");
     assert!(defined > 2000 && excluded > 100, "{defined} defined, {excluded} excluded");
 }
+
+/// A program with the newer syntax: `tropism` (statement and module),
+/// `consider`, `decompose`, and a link's `heading continue; aim middle; take v;`.
+const NEWER: &str = "// Newer syntax in one file.
+const E = 0.2;
+const V = 1;
+module Apex(len, depth);
+lsystem Tree(w) {
+    tropism (0, -1, 0) E;
+    consider A Apex;
+    axiom A(w) Apex(1, 2);
+    A(x) -> F(x) [+(30) tropism(E * 2) A(x * 0.5)] A(x);
+    decompose Apex(l, d) : d > 0 -> F(l) Apex(l, d - 1);
+}
+scene S {
+    guide g {
+        polygon (0, 0) (10, 0) (10, 10);
+        system Tree;
+        seed (1, 1) with (1);
+    }
+    guide h {
+        polygon (0, 10) (10, 10) (10, 20);
+        system Tree;
+    }
+    link g.edge(1) -> h.edge(0) { tokens 1; heading continue; aim middle; take V; }
+}
+";
+
+#[test]
+fn newer_syntax_is_indexed_and_explained() {
+    let text = NEWER;
+    let uri = "file:///newer.lsy";
+    let mut c = Client::start();
+    c.initialize();
+    assert_eq!(c.open(uri, text)["diagnostics"], json!([]));
+    let doc = |p: Value| json!({"textDocument": {"uri": uri}, "position": p});
+    let mut hovers = String::new();
+    for (needle, nth, want) in [
+        ("tropism (", 0, "after every `F`"),
+        ("tropism(E", 0, "rest of the branch"),
+        ("consider", 0, "sees only these modules"),
+        ("decompose", 0, "decomposition rule"),
+        ("continue", 0, "keeps the heading"),
+        ("aim", 0, "middle of this link's edge"),
+        ("middle", 0, "middle of the link's edge"),
+        ("take", 0, "`?X`"),
+        ("E;", 0, "const E = 0.2"),
+        ("V;", 0, "const V = 1"),
+    ] {
+        let h = c.request("textDocument/hover", doc(pos(text, needle, nth)));
+        let t = hover_text(&h);
+        assert!(t.contains(want), "{needle}: {t}");
+        hovers.push_str(&format!("--- `{needle}`\n{t}\n"));
+    }
+    insta::assert_snapshot!("lsp_hover_newer_syntax", hovers);
+    // Definitions through the new places.
+    let def = |c: &mut Client, needle: &str, nth: usize| -> Value {
+        let d = c.request("textDocument/definition", doc(pos(text, needle, nth)));
+        if d.is_array() { d[0].clone() } else { d }
+    };
+    assert_eq!(def(&mut c, "E;", 0)["range"]["start"], pos(text, "E = 0.2", 0));
+    assert_eq!(def(&mut c, "E * 2", 0)["range"]["start"], pos(text, "E = 0.2", 0));
+    assert_eq!(def(&mut c, "V;", 0)["range"]["start"], pos(text, "V = 1", 0));
+    assert_eq!(def(&mut c, "Apex;", 0)["range"]["start"], pos(text, "Apex(len", 0));
+    // `A` in `consider` is a letter: it goes to the rule that rewrites it.
+    assert_eq!(def(&mut c, "A Apex;", 0)["range"]["start"], pos(text, "A(x) ->", 0));
+    // The words are not names: nothing to go to, nothing to rename.
+    for w in ["tropism(E", "continue", "middle", "aim"] {
+        assert!(def(&mut c, w, 0).is_null(), "{w}");
+        let r = c.request_raw("textDocument/prepareRename", doc(pos(text, w, 0)));
+        assert!(r.get("error").is_some(), "{w}: {r}");
+    }
+    // A constant used in `tropism` and in `take` renames everywhere.
+    let edit = c.request(
+        "textDocument/rename",
+        json!({"textDocument": {"uri": uri}, "position": pos(text, "E = 0.2", 0), "newName": "elasticity"}),
+    );
+    let renamed = apply(text, &edit["changes"][uri]);
+    assert_eq!(renamed.matches("elasticity").count(), 3, "{renamed}");
+    let edit = c.request(
+        "textDocument/rename",
+        json!({"textDocument": {"uri": uri}, "position": pos(text, "V;", 0), "newName": "leader"}),
+    );
+    assert!(apply(text, &edit["changes"][uri]).contains("take leader;"));
+    // Completion in a link offers its words.
+    let at = text.find("take V").expect("take");
+    let items = c.request("textDocument/completion", doc(position_of(text, at)));
+    let labels: Vec<&str> = items
+        .as_array()
+        .expect("items")
+        .iter()
+        .filter_map(|i| i["label"].as_str())
+        .collect();
+    for w in ["aim", "take", "continue", "middle", "tokens"] {
+        assert!(labels.contains(&w), "{w}: {labels:?}");
+    }
+}
+
+/// Semantic tokens decoded back to text: `line:col text type [modifiers]`.
+fn show_tokens(text: &str, legend: &Value, data: &Value) -> String {
+    let types = legend["tokenTypes"].as_array().expect("types");
+    let mods = legend["tokenModifiers"].as_array().expect("modifiers");
+    let lines: Vec<&str> = text.split('\n').collect();
+    let d: Vec<u64> = data
+        .as_array()
+        .expect("data")
+        .iter()
+        .map(|v| v.as_u64().expect("u32"))
+        .collect();
+    assert_eq!(d.len() % 5, 0);
+    let (mut line, mut col) = (0u64, 0u64);
+    let mut out = String::new();
+    for t in d.chunks(5) {
+        if t[0] > 0 {
+            line += t[0];
+            col = t[1];
+        } else {
+            col += t[1];
+        }
+        let l: Vec<u16> = lines[line as usize].encode_utf16().collect();
+        let word = String::from_utf16_lossy(&l[col as usize..(col + t[2]) as usize]);
+        let m: Vec<&str> = (0..mods.len())
+            .filter(|i| t[4] & (1 << i) != 0)
+            .map(|i| mods[i].as_str().expect("name"))
+            .collect();
+        out.push_str(&format!(
+            "{}:{} {word} {} {}\n",
+            line + 1,
+            col + 1,
+            types[t[3] as usize].as_str().expect("type"),
+            m.join(",")
+        ));
+    }
+    out
+}
+
+#[test]
+fn semantic_tokens_signatures_and_range_formatting() {
+    let text = NEWER;
+    let uri = "file:///newer.lsy";
+    let mut c = Client::start();
+    let init = c.initialize();
+    let legend = init["capabilities"]["semanticTokensProvider"]["legend"].clone();
+    c.open(uri, text);
+    let toks = c.request(
+        "textDocument/semanticTokens/full",
+        json!({"textDocument": {"uri": uri}}),
+    );
+    let shown = show_tokens(text, &legend, &toks["data"]);
+    for want in [
+        "2:7 E variable declaration,readonly",
+        "4:8 Apex type declaration",
+        "6:5 tropism keyword",
+        "6:24 E variable readonly",
+        "9:7 x parameter declaration",
+        "9:13 F type defaultLibrary",
+        "9:19 + operator defaultLibrary",
+        "9:25 tropism keyword",
+        "10:5 decompose keyword",
+        "22:53 continue keyword",
+        "22:67 middle keyword",
+        "22:80 V variable readonly",
+    ] {
+        assert!(shown.contains(want), "{want}:\n{shown}");
+    }
+    insta::assert_snapshot!("lsp_semantic_tokens_newer", shown);
+
+    // Signature help inside a module's parentheses, the active one marked.
+    let doc = |p: Value| json!({"textDocument": {"uri": uri}, "position": p});
+    let after = |needle: &str| {
+        let at = text.find(needle).expect("needle") + needle.len();
+        doc(position_of(text, at))
+    };
+    let mut sigs = String::new();
+    for needle in ["Apex(1, ", "Apex(1", "A(x * 0.", "tropism(E", "+(3", "F(l", "Apex(l, d - "] {
+        let h = c.request("textDocument/signatureHelp", after(needle));
+        let s = &h["signatures"][0];
+        let active = h["activeParameter"].as_u64().expect("active") as usize;
+        let param = s["parameters"][active]["label"].as_str().unwrap_or("?");
+        sigs.push_str(&format!("{needle:<12} {}  [{param}]\n", s["label"].as_str().expect("label")));
+    }
+    assert!(sigs.contains("Apex(1,      Apex(len, depth)  [depth]"), "{sigs}");
+    assert!(sigs.contains("Apex(1       Apex(len, depth)  [len]"), "{sigs}");
+    assert!(sigs.contains("A(x * 0.     A(x)  [x]"), "{sigs}");
+    assert!(sigs.contains("tropism(E    tropism(e)  [e]"), "{sigs}");
+    // Outside parentheses there is none.
+    let none = c.request("textDocument/signatureHelp", doc(pos(text, "consider", 0)));
+    assert!(none.is_null(), "{none}");
+    // A query module in a predecessor shows its outputs first.
+    let palm = gallery("palm.lsy");
+    c.open("file:///palm.lsy", &palm);
+    let at = palm.find("?D_L(found, d, beta, _, D, w)").expect("?D_L") + "?D_L(found, ".len();
+    let h = c.request(
+        "textDocument/signatureHelp",
+        json!({"textDocument": {"uri": "file:///palm.lsy"}, "position": position_of(&palm, at)}),
+    );
+    sigs.push_str(&format!("?D_L(found,  {}  [{}]\n", h["signatures"][0]["label"], h["activeParameter"]));
+    assert_eq!(h["activeParameter"], 1, "{h}");
+    insta::assert_snapshot!("lsp_signature_help", sigs);
+
+    // Range formatting: the items the range touches come out as `lsyc fmt`
+    // prints them; the others stay as written.
+    let messy = text
+        .replace("    ", "  ")
+        .replace("F(x) [+(30)", "F(x)   [ +(30)");
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 2}, "contentChanges": [{"text": messy}]}),
+    );
+    c.notification("textDocument/publishDiagnostics");
+    let canonical = lsyc::fmt::format_file(&lsyc::parser::parse(&messy).file);
+    let range_format = |c: &mut Client, from: &str, to: &str| -> String {
+        let edits = c.request(
+            "textDocument/rangeFormatting",
+            json!({"textDocument": {"uri": uri}, "options": {"tabSize": 4, "insertSpaces": true},
+                   "range": {"start": pos(&messy, from, 0), "end": pos(&messy, to, 0)}}),
+        );
+        apply(&messy, &edits)
+    };
+    let whole = range_format(&mut c, "// Newer", "take V");
+    assert_eq!(whole, canonical);
+    // Only the lsystem (the range is inside its `A` rule).
+    let part = range_format(&mut c, "A(x) ->", "A(x * 0.5)");
+    let lsystem = |s: &str| {
+        s[s.find("lsystem").expect("ls")..s.find("scene").expect("scene")].to_string()
+    };
+    let scene = |s: &str| s[s.find("scene").expect("scene")..].to_string();
+    assert_eq!(lsystem(&part).trim_end(), lsystem(&canonical).trim_end());
+    assert_eq!(scene(&part), scene(&messy), "the scene is left as written");
+    assert!(part.starts_with(&messy[..messy.find("lsystem").expect("ls")]));
+    // Already canonical: no edits.
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 3}, "contentChanges": [{"text": canonical}]}),
+    );
+    c.notification("textDocument/publishDiagnostics");
+    let edits = c.request(
+        "textDocument/rangeFormatting",
+        json!({"textDocument": {"uri": uri}, "options": {"tabSize": 4, "insertSpaces": true},
+               "range": {"start": {"line": 0, "character": 0}, "end": {"line": 40, "character": 0}}}),
+    );
+    assert_eq!(edits, json!([]));
+}
