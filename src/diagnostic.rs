@@ -142,8 +142,9 @@ pub struct Diagnostic {
     pub notes: Vec<String>,
     pub help: Option<String>,
     /// Machine-applicable fixes for what `help` says (editors offer them as
-    /// quick fixes); most diagnostics have none.
-    pub fixes: Vec<Fix>,
+    /// quick fixes); most diagnostics have none. (A boxed slice: diagnostics
+    /// travel in `Result`s, and this keeps them small.)
+    pub fixes: Box<[Fix]>,
 }
 
 /// A concrete fix: replace each span with its text. Applying it gives a
@@ -164,7 +165,7 @@ impl Diagnostic {
             labels: Vec::new(),
             notes: Vec::new(),
             help: None,
-            fixes: Vec::new(),
+            fixes: Box::new([]),
         }
     }
 
@@ -206,18 +207,28 @@ impl Diagnostic {
     }
 
     /// A machine-applicable fix: write `text` in place of `span`.
-    pub fn fix(mut self, title: impl Into<String>, span: Span, text: impl Into<String>) -> Diagnostic {
-        self.fixes.push(Fix {
+    pub fn fix(
+        mut self,
+        title: impl Into<String>,
+        span: Span,
+        text: impl Into<String>,
+    ) -> Diagnostic {
+        let mut fixes = std::mem::take(&mut self.fixes).into_vec();
+        fixes.push(Fix {
             title: title.into(),
             edits: vec![(span, text.into())],
         });
+        self.fixes = fixes.into_boxed_slice();
         self
     }
 
     /// "did you mean `name`?", and the fix that writes `name` at `span`.
     pub fn did_you_mean(self, span: Span, name: &str) -> Diagnostic {
-        self.help(format!("did you mean `{name}`?"))
-            .fix(format!("replace with `{name}`"), span, name)
+        self.help(format!("did you mean `{name}`?")).fix(
+            format!("replace with `{name}`"),
+            span,
+            name,
+        )
     }
 
     pub fn is_error(&self) -> bool {

@@ -362,7 +362,11 @@ fn stray_diagnostic(source: &str, start: usize, end: usize) -> Diagnostic {
             if let Some(list) = port(word).map(|r| r.strip_prefix(':').unwrap_or(r).trim())
                 && !list.is_empty()
             {
-                d = d.fix(format!("write `{word} …;`"), to_eol, format!("{word} {list};"));
+                d = d.fix(
+                    format!("write `{word} …;`"),
+                    to_eol,
+                    format!("{word} {list};"),
+                );
             }
         }
     }

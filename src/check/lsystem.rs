@@ -298,20 +298,23 @@ impl<'a> Checker<'a> {
                     } else {
                         format!("write `{word}`")
                     };
-                    (title, Span::new(l.span.start as usize, l.span.end as usize + 1), word)
+                    (
+                        title,
+                        Span::new(l.span.start as usize, l.span.end as usize + 1),
+                        word,
+                    )
                 });
                 if let Some(help) = help {
-                    let mut d = 
-                        Diagnostic::warning(
-                            Code::SectionLabel,
-                            format!(
-                                "`{}:` is read as the label of one rule, not as a section",
-                                l.name
-                            ),
-                        )
-                        .primary(l.span, "a rule label (a name for this rule only)")
-                        .note("cpfg and L-Py divide an L-system into sections; lsyc has none")
-                        .help(help);
+                    let mut d = Diagnostic::warning(
+                        Code::SectionLabel,
+                        format!(
+                            "`{}:` is read as the label of one rule, not as a section",
+                            l.name
+                        ),
+                    )
+                    .primary(l.span, "a rule label (a name for this rule only)")
+                    .note("cpfg and L-Py divide an L-system into sections; lsyc has none")
+                    .help(help);
                     if let Some((title, span, word)) = fix {
                         d = d.fix(title, span, word);
                     }
@@ -593,7 +596,10 @@ impl<'a> Checker<'a> {
             .collect();
         if !prefixed.is_empty() {
             d = d.help(format!("did you mean {}?", prefixed.join(" or ")));
-            for q in query::QUERIES.iter().filter(|q| q.name.starts_with(name.as_ref())) {
+            for q in query::QUERIES
+                .iter()
+                .filter(|q| q.name.starts_with(name.as_ref()))
+            {
                 d = d.fix(format!("replace with `{}`", q.name), m.name_span, q.name);
             }
         } else if let Some(s) = super::suggest(&name, query::QUERIES.iter().map(|q| q.name)) {

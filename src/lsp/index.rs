@@ -9,11 +9,11 @@
 //! nothing about meaning (the checker does) and never fails: a file the parser
 //! recovered from is indexed as far as it goes.
 
+use super::words;
 use crate::ast::{
     Expr, ExprKind, File, GuideStmt, Item, LinkStmt, Lsystem, ModName, Module, PropValue, Scene,
     SceneStmt, Stmt,
 };
-use super::words;
 use crate::span::Span;
 use std::collections::HashMap;
 

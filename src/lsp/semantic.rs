@@ -12,8 +12,7 @@ use crate::lexer::{Token, lex};
 use crate::resolve::is_letter;
 use crate::span::Span;
 use lsp_types::{
-    SemanticToken, SemanticTokenModifier, SemanticTokenType, SemanticTokens,
-    SemanticTokensLegend,
+    SemanticToken, SemanticTokenModifier, SemanticTokenType, SemanticTokens, SemanticTokensLegend,
 };
 
 /// Token types, in legend order (a token's type is its index here).

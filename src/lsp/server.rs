@@ -289,7 +289,11 @@ impl<W: Write> Server<W> {
                 let a = s.doc(&p.text_document.uri)?;
                 // `only` keeps the actions of these kinds and their sub-kinds.
                 let wanted = |k: &lsp::CodeActionKind| matches!(k.as_str(), "" | "quickfix");
-                if p.context.only.as_ref().is_some_and(|o| !o.iter().any(wanted)) {
+                if p.context
+                    .only
+                    .as_ref()
+                    .is_some_and(|o| !o.iter().any(wanted))
+                {
                     return Ok(None);
                 }
                 let fixes = actions::quick_fixes(a, &p.text_document.uri, p.range);

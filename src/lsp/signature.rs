@@ -14,8 +14,8 @@ use super::words;
 use crate::ast::{ExprKind, Item, ModName, Stmt};
 use crate::{builtins, query};
 use lsp_types::{
-    Documentation, MarkupContent, MarkupKind, ParameterInformation, ParameterLabel,
-    SignatureHelp, SignatureInformation,
+    Documentation, MarkupContent, MarkupKind, ParameterInformation, ParameterLabel, SignatureHelp,
+    SignatureInformation,
 };
 
 /// The open `(` before `offset` that is not closed before it, and the number
@@ -60,12 +60,10 @@ fn callee(text: &str, paren: usize) -> Option<(usize, &str)> {
 fn info(label: String, params: Vec<String>, doc: String, active: usize) -> SignatureInformation {
     SignatureInformation {
         label,
-        documentation: (!doc.is_empty()).then(|| {
-            Documentation::MarkupContent(MarkupContent {
-                kind: MarkupKind::Markdown,
-                value: doc,
-            })
-        }),
+        documentation: (!doc.is_empty()).then_some(Documentation::MarkupContent(MarkupContent {
+            kind: MarkupKind::Markdown,
+            value: doc,
+        })),
         parameters: Some(
             params
                 .into_iter()
@@ -149,7 +147,11 @@ pub fn signature_help(a: &Analysis, offset: usize) -> Option<SignatureHelp> {
             k.doc.to_string(),
             active,
         )
-    } else if let Some(w) = name.chars().next().filter(|_| name.chars().count() == 1).and_then(words::turtle)
+    } else if let Some(w) = name
+        .chars()
+        .next()
+        .filter(|_| name.chars().count() == 1)
+        .and_then(words::turtle)
         && w.form.contains('(')
         && !matches!(
             a.index.at(start).map(|o| &o.target),
@@ -157,10 +159,18 @@ pub fn signature_help(a: &Analysis, offset: usize) -> Option<SignatureHelp> {
         )
     {
         let p = w.form[2..w.form.len() - 1].to_string();
-        info(w.form.to_string(), vec![p], format!("Turtle: {}.", w.meaning), active)
+        info(
+            w.form.to_string(),
+            vec![p],
+            format!("Turtle: {}.", w.meaning),
+            active,
+        )
     } else {
         // A module of the file: declared, or a letter its rules give names.
-        let o = a.index.at(start).filter(|o| o.span.start as usize == start)?;
+        let o = a
+            .index
+            .at(start)
+            .filter(|o| o.span.start as usize == start)?;
         let Target::Symbol(id) = &o.target else {
             return None;
         };
@@ -183,10 +193,18 @@ pub fn signature_help(a: &Analysis, offset: usize) -> Option<SignatureHelp> {
             _ => return None,
         };
         let doc = match s.kind {
-            Kind::Letter => format!("Module `{}`, named as its rules' predecessor binds them.", s.name),
+            Kind::Letter => format!(
+                "Module `{}`, named as its rules' predecessor binds them.",
+                s.name
+            ),
             _ => format!("Module `{}` as declared.", s.name),
         };
-        info(format!("{}({})", s.name, params.join(", ")), params, doc, active)
+        info(
+            format!("{}({})", s.name, params.join(", ")),
+            params,
+            doc,
+            active,
+        )
     };
     Some(SignatureHelp {
         signatures: vec![sig],

@@ -1032,7 +1032,8 @@ fn every_resolved_name_has_a_definition() {
                         } else if sym.kind == Kind::Letter && lsyc::resolve::is_letter(&sym.name) {
                             excluded += 1;
                         } else {
-                            unexplained.push(format!("{rel}:{off}: `{}` has no definition", sym.name));
+                            unexplained
+                                .push(format!("{rel}:{off}: `{}` has no definition", sym.name));
                         }
                     }
                     Target::Word(_) | Target::Function(_) => {
@@ -1051,7 +1052,10 @@ fn every_resolved_name_has_a_definition() {
         unexplained.join("\n")
     );
     assert!(checked > 40, "{checked} files");
-    assert!(defined > 2000 && excluded > 100, "{defined} defined, {excluded} excluded");
+    assert!(
+        defined > 2000 && excluded > 100,
+        "{defined} defined, {excluded} excluded"
+    );
 }
 
 /// A program with the newer syntax: `tropism` (statement and module),
@@ -1113,12 +1117,27 @@ fn newer_syntax_is_indexed_and_explained() {
         let d = c.request("textDocument/definition", doc(pos(text, needle, nth)));
         if d.is_array() { d[0].clone() } else { d }
     };
-    assert_eq!(def(&mut c, "E;", 0)["range"]["start"], pos(text, "E = 0.2", 0));
-    assert_eq!(def(&mut c, "E * 2", 0)["range"]["start"], pos(text, "E = 0.2", 0));
-    assert_eq!(def(&mut c, "V;", 0)["range"]["start"], pos(text, "V = 1", 0));
-    assert_eq!(def(&mut c, "Apex;", 0)["range"]["start"], pos(text, "Apex(len", 0));
+    assert_eq!(
+        def(&mut c, "E;", 0)["range"]["start"],
+        pos(text, "E = 0.2", 0)
+    );
+    assert_eq!(
+        def(&mut c, "E * 2", 0)["range"]["start"],
+        pos(text, "E = 0.2", 0)
+    );
+    assert_eq!(
+        def(&mut c, "V;", 0)["range"]["start"],
+        pos(text, "V = 1", 0)
+    );
+    assert_eq!(
+        def(&mut c, "Apex;", 0)["range"]["start"],
+        pos(text, "Apex(len", 0)
+    );
     // `A` in `consider` is a letter: it goes to the rule that rewrites it.
-    assert_eq!(def(&mut c, "A Apex;", 0)["range"]["start"], pos(text, "A(x) ->", 0));
+    assert_eq!(
+        def(&mut c, "A Apex;", 0)["range"]["start"],
+        pos(text, "A(x) ->", 0)
+    );
     // The words are not names: nothing to go to, nothing to rename.
     for w in ["tropism(E", "continue", "middle", "aim"] {
         assert!(def(&mut c, w, 0).is_null(), "{w}");
@@ -1227,15 +1246,32 @@ fn semantic_tokens_signatures_and_range_formatting() {
         doc(position_of(text, at))
     };
     let mut sigs = String::new();
-    for needle in ["Apex(1, ", "Apex(1", "A(x * 0.", "tropism(E", "+(3", "F(l", "Apex(l, d - "] {
+    for needle in [
+        "Apex(1, ",
+        "Apex(1",
+        "A(x * 0.",
+        "tropism(E",
+        "+(3",
+        "F(l",
+        "Apex(l, d - ",
+    ] {
         let h = c.request("textDocument/signatureHelp", after(needle));
         let s = &h["signatures"][0];
         let active = h["activeParameter"].as_u64().expect("active") as usize;
         let param = s["parameters"][active]["label"].as_str().unwrap_or("?");
-        sigs.push_str(&format!("{needle:<12} {}  [{param}]\n", s["label"].as_str().expect("label")));
+        sigs.push_str(&format!(
+            "{needle:<12} {}  [{param}]\n",
+            s["label"].as_str().expect("label")
+        ));
     }
-    assert!(sigs.contains("Apex(1,      Apex(len, depth)  [depth]"), "{sigs}");
-    assert!(sigs.contains("Apex(1       Apex(len, depth)  [len]"), "{sigs}");
+    assert!(
+        sigs.contains("Apex(1,      Apex(len, depth)  [depth]"),
+        "{sigs}"
+    );
+    assert!(
+        sigs.contains("Apex(1       Apex(len, depth)  [len]"),
+        "{sigs}"
+    );
     assert!(sigs.contains("A(x * 0.     A(x)  [x]"), "{sigs}");
     assert!(sigs.contains("tropism(E    tropism(e)  [e]"), "{sigs}");
     // Outside parentheses there is none.
@@ -1249,7 +1285,10 @@ fn semantic_tokens_signatures_and_range_formatting() {
         "textDocument/signatureHelp",
         json!({"textDocument": {"uri": "file:///palm.lsy"}, "position": position_of(&palm, at)}),
     );
-    sigs.push_str(&format!("?D_L(found,  {}  [{}]\n", h["signatures"][0]["label"], h["activeParameter"]));
+    sigs.push_str(&format!(
+        "?D_L(found,  {}  [{}]\n",
+        h["signatures"][0]["label"], h["activeParameter"]
+    ));
     assert_eq!(h["activeParameter"], 1, "{h}");
     insta::assert_snapshot!("lsp_signature_help", sigs);
 
@@ -1276,9 +1315,8 @@ fn semantic_tokens_signatures_and_range_formatting() {
     assert_eq!(whole, canonical);
     // Only the lsystem (the range is inside its `A` rule).
     let part = range_format(&mut c, "A(x) ->", "A(x * 0.5)");
-    let lsystem = |s: &str| {
-        s[s.find("lsystem").expect("ls")..s.find("scene").expect("scene")].to_string()
-    };
+    let lsystem =
+        |s: &str| s[s.find("lsystem").expect("ls")..s.find("scene").expect("scene")].to_string();
     let scene = |s: &str| s[s.find("scene").expect("scene")..].to_string();
     assert_eq!(lsystem(&part).trim_end(), lsystem(&canonical).trim_end());
     assert_eq!(scene(&part), scene(&messy), "the scene is left as written");
