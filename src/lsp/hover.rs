@@ -335,8 +335,19 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
                             head.push_str(&format!("\n    derive {};", format_expr(e)))
                         }
                         Stmt::Step(e) => head.push_str(&format!("\n    step {};", format_expr(e))),
+                        Stmt::Tropism(t) => head.push_str(&format!(
+                            "\n    tropism ({}, {}, {}) {};",
+                            format_expr(&t.dir[0]),
+                            format_expr(&t.dir[1]),
+                            format_expr(&t.dir[2]),
+                            format_expr(&t.elasticity)
+                        )),
                         Stmt::Rule(_) => rules += 1,
-                        _ => {}
+                        Stmt::Axiom(_)
+                        | Stmt::Ignore(_)
+                        | Stmt::Consider(_)
+                        | Stmt::Module(_)
+                        | Stmt::Error => {}
                     }
                 }
                 parts.push(format!("```lsy\n{head}\n```"));
@@ -402,7 +413,7 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
                             lines.push(format!("    system {};", n.name))
                         }
                         crate::ast::GuideStmt::Seed(_) => lines.push("    seed …;".to_string()),
-                        _ => {}
+                        crate::ast::GuideStmt::Error => {}
                     }
                 }
                 parts.push(format!("```lsy\n{}\n```", lines.join("\n")));
