@@ -1008,6 +1008,16 @@ fn every_resolved_name_has_a_definition() {
             }
         }
         for (start, tok, end) in lex(&text).tokens {
+            // A keyword is never a name (the module `tropism(e)` is a word).
+            if tok.is_keyword() {
+                if let Some(o) = a.index.at(start).filter(|o| o.span.start as usize == start) {
+                    assert!(
+                        !matches!(o.target, Target::Symbol(_)),
+                        "{rel}:{start}: the keyword {tok} is indexed as a name"
+                    );
+                }
+                continue;
+            }
             let Token::Ident(name) = tok else { continue };
             if name == "_" || unused_decl.contains(&(start as u32)) {
                 excluded += 1;
