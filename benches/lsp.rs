@@ -7,13 +7,17 @@
 //!   an incremental `didChange` read from JSON-RPC, applied, analysed, and the
 //!   `publishDiagnostics` notification written (to a sink). Per keystroke.
 //!
+//! - `lsp_tokens/FILE`: semantic tokens for the whole document, which an
+//!   editor asks for after every change too (`lsp::semantic::tokens`, the
+//!   analysis already made).
+//!
 //! Files: a gallery program (`monopodial-tree.lsy`), the palm scene and the
 //! largest scene of `lang-examples/` (`bridge.lsy`).
 //!
 //! `cargo bench --bench lsp`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use lsyc::lsp::{Analysis, serve};
+use lsyc::lsp::{Analysis, semantic, serve};
 use serde_json::json;
 use std::hint::black_box;
 use std::io::BufReader;
@@ -101,6 +105,15 @@ fn bench(c: &mut Criterion) {
                 assert_eq!(end, lsyc::lsp::End::Clean);
                 t.elapsed()
             })
+        });
+    }
+    g.finish();
+    let mut g = c.benchmark_group("lsp_tokens");
+    g.measurement_time(Duration::from_secs(3));
+    for file in FILES {
+        let a = Analysis::new(read(file));
+        g.bench_function(*file, |b| {
+            b.iter(|| black_box(semantic::tokens(black_box(&a))))
         });
     }
     g.finish();

@@ -142,6 +142,19 @@ pub struct Diagnostic {
     pub labels: Vec<Label>,
     pub notes: Vec<String>,
     pub help: Option<String>,
+    /// Machine-applicable fixes for what `help` says (editors offer them as
+    /// quick fixes); most diagnostics have none. (A boxed slice: diagnostics
+    /// travel in `Result`s, and this keeps them small.)
+    pub fixes: Box<[Fix]>,
+}
+
+/// A concrete fix: replace each span with its text. Applying it gives a
+/// program that no longer has this problem.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fix {
+    /// What it does, in a few words ("replace with `crown`").
+    pub title: String,
+    pub edits: Vec<(Span, String)>,
 }
 
 impl Diagnostic {
@@ -153,6 +166,7 @@ impl Diagnostic {
             labels: Vec::new(),
             notes: Vec::new(),
             help: None,
+            fixes: Box::new([]),
         }
     }
 
@@ -191,6 +205,31 @@ impl Diagnostic {
     pub fn help(mut self, help: impl Into<String>) -> Diagnostic {
         self.help = Some(help.into());
         self
+    }
+
+    /// A machine-applicable fix: write `text` in place of `span`.
+    pub fn fix(
+        mut self,
+        title: impl Into<String>,
+        span: Span,
+        text: impl Into<String>,
+    ) -> Diagnostic {
+        let mut fixes = std::mem::take(&mut self.fixes).into_vec();
+        fixes.push(Fix {
+            title: title.into(),
+            edits: vec![(span, text.into())],
+        });
+        self.fixes = fixes.into_boxed_slice();
+        self
+    }
+
+    /// "did you mean `name`?", and the fix that writes `name` at `span`.
+    pub fn did_you_mean(self, span: Span, name: &str) -> Diagnostic {
+        self.help(format!("did you mean `{name}`?")).fix(
+            format!("replace with `{name}`"),
+            span,
+            name,
+        )
     }
 
     pub fn is_error(&self) -> bool {

@@ -45,6 +45,26 @@ pub fn format_file(file: &File) -> String {
     p.out
 }
 
+/// Prints the top-level items `range` of a file as `format_file` prints them
+/// there (the file's module declarations decide how letters are spaced), for
+/// formatting part of a file. The blank line before the first one, and the
+/// comments after the file's last item, are left to the caller.
+pub fn format_items(file: &File, range: std::ops::Range<usize>) -> String {
+    let mut p = Printer::default();
+    let top = Scope::file(file);
+    let part = crate::ast::Block {
+        stmts: file.items.stmts.get(range).unwrap_or_default().to_vec(),
+        end_comments: Vec::new(),
+    };
+    p.block(
+        &part,
+        0,
+        |it| !matches!(it, Item::Error),
+        |p, it, ind| p.item(it, ind, &top),
+    );
+    p.out
+}
+
 /// Prints an expression with the fewest parentheses that parse back to it.
 pub fn format_expr(e: &Expr) -> String {
     let mut s = String::new();

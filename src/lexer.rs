@@ -340,6 +340,36 @@ fn stray_diagnostic(source: &str, start: usize, end: usize) -> Diagnostic {
         "no token of the language starts here",
     );
     let after = &source[end..];
+    // `#define N 5` and `#ignore: + -` to the end of the line, rewritten.
+    let line = &after[..after.find('\n').unwrap_or(after.len())];
+    let to_eol = Span::new(start, end + line.len());
+    let port = |word: &str| {
+        let rest = line.strip_prefix(word)?.trim();
+        let rest = rest.strip_suffix(';').unwrap_or(rest).trim();
+        (!rest.is_empty() && !rest.contains("//") && !rest.contains("/*")).then_some(rest)
+    };
+    if text == "#" {
+        if let Some((name, value)) = port("define").and_then(|r| r.split_once(char::is_whitespace))
+            && matches!(&lex(name).tokens[..], [(_, Token::Ident(n), _)] if n == name)
+        {
+            d = d.fix(
+                "write it as a constant",
+                to_eol,
+                format!("const {name} = {};", value.trim()),
+            );
+        }
+        for word in ["ignore", "consider"] {
+            if let Some(list) = port(word).map(|r| r.strip_prefix(':').unwrap_or(r).trim())
+                && !list.is_empty()
+            {
+                d = d.fix(
+                    format!("write `{word} …;`"),
+                    to_eol,
+                    format!("{word} {list};"),
+                );
+            }
+        }
+    }
     d = match first {
         '#' if after.starts_with("define") => d.help(
             "cpfg's `#define N 5` is a constant in lsyc: `const N = 5;` (before the lsystem; `-D N=…` overrides it)",
@@ -360,6 +390,9 @@ fn stray_diagnostic(source: &str, start: usize, end: usize) -> Diagnostic {
         '~' => d.help("surfaces are drawn by declared `element` items, not `~`"),
         '?' => d.help("a query module is written `?` followed directly by its name, as in `?X(d)`"),
         '"' => d.help("strings are written in double quotes: \"…\""),
+        '→' if text == "→" => d
+            .help("write the arrow as `->`")
+            .fix("replace with `->`", Span::new(start, end), "->"),
         '→' => d.help("write the arrow as `->`"),
         _ => d,
     };

@@ -349,13 +349,16 @@ fn explain_context(
             break;
         }
         if let Token::Label(name) = &t.1 {
+            let label = Span::new(t.0, t.2);
             d = match name.as_str() {
                 "ω" | "omega" | "axiom" | "Axiom" => d
                     .note(format!("`{name}:` is read as a rule label"))
-                    .help("the axiom is a statement: `axiom F;`"),
+                    .help("the axiom is a statement: `axiom F;`")
+                    .fix("write `axiom`", label, "axiom"),
                 "ignore" | "consider" => d
                     .note(format!("`{name}:` is read as a rule label"))
-                    .help(format!("`{name}` takes the modules without a colon: `{name} + - F;`")),
+                    .help(format!("`{name}` takes the modules without a colon: `{name} + - F;`"))
+                    .fix(format!("write `{name}`"), label, name.as_str()),
                 _ => d.note(format!(
                     "`{name}:` is read as a rule label; for a condition write a space before the colon: `{name} : …`"
                 )),
@@ -370,7 +373,8 @@ fn explain_context(
     {
         d = d
             .secondary(Span::new(t.0, t.2), "cpfg's and L-Py's end of an lsystem")
-            .help("an lsyc lsystem ends with its closing `}`: remove `endlsystem`");
+            .help("an lsyc lsystem ends with its closing `}`: remove `endlsystem`")
+            .fix("remove it", Span::new(t.0, t.2), "");
     }
     d
 }
@@ -399,7 +403,8 @@ fn syntax_error_at(
             if semi && let Some(pend) = missing_semicolon(tokens, l, index) {
                 d = d
                     .secondary(Span::new(pend, pend), "`;` may be missing here")
-                    .help("end each statement with `;`");
+                    .help("end each statement with `;`")
+                    .fix("insert `;`", Span::new(pend, pend), ";");
             }
             if tok.is_keyword()
                 && expected.iter().any(|e| e == "\"name\"")
@@ -410,18 +415,22 @@ fn syntax_error_at(
                 ));
             }
             if tok == Token::Assign {
-                d = d.help("to compare, write `==`; `=` only defines a constant");
+                d = d
+                    .help("to compare, write `==`; `=` only defines a constant")
+                    .fix("replace with `==`", span, "==");
             }
             if tok == Token::Star
-                && tokens
+                && let Some(colon) = tokens
                     .iter()
                     .rev()
                     .find(|t| t.0 < l)
-                    .is_some_and(|t| t.1 == Token::Colon)
+                    .filter(|t| t.1 == Token::Colon)
             {
-                d = d.help(
-                    "`: *` is cpfg's \"no condition\"; in lsyc leave the condition out: `A -> …`",
-                );
+                d = d
+                    .help(
+                        "`: *` is cpfg's \"no condition\"; in lsyc leave the condition out: `A -> …`",
+                    )
+                    .fix("remove `: *`", Span::new(colon.0, r), "");
             }
             if matches!(tok, Token::Label(_)) {
                 d = d.note("a name followed directly by `:` is a rule label; write a space before `:` for a condition");
@@ -448,7 +457,8 @@ fn syntax_error_at(
                         "so this `}` was read as part of the successor",
                     )
                     .note("inside a successor `}` closes a polygon `{`")
-                    .help("end each statement with `;`");
+                    .help("end each statement with `;`")
+                    .fix("insert `;`", Span::new(pend, pend), ";");
             }
             d
         }

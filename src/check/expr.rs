@@ -213,7 +213,7 @@ impl Checker<'_> {
             .chain(consts)
             .collect();
         if let Some(s) = suggest(name, names) {
-            d = d.help(format!("did you mean `{s}`?"));
+            d = d.did_you_mean(span, s);
         } else if self.lsystem_params.iter().any(|p| p == name) {
             d = d.help(format!(
                 "`{name}` is a parameter of the lsystem: it is visible in the axiom only; pass it on as a module parameter, e.g. `axiom A({name});`"
@@ -236,7 +236,7 @@ impl Checker<'_> {
             )
             .primary(f.span, "no built-in function has this name");
             if let Some(s) = suggest(&f.name, builtins::BUILTINS.iter().map(|b| b.name)) {
-                d = d.help(format!("did you mean `{s}`?"));
+                d = d.did_you_mean(f.span, s);
             } else {
                 d = d.note("the functions are listed in docs/language.md");
             }

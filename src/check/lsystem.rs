@@ -274,32 +274,51 @@ impl<'a> Checker<'a> {
     fn labels(&mut self, ls: &Lsystem) {
         let mut seen: HashMap<&str, Span> = HashMap::new();
         for s in &ls.body.stmts {
-            if let Stmt::Rule(Rule { label: Some(l), .. }) = &s.node {
-                let help = match l.name.as_str() {
-                    "decomposition" | "decompositions" => {
-                        Some("lsyc marks each rule instead of a section: `decompose A -> B C;`")
-                    }
-                    "homomorphism" | "homomorphisms" | "interpretation" => {
-                        Some("lsyc marks each rule instead of a section: `interpret A -> F;`")
-                    }
+            if let Stmt::Rule(r @ Rule { label: Some(l), .. }) = &s.node {
+                let (help, word) = match l.name.as_str() {
+                    "decomposition" | "decompositions" => (
+                        Some("lsyc marks each rule instead of a section: `decompose A -> B C;`"),
+                        "decompose",
+                    ),
+                    "homomorphism" | "homomorphisms" | "interpretation" => (
+                        Some("lsyc marks each rule instead of a section: `interpret A -> F;`"),
+                        "interpret",
+                    ),
                     "production" | "productions" | "derivation" | "endgroup" | "group" => {
-                        Some("lsyc rules need no section: remove the label")
+                        (Some("lsyc rules need no section: remove the label"), "")
                     }
-                    _ => None,
+                    _ => (None, ""),
                 };
+                // The label and its colon, replaced by the rule's kind (when
+                // the rule can be one: no kind yet, no context).
+                let plain = !r.interpret && !r.decompose && r.left.is_none() && r.right.is_none();
+                let fix = (word.is_empty() || plain).then(|| {
+                    let title = if word.is_empty() {
+                        "remove the label".to_string()
+                    } else {
+                        format!("write `{word}`")
+                    };
+                    (
+                        title,
+                        Span::new(l.span.start as usize, l.span.end as usize + 1),
+                        word,
+                    )
+                });
                 if let Some(help) = help {
-                    self.diags.push(
-                        Diagnostic::warning(
-                            Code::SectionLabel,
-                            format!(
-                                "`{}:` is read as the label of one rule, not as a section",
-                                l.name
-                            ),
-                        )
-                        .primary(l.span, "a rule label (a name for this rule only)")
-                        .note("cpfg and L-Py divide an L-system into sections; lsyc has none")
-                        .help(help),
-                    );
+                    let mut d = Diagnostic::warning(
+                        Code::SectionLabel,
+                        format!(
+                            "`{}:` is read as the label of one rule, not as a section",
+                            l.name
+                        ),
+                    )
+                    .primary(l.span, "a rule label (a name for this rule only)")
+                    .note("cpfg and L-Py divide an L-system into sections; lsyc has none")
+                    .help(help);
+                    if let Some((title, span, word)) = fix {
+                        d = d.fix(title, span, word);
+                    }
+                    self.diags.push(d);
                 }
                 if let Some(first) = seen.get(l.name.as_str()) {
                     self.diags
@@ -577,8 +596,14 @@ impl<'a> Checker<'a> {
             .collect();
         if !prefixed.is_empty() {
             d = d.help(format!("did you mean {}?", prefixed.join(" or ")));
+            for q in query::QUERIES
+                .iter()
+                .filter(|q| q.name.starts_with(name.as_ref()))
+            {
+                d = d.fix(format!("replace with `{}`", q.name), m.name_span, q.name);
+            }
         } else if let Some(s) = super::suggest(&name, query::QUERIES.iter().map(|q| q.name)) {
-            d = d.help(format!("did you mean `{s}`?"));
+            d = d.did_you_mean(m.name_span, s);
         } else {
             let names: Vec<&str> = query::QUERIES.iter().map(|q| q.name).collect();
             d = d.note(format!("the query modules are {}", names.join(" ")));

@@ -40,7 +40,7 @@ impl<'a> Checker<'a> {
                     _ => None,
                 };
                 if let Some(s) = synonym.or_else(|| suggest(key, PROPS.iter().map(|(k, _)| *k))) {
-                    d = d.help(format!("did you mean `{s}`?"));
+                    d = d.did_you_mean(p.node.key.span, s);
                 } else {
                     d = d.note("the properties are path, fill, stroke and width");
                 }
@@ -206,7 +206,7 @@ impl<'a> Checker<'a> {
                             )
                             .primary(name.span, "not defined in this file");
                             if let Some(sg) = suggest(&name.name, self.systems.keys().copied()) {
-                                d = d.help(format!("did you mean `{sg}`?"));
+                                d = d.did_you_mean(name.span, sg);
                             }
                             self.diags.push(d);
                             None
@@ -346,7 +346,7 @@ impl<'a> Checker<'a> {
             )
             .primary(r.guide.span, "unknown guide");
             if let Some(s) = suggest(&r.guide.name, guides.keys().copied()) {
-                d = d.help(format!("did you mean `{s}`?"));
+                d = d.did_you_mean(r.guide.span, s);
             }
             self.diags.push(d);
             return;

@@ -86,7 +86,7 @@ impl Analysis {
             .collect()
     }
 
-    fn convert(&self, d: &Diagnostic, uri: &lsp::Uri) -> lsp::Diagnostic {
+    pub fn convert(&self, d: &Diagnostic, uri: &lsp::Uri) -> lsp::Diagnostic {
         let pi = d.labels.iter().position(|l| l.primary);
         let range = pi.map_or_else(lsp::Range::default, |i| self.range(d.labels[i].span));
         let mut message = d.message.clone();

@@ -79,6 +79,7 @@ fn target_text(a: &Analysis, t: &Target) -> Option<String> {
         Target::Symbol(id) => Some(symbol_text(a, a.index.symbols.get(*id)?)),
         Target::Query(q) => Some(query_text(q)),
         Target::Turtle(c) => words::turtle(*c).map(turtle_text),
+        Target::Word(w) => words::word(w).map(|k| format!("```lsy\n{}\n```\n\n{}", k.word, k.doc)),
         Target::Cut => words::turtle('%').map(|w| format!("```lsy\ncut\n```\n\n{}", w.meaning)),
         Target::Function(f) => Some(match builtins::lookup(f) {
             Some(b) => {
@@ -334,8 +335,19 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
                             head.push_str(&format!("\n    derive {};", format_expr(e)))
                         }
                         Stmt::Step(e) => head.push_str(&format!("\n    step {};", format_expr(e))),
+                        Stmt::Tropism(t) => head.push_str(&format!(
+                            "\n    tropism ({}, {}, {}) {};",
+                            format_expr(&t.dir[0]),
+                            format_expr(&t.dir[1]),
+                            format_expr(&t.dir[2]),
+                            format_expr(&t.elasticity)
+                        )),
                         Stmt::Rule(_) => rules += 1,
-                        _ => {}
+                        Stmt::Axiom(_)
+                        | Stmt::Ignore(_)
+                        | Stmt::Consider(_)
+                        | Stmt::Module(_)
+                        | Stmt::Error => {}
                     }
                 }
                 parts.push(format!("```lsy\n{head}\n```"));
@@ -401,7 +413,7 @@ fn symbol_text(a: &Analysis, s: &Symbol) -> String {
                             lines.push(format!("    system {};", n.name))
                         }
                         crate::ast::GuideStmt::Seed(_) => lines.push("    seed …;".to_string()),
-                        _ => {}
+                        crate::ast::GuideStmt::Error => {}
                     }
                 }
                 parts.push(format!("```lsy\n{}\n```", lines.join("\n")));

@@ -9,6 +9,7 @@
 //! nothing about meaning (the checker does) and never fails: a file the parser
 //! recovered from is indexed as far as it goes.
 
+use super::words;
 use crate::ast::{
     Expr, ExprKind, File, GuideStmt, Item, LinkStmt, Lsystem, ModName, Module, PropValue, Scene,
     SceneStmt, Stmt,
@@ -86,6 +87,17 @@ pub struct Symbol {
 }
 
 impl Symbol {
+    /// Where go-to-definition leads: the declaration, or for a letter module
+    /// (declared by use) the predecessors of the rules that rewrite it.
+    /// Empty for a letter no rule rewrites (`F`, or a letter that only
+    /// appears in strings).
+    pub fn definition(&self) -> Vec<Span> {
+        match self.decl {
+            Some(d) => vec![d],
+            None => self.rules.clone(),
+        }
+    }
+
     /// The rule (item, statement) or lsystem header (item, `usize::MAX`) a
     /// parameter belongs to.
     pub fn origin_rule(&self) -> Option<(usize, usize)> {
@@ -108,6 +120,10 @@ pub enum Target {
     Cut,
     /// A built-in function.
     Function(String),
+    /// A word of the language written where a name could be: the module
+    /// `tropism(e)`, a link setting (`aim`, `take`) and its value words
+    /// (`continue`, `middle`, `closest`). Never a constant, never renamed.
+    Word(String),
 }
 
 #[derive(Clone, Debug)]
@@ -253,7 +269,7 @@ impl Builder {
                 Item::Element(e) => (Ns::Module, Kind::Element, &e.name),
                 Item::Lsystem(l) => (Ns::Lsystem, Kind::Lsystem, &l.name),
                 Item::Scene(s) => (Ns::Scene, Kind::Scene, &s.name),
-                _ => continue,
+                Item::Error => continue,
             };
             if name.name.is_empty() {
                 continue;
@@ -277,7 +293,7 @@ impl Builder {
                 }
                 Item::Lsystem(l) => self.lsystem(i, l),
                 Item::Scene(s) => self.scene(i, s),
-                _ => {}
+                Item::Module(_) | Item::Error => {}
             }
         }
     }
@@ -304,7 +320,14 @@ impl Builder {
             match &st.node {
                 Stmt::Angle(e) | Stmt::Derive(e) | Stmt::Step(e) => self.expr(e, &[]),
                 Stmt::Axiom(ms) => self.modules(i, ms, &ls_params),
-                Stmt::Ignore(ms) => self.modules(i, ms, &[]),
+                Stmt::Ignore(ms) | Stmt::Consider(ms) => self.modules(i, ms, &[]),
+                Stmt::Tropism(t) => {
+                    for e in t.dir.iter().chain(std::iter::once(&t.elasticity)) {
+                        self.expr(e, &[]);
+                    }
+                }
+                // Declared above; a statement the parser skipped has nothing.
+                Stmt::Module(_) | Stmt::Error => {}
                 Stmt::Rule(r) => {
                     let mut params: Vec<(&str, usize)> = Vec::new();
                     let pats = r
@@ -346,7 +369,6 @@ impl Builder {
                     }
                     self.modules(i, &r.succ, &params);
                 }
-                _ => {}
             }
         }
     }
@@ -391,6 +413,7 @@ impl Builder {
 
     fn module(&mut self, ls: usize, m: &Module) {
         let target = match &m.name {
+            ModName::Name(n) if crate::resolve::is_builtin(n) => Target::Word(n.clone()),
             ModName::Name(n) => match self.module_symbol(ls, n) {
                 Some(id) => Target::Symbol(id),
                 None => return,
@@ -437,7 +460,7 @@ impl Builder {
                                     self.expr(e, &[]);
                                 }
                             }
-                            _ => {}
+                            GuideStmt::Error => {}
                         }
                     }
                 }
@@ -451,12 +474,29 @@ impl Builder {
                     }
                     for ls in &l.body.stmts {
                         match &ls.node {
+                            // `heading continue;`, `aim middle;`: the value is a
+                            // word, never a constant (as the checker reads it).
+                            LinkStmt::Heading(e) if link_word(e) == Some("continue") => {
+                                self.occ(e.span, Target::Word("continue".into()), false)
+                            }
                             LinkStmt::Tokens(e) | LinkStmt::Heading(e) => self.expr(e, &[]),
-                            _ => {}
+                            LinkStmt::Setting(k, e) => {
+                                // An unknown setting is the checker's error (E0805).
+                                if words::is_link_setting(&k.name) {
+                                    self.occ(k.span, Target::Word(k.name.clone()), false);
+                                }
+                                match link_word(e) {
+                                    Some(w @ ("middle" | "closest")) if k.name == "aim" => {
+                                        self.occ(e.span, Target::Word(w.to_string()), false)
+                                    }
+                                    _ => self.expr(e, &[]),
+                                }
+                            }
+                            LinkStmt::Error => {}
                         }
                     }
                 }
-                _ => {}
+                SceneStmt::Error => {}
             }
         }
     }
@@ -481,8 +521,16 @@ impl Builder {
                     self.expr(a, locals);
                 }
             }
-            _ => {}
+            ExprKind::Num(_) | ExprKind::Bool(_) | ExprKind::Error => {}
         }
+    }
+}
+
+/// A link setting's value written as a bare word, as the checker reads it.
+fn link_word(e: &Expr) -> Option<&str> {
+    match &e.kind {
+        ExprKind::Var(n) => Some(n),
+        _ => None,
     }
 }
 

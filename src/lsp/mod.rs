@@ -1,5 +1,6 @@
-//! `lsyc lsp`: a Language Server for `.lsy` files (diagnostics, formatting,
-//! hover, go-to-definition, references, completion, document symbols, rename).
+//! `lsyc lsp`: a Language Server for `.lsy` files (diagnostics and their quick
+//! fixes, formatting, hover, go-to-definition, references, completion,
+//! signature help, semantic tokens, document symbols, rename).
 //!
 //! Owns: the editor's view of a program. It is a thin layer over the same
 //! library the command line uses: `frontend` for diagnostics (what `lsyc
@@ -8,6 +9,7 @@
 //! not grow one. The protocol types are lsp-types'; the message types and
 //! their framing lsp-server's (docs/lsp.md says why and where we differ).
 
+pub mod actions;
 pub mod analysis;
 pub mod complete;
 pub mod format;
@@ -15,7 +17,9 @@ pub mod hover;
 pub mod index;
 pub mod outline;
 pub mod rename;
+pub mod semantic;
 pub mod server;
+pub mod signature;
 pub mod text;
 pub mod transport;
 pub mod words;

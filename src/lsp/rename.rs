@@ -29,6 +29,9 @@ pub fn prepare(a: &Analysis, offset: usize) -> Result<(Span, String), String> {
         }
         Target::Turtle(_) | Target::Cut => Err("turtle symbols cannot be renamed".into()),
         Target::Function(_) => Err("built-in functions cannot be renamed".into()),
+        Target::Word(w) => Err(format!(
+            "`{w}` is a word of the language; it cannot be renamed"
+        )),
     }
 }
 

@@ -9,7 +9,7 @@
 
 use super::analysis::Analysis;
 use super::transport::{self, Incoming};
-use super::{complete, format, hover, outline, rename, text};
+use super::{actions, complete, format, hover, outline, rename, semantic, signature, text};
 use lsp_server::{ErrorCode, Message, Notification, Request, Response, ResponseError};
 use lsp_types as lsp;
 use lsp_types::notification::{self as note, Notification as _};
@@ -105,8 +105,30 @@ pub fn capabilities() -> lsp::ServerCapabilities {
             trigger_characters: Some(vec!["?".to_string()]),
             ..Default::default()
         }),
+        signature_help_provider: Some(lsp::SignatureHelpOptions {
+            trigger_characters: Some(vec!["(".to_string(), ",".to_string()]),
+            retrigger_characters: None,
+            work_done_progress_options: Default::default(),
+        }),
+        semantic_tokens_provider: Some(
+            lsp::SemanticTokensServerCapabilities::SemanticTokensOptions(
+                lsp::SemanticTokensOptions {
+                    legend: semantic::legend(),
+                    full: Some(lsp::SemanticTokensFullOptions::Bool(true)),
+                    range: None,
+                    work_done_progress_options: Default::default(),
+                },
+            ),
+        ),
         document_symbol_provider: Some(lsp::OneOf::Left(true)),
         document_formatting_provider: Some(lsp::OneOf::Left(true)),
+        document_range_formatting_provider: Some(lsp::OneOf::Left(true)),
+        code_action_provider: Some(lsp::CodeActionProviderCapability::Options(
+            lsp::CodeActionOptions {
+                code_action_kinds: Some(vec![lsp::CodeActionKind::QUICKFIX]),
+                ..Default::default()
+            },
+        )),
         rename_provider: Some(lsp::OneOf::Right(lsp::RenameOptions {
             prepare_provider: Some(true),
             work_done_progress_options: Default::default(),
@@ -175,16 +197,8 @@ impl<W: Write> Server<W> {
                 let Some(sym) = a.index.at(off).and_then(|o| a.index.symbol(&o.target)) else {
                     return Ok(None);
                 };
-                let spans: Vec<_> = sym
-                    .decl
-                    .into_iter()
-                    .chain(if sym.decl.is_none() {
-                        sym.rules.clone()
-                    } else {
-                        Vec::new()
-                    })
-                    .collect();
-                let locs: Vec<lsp::Location> = spans
+                let locs: Vec<lsp::Location> = sym
+                    .definition()
                     .into_iter()
                     .map(|sp| lsp::Location {
                         uri: tdp.text_document.uri.clone(),
@@ -244,6 +258,16 @@ impl<W: Write> Server<W> {
                     a, off,
                 ))))
             }),
+            req::SignatureHelpRequest::METHOD => self.on::<req::SignatureHelpRequest>(r, |s, p| {
+                let (a, off) = s.at(&p.text_document_position_params)?;
+                Ok(signature::signature_help(a, off))
+            }),
+            req::SemanticTokensFullRequest::METHOD => {
+                self.on::<req::SemanticTokensFullRequest>(r, |s, p| {
+                    let a = s.doc(&p.text_document.uri)?;
+                    Ok(Some(lsp::SemanticTokensResult::Tokens(semantic::tokens(a))))
+                })
+            }
             req::DocumentSymbolRequest::METHOD => {
                 self.on::<req::DocumentSymbolRequest>(r, |s, p| {
                     let a = s.doc(&p.text_document.uri)?;
@@ -255,6 +279,30 @@ impl<W: Write> Server<W> {
             req::Formatting::METHOD => self.on::<req::Formatting>(r, |s, p| {
                 let a = s.doc(&p.text_document.uri)?;
                 Ok(format::format(&a.text))
+            }),
+            req::RangeFormatting::METHOD => self.on::<req::RangeFormatting>(r, |s, p| {
+                let a = s.doc(&p.text_document.uri)?;
+                let range = a.lines.span(&a.text, p.range);
+                Ok(format::format_range(&a.text, range))
+            }),
+            req::CodeActionRequest::METHOD => self.on::<req::CodeActionRequest>(r, |s, p| {
+                let a = s.doc(&p.text_document.uri)?;
+                // `only` keeps the actions of these kinds and their sub-kinds.
+                let wanted = |k: &lsp::CodeActionKind| matches!(k.as_str(), "" | "quickfix");
+                if p.context
+                    .only
+                    .as_ref()
+                    .is_some_and(|o| !o.iter().any(wanted))
+                {
+                    return Ok(None);
+                }
+                let fixes = actions::quick_fixes(a, &p.text_document.uri, p.range);
+                Ok(Some(
+                    fixes
+                        .into_iter()
+                        .map(lsp::CodeActionOrCommand::CodeAction)
+                        .collect(),
+                ))
             }),
             req::PrepareRenameRequest::METHOD => self.on::<req::PrepareRenameRequest>(r, |s, p| {
                 let (a, off) = s.at(&p)?;

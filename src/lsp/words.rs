@@ -168,6 +168,26 @@ pub const KEYWORDS: &[Keyword] = &[
         "`interpret A -> …;`: a rule applied when drawing, not when deriving",
     ),
     k(
+        "consider",
+        Context::Lsystem,
+        "`consider A B;`: context matching sees only these modules (and brackets); the complement of `ignore`, and not with it in one lsystem (E0606)",
+    ),
+    k(
+        "tropism",
+        Context::Lsystem,
+        "`tropism (x, y, z) e;`: after every `F` the heading bends toward T = (x, y, z) with elasticity e (ABOP §2.2); `tropism (0, -1, 0) 0.22;` is gravity",
+    ),
+    k(
+        "decompose",
+        Context::Lsystem,
+        "`decompose A -> B C;`: a decomposition rule, applied after each derivation step (not to the axiom) until none matches; chains deeper than 64 stop the run (E0910)",
+    ),
+    k(
+        "tropism",
+        Context::Anywhere,
+        "`tropism(e)` in a module string: sets the tropism elasticity to e for the rest of the branch (`[` saves it, `]` restores it); a bare `tropism` goes back to the `tropism` statement's e",
+    ),
+    k(
         "cut",
         Context::Anywhere,
         "`cut` (or `%`): erase the rest of the branch",
@@ -240,6 +260,31 @@ pub const KEYWORDS: &[Keyword] = &[
         "`heading a;`: the heading a message seeds the end guide with",
     ),
     k(
+        "continue",
+        Context::Link,
+        "`heading continue;`: the seeded lsystem keeps the heading of the segment that crossed (streets go straight on)",
+    ),
+    k(
+        "aim",
+        Context::Link,
+        "`aim middle;`: `?D_L` in the start guide measures `d` and `beta` to the middle of this link's edge, not to its closest point (often a corner); `aim closest;` is the default",
+    ),
+    k(
+        "middle",
+        Context::Link,
+        "`aim middle;`: `?D_L` measures to the middle of the link's edge",
+    ),
+    k(
+        "closest",
+        Context::Link,
+        "`aim closest;` (the default): `?D_L` measures to the closest point of the link's edge",
+    ),
+    k(
+        "take",
+        Context::Link,
+        "`take v;`: only a `?X` whose second parameter (the first after Δ) equals v takes this link's tokens: the leader's `?X(D, 1)`, the side shoots' `?X(D, 0)`",
+    ),
+    k(
         "edge",
         Context::Scene,
         "`guide.edge(i)`: edge i of a guide's polygon",
@@ -249,6 +294,20 @@ pub const KEYWORDS: &[Keyword] = &[
 /// The keyword's text for hover (the first entry for a word).
 pub fn keyword(word: &str) -> Option<&'static Keyword> {
     KEYWORDS.iter().find(|k| k.word == word)
+}
+
+/// Whether a name is one of the named settings a link takes (`aim`, `take`).
+pub fn is_link_setting(name: &str) -> bool {
+    matches!(name, "aim" | "take")
+}
+
+/// The text of a word written where a name could be (`Target::Word`): the
+/// module `tropism(e)` in a string, a link setting or its value.
+pub fn word(word: &str) -> Option<&'static Keyword> {
+    KEYWORDS
+        .iter()
+        .find(|k| k.word == word && matches!(k.context, Context::Anywhere | Context::Link))
+        .or_else(|| keyword(word))
 }
 
 #[cfg(test)]

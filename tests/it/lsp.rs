@@ -671,6 +671,16 @@ fn editor_support_files_fit_the_language() {
             "the grammar does not highlight the keyword `{w}`"
         );
     }
+    // Words a link takes that are names to the lexer (`aim middle;`).
+    for k in lsyc::lsp::words::KEYWORDS {
+        if k.context == lsyc::lsp::words::Context::Link {
+            assert!(
+                text.contains(k.word),
+                "the grammar does not know the link word `{}`",
+                k.word
+            );
+        }
+    }
     for b in lsyc::builtins::BUILTINS {
         assert!(
             text.contains(&format!("|{}|", b.name))
@@ -728,7 +738,7 @@ fn every_file_every_name() {
                 Target::Query(q) => assert_eq!(written, q, "{rel}"),
                 Target::Turtle(c) => assert_eq!(written, c.to_string(), "{rel}"),
                 Target::Cut => assert_eq!(written, "cut", "{rel}"),
-                Target::Function(f) => assert_eq!(written, f, "{rel}"),
+                Target::Function(f) | Target::Word(f) => assert_eq!(written, f, "{rel}"),
             }
             assert!(hover::hover(&a, s).is_some(), "{rel}: no hover at {o:?}");
             assert!(a.index.at(s).is_some(), "{rel}");
@@ -756,4 +766,581 @@ fn every_file_every_name() {
         }
     }
     assert!(names > 2000, "only {names} names indexed");
+}
+
+fn lsyc_check(text: &str) -> (bool, String) {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("fixed.lsy");
+    std::fs::write(&path, text).expect("write");
+    let out = Command::new(env!("CARGO_BIN_EXE_lsyc"))
+        .args(["check", path.to_str().expect("utf-8")])
+        .output()
+        .expect("run lsyc check");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Programs with one problem each whose diagnostic carries a fix: the server
+/// offers it as a quick fix on the diagnostic's line, and the program the edit
+/// gives is one `lsyc check` accepts (and the server then reports no error).
+#[test]
+fn quick_fixes_give_programs_lsyc_check_accepts() {
+    const CASES: &[(&str, &str, &str)] = &[
+        (
+            "a constant misspelt",
+            "const len = 2;\nlsystem A {\n    axiom F(lne);\n}\n",
+            "replace with `len`",
+        ),
+        (
+            "a parameter misspelt",
+            "lsystem A {\n    axiom A(1);\n    A(size) -> F(sise) A(size);\n}\n",
+            "replace with `size`",
+        ),
+        (
+            "a function misspelt",
+            "lsystem A {\n    axiom F(sqtr(4));\n}\n",
+            "replace with `sqrt`",
+        ),
+        (
+            "a query module misspelt",
+            "lsystem A {\n    axiom A ?Q;\n    A > ?P(x, y, _) -> F(x + y);\n}\n",
+            "replace with `?P`",
+        ),
+        (
+            "an element property by another name",
+            "element Leaf {\n    path \"M0 0 L0 10\";\n    colour \"green\";\n}\nlsystem A {\n    axiom F Leaf;\n}\n",
+            "replace with `fill`",
+        ),
+        (
+            "a guide's lsystem misspelt",
+            "lsystem Trunk {\n    axiom F;\n}\nscene S {\n    guide g {\n        polygon (0, 0) (10, 0) (10, 10);\n        system Trnk;\n        seed (1, 1);\n    }\n}\n",
+            "replace with `Trunk`",
+        ),
+        (
+            "a link's guide misspelt",
+            "lsystem T {\n    axiom F;\n}\nscene S {\n    guide stem {\n        polygon (0, 0) (10, 0) (10, 10);\n        system T;\n        seed (1, 1);\n    }\n    guide crown {\n        polygon (0, 10) (10, 10) (10, 20);\n        system T;\n    }\n    link stem.edge(1) -> crwon.edge(0) {\n        tokens 1;\n    }\n}\n",
+            "replace with `crown`",
+        ),
+        (
+            "cpfg's #define",
+            "#define N 5\nlsystem A {\n    derive N;\n    axiom F;\n}\n",
+            "write it as a constant",
+        ),
+        (
+            "cpfg's #ignore",
+            "lsystem A {\n    #ignore: + -\n    axiom B F A;\n    B < A -> F;\n}\n",
+            "write `ignore …;`",
+        ),
+        (
+            "cpfg's #consider",
+            "lsystem A {\n    #consider: A B;\n    axiom B F A;\n    B < A -> F;\n}\n",
+            "write `consider …;`",
+        ),
+        (
+            "ω: as in the books",
+            "lsystem A {\n    ω: F;\n    F -> F F;\n}\n",
+            "write `axiom`",
+        ),
+        (
+            "ignore with a colon",
+            "lsystem A {\n    axiom B F A;\n    ignore: F;\n    B < A -> F;\n}\n",
+            "write `ignore`",
+        ),
+        (
+            "= for ==",
+            "lsystem A {\n    axiom A(1);\n    A(x) : x = 1 -> A(x + 1);\n}\n",
+            "replace with `==`",
+        ),
+        (
+            "cpfg's : *",
+            "lsystem A {\n    axiom A;\n    A : * -> F A;\n}\n",
+            "remove `: *`",
+        ),
+        (
+            "a missing ;",
+            "lsystem A {\n    axiom A\n    A -> F A;\n}\n",
+            "insert `;`",
+        ),
+        (
+            "the arrow →",
+            "lsystem A {\n    axiom A;\n    A → F A;\n}\n",
+            "replace with `->`",
+        ),
+        (
+            "endlsystem",
+            "lsystem A {\n    axiom A;\n    A -> F A;\n    endlsystem\n}\n",
+            "remove it",
+        ),
+        (
+            "a section label (a warning)",
+            "lsystem A {\n    axiom A;\n    A -> B;\n    decomposition: B -> F F;\n}\n",
+            "write `decompose`",
+        ),
+    ];
+    let mut c = Client::start();
+    c.initialize();
+    let mut report = String::new();
+    for (n, (what, text, title)) in CASES.iter().enumerate() {
+        let uri = format!("file:///fix/{n}.lsy");
+        let diags = c.open(&uri, text);
+        // The first error, or the warning when there is no error.
+        let all = diags["diagnostics"].as_array().expect("diagnostics");
+        let first = all
+            .iter()
+            .find(|d| d["severity"] == 1)
+            .or(all.first())
+            .unwrap_or_else(|| panic!("{what}: no diagnostic"))
+            .clone();
+        // Asked at the diagnostic's range, as an editor does for the cursor.
+        let actions = c.request(
+            "textDocument/codeAction",
+            json!({
+                "textDocument": {"uri": uri},
+                "range": first["range"],
+                "context": {"diagnostics": [first], "only": ["quickfix"]},
+            }),
+        );
+        let actions = actions.as_array().expect("actions");
+        let action = actions
+            .iter()
+            .find(|a| a["title"] == *title)
+            .unwrap_or_else(|| panic!("{what}: no `{title}` among {actions:?}"));
+        assert_eq!(action["kind"], "quickfix", "{what}");
+        assert_eq!(
+            action["diagnostics"][0]["code"], first["code"],
+            "{what}: the fix names its diagnostic"
+        );
+        let edits = &action["edit"]["changes"][&uri];
+        let fixed = apply(text, edits);
+        let (ok, stderr) = lsyc_check(&fixed);
+        assert!(ok, "{what}: after `{title}`:\n{fixed}\n{stderr}");
+        c.notify(
+            "textDocument/didChange",
+            json!({"textDocument": {"uri": uri, "version": 2},
+                   "contentChanges": [{"text": fixed}]}),
+        );
+        let after = c.notification("textDocument/publishDiagnostics");
+        assert!(
+            after["diagnostics"]
+                .as_array()
+                .expect("diagnostics")
+                .iter()
+                .all(|d| d["severity"] != 1),
+            "{what}: {after}"
+        );
+        report.push_str(&format!(
+            "--- {what}: {} `{title}`\n{fixed}",
+            first["code"].as_str().unwrap_or("-")
+        ));
+    }
+    // Nothing is offered where the diagnostic has no concrete fix, nor when
+    // the client asks only for other kinds of actions.
+    let uri = "file:///fix/none.lsy";
+    let text = "lsystem A {\n    axiom F(zzzz);\n}\n";
+    let d = c.open(uri, text);
+    let first = d["diagnostics"][0].clone();
+    assert_eq!(first["code"], "E0302", "{d}");
+    let none = c.request(
+        "textDocument/codeAction",
+        json!({"textDocument": {"uri": uri}, "range": first["range"],
+               "context": {"diagnostics": [first]}}),
+    );
+    assert_eq!(none, json!([]));
+    let refactor = c.request(
+        "textDocument/codeAction",
+        json!({"textDocument": {"uri": "file:///fix/0.lsy"},
+               "range": {"start": {"line": 0, "character": 0}, "end": {"line": 9, "character": 0}},
+               "context": {"diagnostics": [], "only": ["refactor"]}}),
+    );
+    assert!(refactor.is_null() || refactor == json!([]), "{refactor}");
+    insta::assert_snapshot!("lsp_quick_fixes", report);
+}
+
+/// Over the gallery and the test corpus, in every file the checker accepts
+/// (so it resolved every name): every name token has a definition answer,
+/// except these classes, which have nowhere to go:
+/// - words of the language (`tropism(e)`, `aim`, `take`, `continue`,
+///   `middle`, `closest`) and built-in functions: hover explains them;
+/// - letter modules no rule rewrites (`F`, or a letter that is only written
+///   in strings): declared by use, with no declaration or rule to show;
+/// - the parameters of a `module` declaration and of a module declared in an
+///   lsystem, and element property keys: names with no uses;
+/// - `_`, which binds nothing.
+#[test]
+fn every_resolved_name_has_a_definition() {
+    use lsyc::lexer::{Token, lex};
+    use lsyc::lsp::index::{Kind, Target};
+    use lsyc::lsp::{Analysis, hover};
+    let files = crate::support::lsy_files(&["lang-examples", "tests/data"]);
+    let (mut checked, mut defined, mut excluded) = (0, 0, 0);
+    let mut unexplained = Vec::new();
+    for path in files {
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue;
+        };
+        let a = Analysis::new(text.clone());
+        if a.diagnostics.iter().any(|d| d.is_error()) {
+            continue;
+        }
+        checked += 1;
+        let rel = crate::support::rel(&path);
+        // Names that declare nothing other names use: `module` parameters
+        // and element property keys.
+        let mut unused_decl = std::collections::HashSet::new();
+        for item in &a.file.items.stmts {
+            match &item.node {
+                lsyc::ast::Item::Module(m) => {
+                    unused_decl.extend(m.params.iter().map(|p| p.span.start));
+                }
+                lsyc::ast::Item::Lsystem(l) => {
+                    for st in &l.body.stmts {
+                        if let lsyc::ast::Stmt::Module(m) = &st.node {
+                            unused_decl.extend(m.params.iter().map(|p| p.span.start));
+                        }
+                    }
+                }
+                lsyc::ast::Item::Element(e) => {
+                    unused_decl.extend(e.props.stmts.iter().map(|p| p.node.key.span.start));
+                }
+                _ => {}
+            }
+        }
+        for (start, tok, end) in lex(&text).tokens {
+            // A keyword is never a name (the module `tropism(e)` is a word).
+            if tok.is_keyword() {
+                if let Some(o) = a.index.at(start).filter(|o| o.span.start as usize == start) {
+                    assert!(
+                        !matches!(o.target, Target::Symbol(_)),
+                        "{rel}:{start}: the keyword {tok} is indexed as a name"
+                    );
+                }
+                continue;
+            }
+            let Token::Ident(name) = tok else { continue };
+            if name == "_" || unused_decl.contains(&(start as u32)) {
+                excluded += 1;
+                continue;
+            }
+            // Every letter of a run the resolver split is its own module.
+            for off in start..end {
+                if !text.is_char_boundary(off) {
+                    continue;
+                }
+                let Some(o) = a.index.at(off).filter(|o| o.span.start as usize == off) else {
+                    if off == start {
+                        unexplained.push(format!("{rel}:{start}: `{name}` is not indexed"));
+                    }
+                    continue;
+                };
+                match &o.target {
+                    Target::Symbol(id) => {
+                        let sym = &a.index.symbols[*id];
+                        if !sym.definition().is_empty() {
+                            defined += 1;
+                        } else if sym.kind == Kind::Letter && lsyc::resolve::is_letter(&sym.name) {
+                            excluded += 1;
+                        } else {
+                            unexplained
+                                .push(format!("{rel}:{off}: `{}` has no definition", sym.name));
+                        }
+                    }
+                    Target::Word(_) | Target::Function(_) => {
+                        assert!(hover::hover(&a, off).is_some(), "{rel}:{off}");
+                        excluded += 1;
+                    }
+                    other => unexplained.push(format!("{rel}:{off}: `{name}` is {other:?}")),
+                }
+            }
+        }
+    }
+    assert!(
+        unexplained.is_empty(),
+        "{} names:\n{}",
+        unexplained.len(),
+        unexplained.join("\n")
+    );
+    assert!(checked > 40, "{checked} files");
+    assert!(
+        defined > 2000 && excluded > 100,
+        "{defined} defined, {excluded} excluded"
+    );
+}
+
+/// A program with the newer syntax: `tropism` (statement and module),
+/// `consider`, `decompose`, and a link's `heading continue; aim middle; take v;`.
+const NEWER: &str = "// Newer syntax in one file.
+const E = 0.2;
+const V = 1;
+module Apex(len, depth);
+lsystem Tree(w) {
+    tropism (0, -1, 0) E;
+    consider A Apex;
+    axiom A(w) Apex(1, 2);
+    A(x) -> F(x) [+(30) tropism(E * 2) A(x * 0.5)] A(x);
+    decompose Apex(l, d) : d > 0 -> F(l) Apex(l, d - 1);
+}
+scene S {
+    guide g {
+        polygon (0, 0) (10, 0) (10, 10);
+        system Tree;
+        seed (1, 1) with (1);
+    }
+    guide h {
+        polygon (0, 10) (10, 10) (10, 20);
+        system Tree;
+    }
+    link g.edge(1) -> h.edge(0) { tokens 1; heading continue; aim middle; take V; }
+}
+";
+
+#[test]
+fn newer_syntax_is_indexed_and_explained() {
+    let text = NEWER;
+    let uri = "file:///newer.lsy";
+    let mut c = Client::start();
+    c.initialize();
+    assert_eq!(c.open(uri, text)["diagnostics"], json!([]));
+    let doc = |p: Value| json!({"textDocument": {"uri": uri}, "position": p});
+    let mut hovers = String::new();
+    for (needle, nth, want) in [
+        ("tropism (", 0, "after every `F`"),
+        ("tropism(E", 0, "rest of the branch"),
+        ("consider", 0, "sees only these modules"),
+        ("decompose", 0, "decomposition rule"),
+        ("continue", 0, "keeps the heading"),
+        ("aim", 0, "middle of this link's edge"),
+        ("middle", 0, "middle of the link's edge"),
+        ("take", 0, "`?X`"),
+        ("E;", 0, "const E = 0.2"),
+        ("V;", 0, "const V = 1"),
+    ] {
+        let h = c.request("textDocument/hover", doc(pos(text, needle, nth)));
+        let t = hover_text(&h);
+        assert!(t.contains(want), "{needle}: {t}");
+        hovers.push_str(&format!("--- `{needle}`\n{t}\n"));
+    }
+    insta::assert_snapshot!("lsp_hover_newer_syntax", hovers);
+    // Definitions through the new places.
+    let def = |c: &mut Client, needle: &str, nth: usize| -> Value {
+        let d = c.request("textDocument/definition", doc(pos(text, needle, nth)));
+        if d.is_array() { d[0].clone() } else { d }
+    };
+    assert_eq!(
+        def(&mut c, "E;", 0)["range"]["start"],
+        pos(text, "E = 0.2", 0)
+    );
+    assert_eq!(
+        def(&mut c, "E * 2", 0)["range"]["start"],
+        pos(text, "E = 0.2", 0)
+    );
+    assert_eq!(
+        def(&mut c, "V;", 0)["range"]["start"],
+        pos(text, "V = 1", 0)
+    );
+    assert_eq!(
+        def(&mut c, "Apex;", 0)["range"]["start"],
+        pos(text, "Apex(len", 0)
+    );
+    // `A` in `consider` is a letter: it goes to the rule that rewrites it.
+    assert_eq!(
+        def(&mut c, "A Apex;", 0)["range"]["start"],
+        pos(text, "A(x) ->", 0)
+    );
+    // The words are not names: nothing to go to, nothing to rename.
+    for w in ["tropism(E", "continue", "middle", "aim"] {
+        assert!(def(&mut c, w, 0).is_null(), "{w}");
+        let r = c.request_raw("textDocument/prepareRename", doc(pos(text, w, 0)));
+        assert!(r.get("error").is_some(), "{w}: {r}");
+    }
+    // A constant used in `tropism` and in `take` renames everywhere.
+    let edit = c.request(
+        "textDocument/rename",
+        json!({"textDocument": {"uri": uri}, "position": pos(text, "E = 0.2", 0), "newName": "elasticity"}),
+    );
+    let renamed = apply(text, &edit["changes"][uri]);
+    assert_eq!(renamed.matches("elasticity").count(), 3, "{renamed}");
+    let edit = c.request(
+        "textDocument/rename",
+        json!({"textDocument": {"uri": uri}, "position": pos(text, "V;", 0), "newName": "leader"}),
+    );
+    assert!(apply(text, &edit["changes"][uri]).contains("take leader;"));
+    // Completion in a link offers its words.
+    let at = text.find("take V").expect("take");
+    let items = c.request("textDocument/completion", doc(position_of(text, at)));
+    let labels: Vec<&str> = items
+        .as_array()
+        .expect("items")
+        .iter()
+        .filter_map(|i| i["label"].as_str())
+        .collect();
+    for w in ["aim", "take", "continue", "middle", "tokens"] {
+        assert!(labels.contains(&w), "{w}: {labels:?}");
+    }
+}
+
+/// Semantic tokens decoded back to text: `line:col text type [modifiers]`.
+fn show_tokens(text: &str, legend: &Value, data: &Value) -> String {
+    let types = legend["tokenTypes"].as_array().expect("types");
+    let mods = legend["tokenModifiers"].as_array().expect("modifiers");
+    let lines: Vec<&str> = text.split('\n').collect();
+    let d: Vec<u64> = data
+        .as_array()
+        .expect("data")
+        .iter()
+        .map(|v| v.as_u64().expect("u32"))
+        .collect();
+    assert_eq!(d.len() % 5, 0);
+    let (mut line, mut col) = (0u64, 0u64);
+    let mut out = String::new();
+    for t in d.chunks(5) {
+        if t[0] > 0 {
+            line += t[0];
+            col = t[1];
+        } else {
+            col += t[1];
+        }
+        let l: Vec<u16> = lines[line as usize].encode_utf16().collect();
+        let word = String::from_utf16_lossy(&l[col as usize..(col + t[2]) as usize]);
+        let m: Vec<&str> = (0..mods.len())
+            .filter(|i| t[4] & (1 << i) != 0)
+            .map(|i| mods[i].as_str().expect("name"))
+            .collect();
+        out.push_str(&format!(
+            "{}:{} {word} {} {}\n",
+            line + 1,
+            col + 1,
+            types[t[3] as usize].as_str().expect("type"),
+            m.join(",")
+        ));
+    }
+    out
+}
+
+#[test]
+fn semantic_tokens_signatures_and_range_formatting() {
+    let text = NEWER;
+    let uri = "file:///newer.lsy";
+    let mut c = Client::start();
+    let init = c.initialize();
+    let legend = init["capabilities"]["semanticTokensProvider"]["legend"].clone();
+    c.open(uri, text);
+    let toks = c.request(
+        "textDocument/semanticTokens/full",
+        json!({"textDocument": {"uri": uri}}),
+    );
+    let shown = show_tokens(text, &legend, &toks["data"]);
+    for want in [
+        "2:7 E variable declaration,readonly",
+        "4:8 Apex type declaration",
+        "6:5 tropism keyword",
+        "6:24 E variable readonly",
+        "9:7 x parameter declaration",
+        "9:13 F type defaultLibrary",
+        "9:19 + operator defaultLibrary",
+        "9:25 tropism keyword",
+        "10:5 decompose keyword",
+        "22:53 continue keyword",
+        "22:67 middle keyword",
+        "22:80 V variable readonly",
+    ] {
+        assert!(shown.contains(want), "{want}:\n{shown}");
+    }
+    insta::assert_snapshot!("lsp_semantic_tokens_newer", shown);
+
+    // Signature help inside a module's parentheses, the active one marked.
+    let doc = |p: Value| json!({"textDocument": {"uri": uri}, "position": p});
+    let after = |needle: &str| {
+        let at = text.find(needle).expect("needle") + needle.len();
+        doc(position_of(text, at))
+    };
+    let mut sigs = String::new();
+    for needle in [
+        "Apex(1, ",
+        "Apex(1",
+        "A(x * 0.",
+        "tropism(E",
+        "+(3",
+        "F(l",
+        "Apex(l, d - ",
+    ] {
+        let h = c.request("textDocument/signatureHelp", after(needle));
+        let s = &h["signatures"][0];
+        let active = h["activeParameter"].as_u64().expect("active") as usize;
+        let param = s["parameters"][active]["label"].as_str().unwrap_or("?");
+        sigs.push_str(&format!(
+            "{needle:<12} {}  [{param}]\n",
+            s["label"].as_str().expect("label")
+        ));
+    }
+    assert!(
+        sigs.contains("Apex(1,      Apex(len, depth)  [depth]"),
+        "{sigs}"
+    );
+    assert!(
+        sigs.contains("Apex(1       Apex(len, depth)  [len]"),
+        "{sigs}"
+    );
+    assert!(sigs.contains("A(x * 0.     A(x)  [x]"), "{sigs}");
+    assert!(sigs.contains("tropism(E    tropism(e)  [e]"), "{sigs}");
+    // Outside parentheses there is none.
+    let none = c.request("textDocument/signatureHelp", doc(pos(text, "consider", 0)));
+    assert!(none.is_null(), "{none}");
+    // A query module in a predecessor shows its outputs first.
+    let palm = gallery("palm.lsy");
+    c.open("file:///palm.lsy", &palm);
+    let at = palm.find("?D_L(found, d, beta, _, D, w)").expect("?D_L") + "?D_L(found, ".len();
+    let h = c.request(
+        "textDocument/signatureHelp",
+        json!({"textDocument": {"uri": "file:///palm.lsy"}, "position": position_of(&palm, at)}),
+    );
+    sigs.push_str(&format!(
+        "?D_L(found,  {}  [{}]\n",
+        h["signatures"][0]["label"], h["activeParameter"]
+    ));
+    assert_eq!(h["activeParameter"], 1, "{h}");
+    insta::assert_snapshot!("lsp_signature_help", sigs);
+
+    // Range formatting: the items the range touches come out as `lsyc fmt`
+    // prints them; the others stay as written.
+    let messy = text
+        .replace("    ", "  ")
+        .replace("F(x) [+(30)", "F(x)   [ +(30)");
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 2}, "contentChanges": [{"text": messy}]}),
+    );
+    c.notification("textDocument/publishDiagnostics");
+    let canonical = lsyc::fmt::format_file(&lsyc::parser::parse(&messy).file);
+    let range_format = |c: &mut Client, from: &str, to: &str| -> String {
+        let edits = c.request(
+            "textDocument/rangeFormatting",
+            json!({"textDocument": {"uri": uri}, "options": {"tabSize": 4, "insertSpaces": true},
+                   "range": {"start": pos(&messy, from, 0), "end": pos(&messy, to, 0)}}),
+        );
+        apply(&messy, &edits)
+    };
+    let whole = range_format(&mut c, "// Newer", "take V");
+    assert_eq!(whole, canonical);
+    // Only the lsystem (the range is inside its `A` rule).
+    let part = range_format(&mut c, "A(x) ->", "A(x * 0.5)");
+    let lsystem =
+        |s: &str| s[s.find("lsystem").expect("ls")..s.find("scene").expect("scene")].to_string();
+    let scene = |s: &str| s[s.find("scene").expect("scene")..].to_string();
+    assert_eq!(lsystem(&part).trim_end(), lsystem(&canonical).trim_end());
+    assert_eq!(scene(&part), scene(&messy), "the scene is left as written");
+    assert!(part.starts_with(&messy[..messy.find("lsystem").expect("ls")]));
+    // Already canonical: no edits.
+    c.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri, "version": 3}, "contentChanges": [{"text": canonical}]}),
+    );
+    c.notification("textDocument/publishDiagnostics");
+    let edits = c.request(
+        "textDocument/rangeFormatting",
+        json!({"textDocument": {"uri": uri}, "options": {"tabSize": 4, "insertSpaces": true},
+               "range": {"start": {"line": 0, "character": 0}, "end": {"line": 40, "character": 0}}}),
+    );
+    assert_eq!(edits, json!([]));
 }
