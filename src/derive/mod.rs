@@ -972,6 +972,7 @@ fn first_error(view: &View, step: u32, seed: u64) -> DeriveError {
     let unlimited = Limits {
         max_modules: usize::MAX,
         max_bytes: usize::MAX,
+        cancel: None,
     };
     let produced = AtomicUsize::new(0);
     for (ci, chunk) in view.s.syms.chunks(CHUNK).enumerate() {
