@@ -1231,6 +1231,7 @@ mod tests {
         let unlimited = Limits {
             max_modules: usize::MAX,
             max_bytes: usize::MAX,
+            cancel: None,
         };
         let out = rewrite_chunk(
             &view,
