@@ -11,6 +11,20 @@ use tiny_skia::{
 
 /// Segments batched into one path before it is stroked.
 const BATCH: usize = 4096;
+/// Stroke widths (in pixels) batched at once for one colour.
+const WIDTHS: usize = 16;
+
+/// The segments of one colour and one stroke width not yet stroked: opaque
+/// strokes of one colour may be painted in any order, so segments of that
+/// colour are grouped by width and each group is stroked as one path (a tree
+/// whose widths change at every branch would otherwise set up one stroke per
+/// segment).
+struct Batch {
+    width: f32,
+    path: PathBuilder,
+    len: usize,
+    last: Option<(f32, f32)>,
+}
 
 /// An element ready to paint: its outline, fill, and optional stroke colour
 /// with the stroke's width in pixels (the element's `width`, as SVG draws it).
@@ -25,10 +39,9 @@ pub struct PngWriter {
     k: f64,
     off: DVec2,
     elements: Vec<Option<Painted>>,
-    batch: PathBuilder,
-    batch_len: usize,
-    style: (f64, u32),
-    last: Option<DVec2>,
+    /// Open batches, all of colour `color`.
+    batches: Vec<Batch>,
+    color: u32,
 }
 
 /// A colour name or `#rrggbb`.
@@ -115,10 +128,8 @@ impl PngWriter {
             k,
             off,
             elements,
-            batch: PathBuilder::new(),
-            batch_len: 0,
-            style: (0.0, 0),
-            last: None,
+            batches: Vec::new(),
+            color: 0,
         })
     }
 
@@ -130,25 +141,33 @@ impl PngWriter {
         )
     }
 
+    /// The stroke width in pixels of a segment `width` wide (hairlines 1.2).
+    fn stroke_px(&self, width: f64) -> f32 {
+        if width > 0.0 {
+            (width * self.k).max(0.6) as f32
+        } else {
+            1.2
+        }
+    }
+
+    /// Strokes every open batch.
     fn flush(&mut self) {
-        if self.batch_len == 0 {
+        for b in std::mem::take(&mut self.batches) {
+            self.stroke_batch(b);
+        }
+    }
+
+    fn stroke_batch(&mut self, b: Batch) {
+        if b.len == 0 {
             return;
         }
-        let pb = std::mem::replace(&mut self.batch, PathBuilder::new());
-        self.batch_len = 0;
-        self.last = None;
-        let Some(path) = pb.finish() else { return };
-        let (width, color) = self.style;
-        let rgb = palette_rgb(color);
+        let Some(path) = b.path.finish() else { return };
+        let rgb = palette_rgb(self.color);
         let mut paint = Paint::default();
         paint.set_color_rgba8(rgb[0], rgb[1], rgb[2], 255);
         paint.anti_alias = true;
         let stroke = Stroke {
-            width: if width > 0.0 {
-                (width * self.k).max(0.6) as f32
-            } else {
-                1.2
-            },
+            width: b.width,
             line_cap: LineCap::Round,
             line_join: LineJoin::Round,
             ..Stroke::default()
@@ -174,19 +193,48 @@ impl PngWriter {
 
 impl Sink for PngWriter {
     fn segment(&mut self, a: DVec3, b: DVec3, width: f64, color: u32) {
-        if self.style != (width, color) || self.batch_len >= BATCH {
+        if self.color != color {
             self.flush();
-            self.style = (width, color);
+            self.color = color;
         }
-        let (ax, ay) = self.px(a);
-        let (bx, by) = self.px(b);
-        let start = DVec2::new(ax as f64, ay as f64);
-        if self.last != Some(start) {
-            self.batch.move_to(ax, ay);
+        let px = self.stroke_px(width);
+        let i = match self.batches.iter().position(|b| b.width == px) {
+            Some(i) => i,
+            None => {
+                if self.batches.len() >= WIDTHS {
+                    let b = self.batches.remove(0);
+                    self.stroke_batch(b);
+                }
+                self.batches.push(Batch {
+                    width: px,
+                    path: PathBuilder::new(),
+                    len: 0,
+                    last: None,
+                });
+                self.batches.len() - 1
+            }
+        };
+        if self.batches[i].len >= BATCH {
+            let full = std::mem::replace(
+                &mut self.batches[i],
+                Batch {
+                    width: px,
+                    path: PathBuilder::new(),
+                    len: 0,
+                    last: None,
+                },
+            );
+            self.stroke_batch(full);
         }
-        self.batch.line_to(bx, by);
-        self.last = Some(DVec2::new(bx as f64, by as f64));
-        self.batch_len += 1;
+        let start = self.px(a);
+        let end = self.px(b);
+        let batch = &mut self.batches[i];
+        if batch.last != Some(start) {
+            batch.path.move_to(start.0, start.1);
+        }
+        batch.path.line_to(end.0, end.1);
+        batch.last = Some(end);
+        batch.len += 1;
     }
 
     fn polygon(&mut self, points: &[DVec3], color: u32) {
