@@ -110,6 +110,9 @@ codes! {
     TooMuchDrawing = "E0908", "interpretation that would draw more than the module limit";
     DrawingTooLarge = "E0909", "a drawing with coordinates too large to write";
     DecomposeTooDeep = "E0910", "decomposition rules that expand into each other too deeply";
+    MeshFile = "E0911", "a `mesh` file that cannot be read as OBJ";
+    TwoShapes = "E0705", "an element with more than one shape";
+    BadOrgan = "E0706", "organ or contour data that makes no shape";
     Unused = "W0101", "a declaration that nothing uses";
     UnusedParameter = "W0102", "a rule parameter that nothing uses";
     NeverProduced = "W0201", "a rule whose predecessor never appears";

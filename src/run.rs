@@ -24,6 +24,9 @@ pub struct Options {
     pub limits: Limits,
     /// The lsystem to run; the first one when `None`.
     pub system: Option<String>,
+    /// The program's directory, where `mesh` files are found (the current
+    /// directory when `None`).
+    pub base_dir: Option<std::path::PathBuf>,
 }
 
 /// A derived program.
@@ -60,6 +63,8 @@ pub fn derive(
 ) -> Result<Derived, Diagnostic> {
     let prog =
         compile::compile(file, checked, opts.system.as_deref()).map_err(|e| e.diagnostic())?;
+    let mut prog = prog;
+    load_meshes(&mut prog, opts.base_dir.as_deref())?;
     let steps = opts.steps.unwrap_or(prog.derive);
     let start = Instant::now();
     let args = vec![0.0; prog.params.len()];
@@ -73,6 +78,32 @@ pub fn derive(
         derive_ms: start.elapsed().as_secs_f64() * 1000.0,
         limits: opts.limits,
     })
+}
+
+/// Reads the OBJ file of every `mesh` element the program uses; an error
+/// points at the file's name in the source.
+pub fn load_meshes(prog: &mut Program, base: Option<&std::path::Path>) -> Result<(), Diagnostic> {
+    for e in &mut prog.elements {
+        let Some((file, span)) = e.mesh.clone() else {
+            continue;
+        };
+        let path = base.map_or_else(|| std::path::PathBuf::from(&file), |b| b.join(&file));
+        let fail = |what: String| {
+            Diagnostic::error(Code::MeshFile, format!("the mesh `{file}` {what}"))
+                .primary(span, "this mesh file")
+                .note("a mesh is Wavefront OBJ text (`v`, `vn` and `f` lines), found relative to the program's directory")
+        };
+        let text = std::fs::read(&path)
+            .map_err(|err| fail(format!("cannot be read: {err}")))?;
+        if text.len() > 64 << 20 {
+            return Err(fail("is larger than 64 MiB".to_string()));
+        }
+        let text = String::from_utf8(text).map_err(|_| fail("is not UTF-8 text".to_string()))?;
+        let solid = compile::organ::parse_obj(&text)
+            .map_err(|m| fail(format!("does not read, line {}: {}", m.line, m.message)))?;
+        e.solid = Some(std::sync::Arc::new(solid));
+    }
+    Ok(())
 }
 
 /// The output formats, by file extension.
@@ -154,11 +185,8 @@ pub struct Written {
 }
 
 /// Local bounding boxes of the program's elements (for fitting the view).
-fn element_boxes(prog: &Program) -> Vec<[f64; 4]> {
-    prog.elements
-        .iter()
-        .map(|e| render::path_bounds(&e.path).unwrap_or([0.0, 0.0, 0.0, 0.0]))
-        .collect()
+fn element_boxes(prog: &Program) -> Vec<Option<(glam::DVec3, glam::DVec3)>> {
+    prog.elements.iter().map(turtle::element_box).collect()
 }
 
 /// Draws without output: the counts and bounding box (in the default view).
@@ -618,7 +646,7 @@ pub fn write_scene(
     // Elements are items of the file, the same for every system of the scene.
     let elements: &[crate::compile::ElementDef] =
         r.scene.programs.first().map_or(&[], |p| &p.elements);
-    let boxes: Vec<[f64; 4]> = r.scene.programs.first().map_or(Vec::new(), element_boxes);
+    let boxes: Vec<_> = r.scene.programs.first().map_or(Vec::new(), element_boxes);
     let mut bounds_sink = BoundsSink {
         view,
         bounds: Bounds::default(),

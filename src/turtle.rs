@@ -30,6 +30,9 @@ pub trait Sink {
     /// Element `index` printed at `at`, its local +y along `h`, its local −x along
     /// `l` (so local +x is −l), scaled by `scale`.
     fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32);
+    /// The branch contour of the segments that follow: the element `Some(i)`
+    /// (declared with `contour`) or `None` for the circle. Only meshes listen.
+    fn contour(&mut self, _element: Option<u16>) {}
     /// Query module number `module` of the string (kind: index into
     /// `query::QUERIES`) met with the turtle in `state`. Only the environment
     /// of a scene listens.
@@ -49,6 +52,8 @@ pub struct State {
     /// The elasticity e of tropism: after each `F` the heading turns toward
     /// the lsystem's tropism vector T by e·|H × T| radians.
     pub elasticity: f64,
+    /// The branch contour: 0 for the circle, element index + 1 otherwise.
+    pub contour: u16,
 }
 
 impl Default for State {
@@ -62,6 +67,7 @@ impl Default for State {
             width: 0.0,
             color: 0,
             elasticity: 0.0,
+            contour: 0,
         }
     }
 }
@@ -245,15 +251,7 @@ pub fn interpret_limited(
             cos: 1.0,
         },
         cands: Vec::new(),
-        element_boxes: prog
-            .elements
-            .iter()
-            .map(|e| {
-                crate::path::parse(&e.path)
-                    .ok()
-                    .and_then(|p| crate::path::control_bounds(&p))
-            })
-            .collect(),
+        element_boxes: prog.elements.iter().map(element_box).collect(),
     };
     let has_interp = prog.interpret.iter().any(|r| !r.is_empty());
     let mut p = 0usize;
@@ -298,8 +296,29 @@ struct Turtle<'a> {
     max_modules: usize,
     /// Modules the current module of the string has expanded into.
     expanded_here: usize,
-    /// Each element's outline box in its own frame, for `Drawn::bbox`.
-    element_boxes: Vec<Option<[f64; 4]>>,
+    /// Each element's box in its own frame, for `Drawn::bbox`.
+    element_boxes: Vec<Option<(DVec3, DVec3)>>,
+}
+
+/// An element's box in its own frame (x along −L, y along H, z along U): its
+/// outline's control points, or its organ's mesh.
+pub fn element_box(e: &crate::compile::ElementDef) -> Option<(DVec3, DVec3)> {
+    if let Some(solid) = &e.solid {
+        return solid.bounds();
+    }
+    let b = crate::path::control_bounds(&crate::path::parse(&e.path).ok()?)?;
+    Some((DVec3::new(b[0], b[1], 0.0), DVec3::new(b[2], b[3], 0.0)))
+}
+
+/// The eight corners of a box.
+pub fn corners((lo, hi): (DVec3, DVec3)) -> [DVec3; 8] {
+    std::array::from_fn(|k| {
+        DVec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
 }
 
 impl Turtle<'_> {
@@ -442,7 +461,11 @@ impl Turtle<'_> {
             Action::Push => self.stack.push(self.state),
             Action::Pop => {
                 if let Some(s) = self.stack.pop() {
+                    let contour = self.state.contour;
                     self.state = s;
+                    if s.contour != contour {
+                        self.sink.contour(s.contour.checked_sub(1));
+                    }
                 }
             }
             Action::PolygonStart => self.polygons.push(Vec::new()),
@@ -468,14 +491,23 @@ impl Turtle<'_> {
                     }
                 }
             }
+            Action::Element(i) if prog.elements.get(i as usize).is_some_and(|e| e.is_contour()) => {
+                // Selects the contour of the branches that follow (until `]`).
+                if self.state.contour != i + 1 {
+                    self.state.contour = i + 1;
+                    self.sink.contour(Some(i));
+                }
+            }
             Action::Element(i) => {
                 self.drawn.elements += 1;
                 let st = self.state;
                 self.drawn.grow(st.pos);
                 if let Some(&Some(b)) = self.element_boxes.get(i as usize) {
-                    // The outline's box, placed as the sinks place the element.
-                    for (x, y) in [(b[0], b[1]), (b[2], b[1]), (b[0], b[3]), (b[2], b[3])] {
-                        self.drawn.grow(st.pos + (-st.l * x + st.h * y) * st.scale);
+                    // The element's box, placed as the sinks place the element.
+                    let u = st.h.cross(st.l);
+                    for c in corners(b) {
+                        self.drawn
+                            .grow(st.pos + (-st.l * c.x + st.h * c.y + u * c.z) * st.scale);
                     }
                 }
                 self.sink.element(i, st.pos, st.h, st.l, st.scale, st.color);

@@ -13,7 +13,15 @@ const PROPS: &[(&str, bool)] = &[
     ("fill", true),
     ("stroke", true),
     ("width", false),
+    ("sphere", false),
+    ("disk", false),
+    ("mesh", true),
+    ("patch", true),
+    ("contour", true),
 ];
+
+/// The properties that give an element its shape: exactly one of them.
+const SHAPES: &[&str] = &["path", "sphere", "disk", "mesh", "patch", "contour"];
 
 /// A guide's `system`: where it is named, and its lsystem's parameter count
 /// when that lsystem exists.
@@ -42,7 +50,7 @@ impl<'a> Checker<'a> {
                 if let Some(s) = synonym.or_else(|| suggest(key, PROPS.iter().map(|(k, _)| *k))) {
                     d = d.help(format!("did you mean `{s}`?"));
                 } else {
-                    d = d.note("the properties are path, fill, stroke and width");
+                    d = d.note("the properties are path, sphere, disk, mesh, patch, contour, fill, stroke and width");
                 }
                 self.diags.push(d);
                 continue;
@@ -56,10 +64,63 @@ impl<'a> Checker<'a> {
                 );
                 continue;
             }
+            if SHAPES.contains(&key)
+                && let Some((other, span)) = seen
+                    .iter()
+                    .find(|(k, _)| SHAPES.contains(k))
+                    .map(|(k, s)| (*k, *s))
+            {
+                self.diags.push(
+                    Diagnostic::error(
+                        Code::TwoShapes,
+                        format!("element `{}` has both `{other}` and `{key}`", e.name.name),
+                    )
+                    .primary(p.node.key.span, "a second shape")
+                    .secondary(span, "the first shape")
+                    .help("declare one element per shape, and print them one after the other"),
+                );
+            }
             seen.insert(key, p.node.key.span);
             match (&p.node.value, wants_string) {
                 (PropValue::Str(s, span), true) => match key {
                     "path" => self.path_data(s, *span),
+                    "contour" => {
+                        self.path_data(s, *span);
+                        if crate::path::parse(s).is_ok()
+                            && let Err(why) = crate::compile::organ::contour_from_path(s)
+                        {
+                            self.diags.push(
+                                Diagnostic::error(Code::BadOrgan, "this path is not a contour")
+                                    .primary(*span, why)
+                                    .help("a contour is one closed outline around the branch's axis, e.g. \"M1 0 L0 1 L-1 0 L0 -1 Z\""),
+                            );
+                        }
+                    }
+                    "patch" => match crate::compile::organ::patch_numbers(s) {
+                        Err(why) => self.diags.push(
+                            Diagnostic::error(Code::BadOrgan, "patch data that is not numbers")
+                                .primary(*span, why)
+                                .help("write the 16 control points of each patch as x y z numbers"),
+                        ),
+                        Ok(n) if n.is_empty() || n.len() % 48 != 0 => self.diags.push(
+                            Diagnostic::error(
+                                Code::BadOrgan,
+                                format!("a patch needs 48 numbers (16 points x y z); this has {}", n.len()),
+                            )
+                            .primary(*span, "not a whole number of patches")
+                            .help("each bicubic patch is 4 rows of 4 control points, 48 numbers"),
+                        ),
+                        Ok(_) => {}
+                    },
+                    "mesh" => {
+                        if s.trim().is_empty() {
+                            self.diags.push(
+                                Diagnostic::error(Code::BadOrgan, "the mesh file is not named")
+                                    .primary(*span, "an empty file name")
+                                    .help("name an OBJ file beside the program: mesh \"leaf.obj\";"),
+                            );
+                        }
+                    }
                     _ => {
                         if s.parse::<svgtypes::Color>().is_err() && s != "none" {
                             self.diags.push(
@@ -70,6 +131,16 @@ impl<'a> Checker<'a> {
                         }
                     }
                 },
+                (PropValue::Expr(x), false) if key != "width" => {
+                    if let Some(v) = self.const_num(x, "a radius")
+                        && !(v > 0.0)
+                    {
+                        self.diags.push(
+                            Diagnostic::error(Code::BadOrgan, format!("a {key}'s radius must be positive"))
+                                .primary(x.span, format!("this is {v}")),
+                        );
+                    }
+                }
                 (PropValue::Expr(x), false) => {
                     if let Some(v) = self.const_num(x, "the width")
                         && v < 0.0
@@ -92,7 +163,7 @@ impl<'a> Checker<'a> {
                 ),
             }
         }
-        if !seen.contains_key("path") {
+        if !SHAPES.iter().any(|k| seen.contains_key(k)) {
             self.diags.push(
                 Diagnostic::error(
                     Code::MissingPath,

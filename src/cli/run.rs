@@ -150,6 +150,11 @@ fn run_inner(args: &Args, reporter: &Reporter) -> Result<(), u8> {
             max_bytes: args.max_memory.saturating_mul(1 << 20),
         },
         system: args.system.clone(),
+        base_dir: args
+            .file
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .map(std::path::Path::to_path_buf),
     };
     if has_scene && args.system.is_none() && !args.disasm {
         return match run_scene(

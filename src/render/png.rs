@@ -11,6 +11,8 @@ use tiny_skia::{
 
 /// Segments batched into one path before it is stroked.
 const BATCH: usize = 4096;
+/// The outline of an organ's facet, in pixels (SVG: the same, non-scaling).
+pub const FACET_SEAM: f32 = 0.6;
 /// Stroke widths (in pixels) batched at once for one colour.
 const WIDTHS: usize = 16;
 
@@ -42,6 +44,8 @@ pub struct PngWriter {
     /// Open batches, all of colour `color`.
     batches: Vec<Batch>,
     color: u32,
+    /// Each element's 3D organ and `fill`, if it is one.
+    organs: Vec<Option<(std::sync::Arc<crate::compile::organ::Solid>, Option<String>)>>,
 }
 
 /// A colour name or `#rrggbb`.
@@ -102,6 +106,10 @@ impl PngWriter {
         ));
         let k = (w as f64 / ext.x).min(h as f64 / ext.y);
         let off = DVec2::new((w as f64 - ext.x * k) / 2.0, (h as f64 - ext.y * k) / 2.0);
+        let organs = elements
+            .iter()
+            .map(|e| e.solid.clone().map(|s| (s, e.fill.clone())))
+            .collect();
         let elements = elements
             .iter()
             .map(|e| {
@@ -130,6 +138,7 @@ impl PngWriter {
             elements,
             batches: Vec::new(),
             color: 0,
+            organs,
         })
     }
 
@@ -174,6 +183,39 @@ impl PngWriter {
         };
         self.pixmap
             .stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+    }
+
+    /// Paints an organ's facets: each filled, and outlined in its own colour
+    /// by a thin line so that neighbouring triangles leave no seam.
+    fn paint_facets(&mut self, facets: &[super::Facet]) {
+        let stroke = Stroke {
+            width: FACET_SEAM,
+            line_join: LineJoin::Round,
+            ..Stroke::default()
+        };
+        for f in facets {
+            let mut pb = PathBuilder::new();
+            for (i, &q) in f.points.iter().enumerate() {
+                let x = ((q.x - self.min.x) * self.k + self.off.x) as f32;
+                let y = ((self.max.y - q.y) * self.k + self.off.y) as f32;
+                if i == 0 {
+                    pb.move_to(x, y);
+                } else {
+                    pb.line_to(x, y);
+                }
+            }
+            pb.close();
+            let Some(path) = pb.finish() else { continue };
+            let mut paint = Paint {
+                anti_alias: true,
+                ..Paint::default()
+            };
+            paint.set_color_rgba8(f.rgb[0], f.rgb[1], f.rgb[2], 255);
+            self.pixmap
+                .fill_path(&path, &paint, FillRule::Winding, Transform::identity(), None);
+            self.pixmap
+                .stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+        }
     }
 
     /// Finishes drawing and encodes the image.
@@ -264,8 +306,14 @@ impl Sink for PngWriter {
         }
     }
 
-    fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, _: u32) {
+    fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32) {
         self.flush();
+        if let Some(Some((solid, fill))) = self.organs.get(index as usize) {
+            let base = super::organ_color(fill.as_deref(), color);
+            let facets = super::organ_facets(solid, (at, h, l, scale), &self.view, base);
+            self.paint_facets(&facets);
+            return;
+        }
         let Some(Some((path, fill, stroke))) = self.elements.get(index as usize) else {
             return;
         };
