@@ -25,6 +25,8 @@ const CLI_ONLY: &[Code] = &[
     Code::DrawingTooLarge,
     // Runaway decomposition: tests/it/plants.rs.
     Code::DecomposeTooDeep,
+    // Mesh files are read by `lsyc run`: tests/it/plants.rs.
+    Code::MeshFile,
     // Only `lsyc run` needs an lsystem: tests/it/hostile.rs.
     Code::NoLsystem,
     // Warnings of a scene's run: tests/it/guided.rs.
