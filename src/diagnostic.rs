@@ -92,7 +92,7 @@ codes! {
     IgnoreAndConsider = "E0606", "`ignore` and `consider` in one lsystem";
     ContextNotAllowed = "E0607", "context on an `interpret` or `decompose` rule";
     InvalidPath = "E0701", "element path data that is not valid SVG";
-    MissingPath = "E0702", "an element without a `path`";
+    MissingPath = "E0702", "an element without a shape (`path`, `sphere`, `disk`, `patch`, `mesh` or `contour`)";
     UnknownProperty = "E0703", "an element property lsyc does not know";
     PropertyKind = "E0704", "an element property with the wrong kind of value";
     PolygonTooSmall = "E0801", "a guide polygon with fewer than three vertices";

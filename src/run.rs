@@ -93,8 +93,7 @@ pub fn load_meshes(prog: &mut Program, base: Option<&std::path::Path>) -> Result
                 .primary(span, "this mesh file")
                 .note("a mesh is Wavefront OBJ text (`v`, `vn` and `f` lines), found relative to the program's directory")
         };
-        let text = std::fs::read(&path)
-            .map_err(|err| fail(format!("cannot be read: {err}")))?;
+        let text = std::fs::read(&path).map_err(|err| fail(format!("cannot be read: {err}")))?;
         if text.len() > 64 << 20 {
             return Err(fail("is larger than 64 MiB".to_string()));
         }

@@ -491,7 +491,12 @@ impl Turtle<'_> {
                     }
                 }
             }
-            Action::Element(i) if prog.elements.get(i as usize).is_some_and(|e| e.is_contour()) => {
+            Action::Element(i)
+                if prog
+                    .elements
+                    .get(i as usize)
+                    .is_some_and(|e| e.is_contour()) =>
+            {
                 // Selects the contour of the branches that follow (until `]`).
                 if self.state.contour != i + 1 {
                     self.state.contour = i + 1;

@@ -105,7 +105,10 @@ impl<'a> Checker<'a> {
                         Ok(n) if n.is_empty() || n.len() % 48 != 0 => self.diags.push(
                             Diagnostic::error(
                                 Code::BadOrgan,
-                                format!("a patch needs 48 numbers (16 points x y z); this has {}", n.len()),
+                                format!(
+                                    "a patch needs 48 numbers (16 points x y z); this has {}",
+                                    n.len()
+                                ),
                             )
                             .primary(*span, "not a whole number of patches")
                             .help("each bicubic patch is 4 rows of 4 control points, 48 numbers"),
@@ -117,7 +120,9 @@ impl<'a> Checker<'a> {
                             self.diags.push(
                                 Diagnostic::error(Code::BadOrgan, "the mesh file is not named")
                                     .primary(*span, "an empty file name")
-                                    .help("name an OBJ file beside the program: mesh \"leaf.obj\";"),
+                                    .help(
+                                        "name an OBJ file beside the program: mesh \"leaf.obj\";",
+                                    ),
                             );
                         }
                     }
@@ -136,8 +141,11 @@ impl<'a> Checker<'a> {
                         && !(v > 0.0)
                     {
                         self.diags.push(
-                            Diagnostic::error(Code::BadOrgan, format!("a {key}'s radius must be positive"))
-                                .primary(x.span, format!("this is {v}")),
+                            Diagnostic::error(
+                                Code::BadOrgan,
+                                format!("a {key}'s radius must be positive"),
+                            )
+                            .primary(x.span, format!("this is {v}")),
                         );
                     }
                 }

@@ -602,9 +602,10 @@ impl<'a> Compiler<'a> {
         }) || tropism.is_some_and(|(t, _)| t[2] != 0.0)
             || self.symbols.info.iter().any(|i| match i.action {
                 // A 3D organ shows its depth only in the oblique view.
-                Action::Element(e) => self.elements.get(e as usize).is_some_and(|d| {
-                    d.solid.is_some() || d.mesh.is_some()
-                }),
+                Action::Element(e) => self
+                    .elements
+                    .get(e as usize)
+                    .is_some_and(|d| d.solid.is_some() || d.mesh.is_some()),
                 _ => false,
             });
         let d0l = d0l_table(&self.symbols, &by_sym, &self.chunk);

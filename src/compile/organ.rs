@@ -137,7 +137,8 @@ pub fn patches(numbers: &[f64]) -> Solid {
                     .try_normalize()
                     .or_else(|| {
                         // At a collapsed edge, step inside the patch.
-                        let (_, du, dv) = bezier_patch(&p, u.clamp(0.01, 0.99), v.clamp(0.01, 0.99));
+                        let (_, du, dv) =
+                            bezier_patch(&p, u.clamp(0.01, 0.99), v.clamp(0.01, 0.99));
                         du.cross(dv).try_normalize()
                     })
                     .unwrap_or(DVec3::Z);
@@ -213,7 +214,12 @@ pub fn parse_obj(text: &str) -> Result<Solid, MeshError> {
                 .take(3)
                 .map(|w| w.parse::<f64>().ok().filter(|v| v.is_finite()))
                 .collect::<Option<_>>()
-                .ok_or_else(|| err(format!("`{}` has a coordinate that is not a number", line.trim())))?;
+                .ok_or_else(|| {
+                    err(format!(
+                        "`{}` has a coordinate that is not a number",
+                        line.trim()
+                    ))
+                })?;
             if v.len() < 3 {
                 return Err(err(format!("`{}` needs three coordinates", line.trim())));
             }
@@ -226,7 +232,9 @@ pub fn parse_obj(text: &str) -> Result<Solid, MeshError> {
                 let mut corners = Vec::new();
                 for w in words {
                     let mut parts = w.split('/');
-                    let index = |part: Option<&str>, count: usize| -> Result<Option<u32>, MeshError> {
+                    let index = |part: Option<&str>,
+                                 count: usize|
+                     -> Result<Option<u32>, MeshError> {
                         let Some(t) = part.filter(|t| !t.is_empty()) else {
                             return Ok(None);
                         };
@@ -282,7 +290,8 @@ pub fn parse_obj(text: &str) -> Result<Solid, MeshError> {
             resolved.push((c.0, n));
         }
         for i in 1..resolved.len() - 1 {
-            s.triangles.push([resolved[0], resolved[i], resolved[i + 1]]);
+            s.triangles
+                .push([resolved[0], resolved[i], resolved[i + 1]]);
             if s.triangles.len() > MAX_MESH_TRIANGLES {
                 return Err(MeshError {
                     line,
@@ -370,7 +379,9 @@ mod tests {
         // A flat patch in the x–y plane faces +z.
         assert!(p.normals.iter().all(|n| (n.z - 1.0).abs() < 1e-9));
         let (lo, hi) = sphere(2.0).bounds().unwrap();
-        assert!((lo + DVec3::splat(2.0)).length() < 1e-9 && (hi - DVec3::splat(2.0)).length() < 1e-9);
+        assert!(
+            (lo + DVec3::splat(2.0)).length() < 1e-9 && (hi - DVec3::splat(2.0)).length() < 1e-9
+        );
     }
 
     #[test]

@@ -211,8 +211,13 @@ impl PngWriter {
                 ..Paint::default()
             };
             paint.set_color_rgba8(f.rgb[0], f.rgb[1], f.rgb[2], 255);
-            self.pixmap
-                .fill_path(&path, &paint, FillRule::Winding, Transform::identity(), None);
+            self.pixmap.fill_path(
+                &path,
+                &paint,
+                FillRule::Winding,
+                Transform::identity(),
+                None,
+            );
             self.pixmap
                 .stroke_path(&path, &paint, &stroke, Transform::identity(), None);
         }

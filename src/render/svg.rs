@@ -82,7 +82,11 @@ impl<W: Write> SvgWriter<W> {
             head.push_str("<defs>\n");
             for (i, e) in elements.iter().enumerate() {
                 // Organs are written in place; contours draw nothing.
-                if !used.get(i).copied().unwrap_or(false) || e.solid.is_some() || e.mesh.is_some() || e.is_contour() {
+                if !used.get(i).copied().unwrap_or(false)
+                    || e.solid.is_some()
+                    || e.mesh.is_some()
+                    || e.is_contour()
+                {
                     continue;
                 }
                 let fill = e.fill.as_deref().unwrap_or("#3f7f3a");
@@ -180,7 +184,12 @@ impl<W: Write> SvgWriter<W> {
         let mut buf = format!("<g class=\"organ\" data-element-index=\"{index}\" stroke-width=\"{}\" vector-effect=\"non-scaling-stroke\">\n", super::png::FACET_SEAM).into_bytes();
         for f in facets {
             let c = super::hex(f.rgb);
-            buf.extend_from_slice(format!("<path fill=\"{c}\" stroke=\"{c}\" vector-effect=\"non-scaling-stroke\" d=\"M").as_bytes());
+            buf.extend_from_slice(
+                format!(
+                    "<path fill=\"{c}\" stroke=\"{c}\" vector-effect=\"non-scaling-stroke\" d=\"M"
+                )
+                .as_bytes(),
+            );
             for (i, q) in f.points.iter().enumerate() {
                 if i > 0 {
                     buf.push(b'L');

@@ -353,8 +353,16 @@ fn assert_valid_mesh(m: &Mesh) {
     for f in &m.faces {
         assert!(f.len() >= 3);
         for &(v, n) in f {
-            assert!(v >= 1 && v as usize <= m.v.len(), "vertex {v} of {}", m.v.len());
-            assert!(n >= 1 && n as usize <= m.vn.len(), "normal {n} of {}", m.vn.len());
+            assert!(
+                v >= 1 && v as usize <= m.v.len(),
+                "vertex {v} of {}",
+                m.v.len()
+            );
+            assert!(
+                n >= 1 && n as usize <= m.vn.len(),
+                "normal {n} of {}",
+                m.vn.len()
+            );
         }
     }
     for n in &m.vn {
@@ -379,14 +387,16 @@ fn organs_are_placed_in_the_turtle_frame() {
     let centre = glam::DVec3::new(0.0, 2.0, 0.0);
     let has = |p: glam::DVec3| m.v.iter().any(|v| (*v - p).length() < 1e-9);
     assert!(has(glam::DVec3::new(-2.0, 2.0, 0.0)), "the sphere's pole");
-    assert!(has(glam::DVec3::new(2.0, 2.0, 0.0)), "the sphere's other pole");
+    assert!(
+        has(glam::DVec3::new(2.0, 2.0, 0.0)),
+        "the sphere's other pole"
+    );
     assert!(has(glam::DVec3::new(0.0, 4.0, 0.0)), "the disk's rim");
     // Sphere vertices are 2 from the centre and their normals point outward.
-    let on_sphere = m
-        .v
-        .iter()
-        .filter(|v| ((**v - centre).length() - 2.0).abs() < 1e-9)
-        .count();
+    let on_sphere =
+        m.v.iter()
+            .filter(|v| ((**v - centre).length() - 2.0).abs() < 1e-9)
+            .count();
     assert!(on_sphere >= 50, "{on_sphere} sphere vertices");
     for f in &m.faces {
         let p = m.v[f[0].0 as usize - 1];
@@ -396,11 +406,17 @@ fn organs_are_placed_in_the_turtle_frame() {
         }
     }
     // The disk faces along H (−x).
-    assert!(m.vn.iter().any(|n| (*n - glam::DVec3::NEG_X).length() < 1e-9));
+    assert!(
+        m.vn.iter()
+            .any(|n| (*n - glam::DVec3::NEG_X).length() < 1e-9)
+    );
     let (drawn, _) = run::measure(&d, 0).expect("measures");
     assert_eq!(drawn.elements, 2);
     let b = drawn.bbox.expect("a box");
-    assert!((b[0] + 2.0).abs() < 1e-9 && (b[3] - 4.0).abs() < 1e-9, "{b:?}");
+    assert!(
+        (b[0] + 2.0).abs() < 1e-9 && (b[3] - 4.0).abs() < 1e-9,
+        "{b:?}"
+    );
 }
 
 #[test]
@@ -412,18 +428,20 @@ fn contours_shape_the_tube_rings() {
     let d = derive(prog, None).expect("derives");
     let m = mesh_of(&d);
     assert_valid_mesh(&m);
-    let off_axis: Vec<f64> = m
-        .v
-        .iter()
-        .filter(|v| v.y.abs() < 1e-9)
-        .map(|v| (v.x * v.x + v.z * v.z).sqrt())
-        .filter(|r| *r > 1e-9)
-        .collect();
+    let off_axis: Vec<f64> =
+        m.v.iter()
+            .filter(|v| v.y.abs() < 1e-9)
+            .map(|v| (v.x * v.x + v.z * v.z).sqrt())
+            .filter(|r| *r > 1e-9)
+            .collect();
     assert_eq!(off_axis.len(), 4, "a square ring: {off_axis:?}");
     assert!(off_axis.iter().all(|r| (r - 2f64.sqrt()).abs() < 1e-9));
     let circle = derive("lsystem S { axiom !(2) F(3); }\n", None).expect("derives");
     let m = mesh_of(&circle);
-    let ring = m.v.iter().filter(|v| v.y.abs() < 1e-9 && v.length() > 1e-9).count();
+    let ring =
+        m.v.iter()
+            .filter(|v| v.y.abs() < 1e-9 && v.length() > 1e-9)
+            .count();
     assert_eq!(ring, 8);
 }
 
@@ -453,7 +471,12 @@ fn mesh_files_are_read_beside_the_program() {
     // Run from elsewhere: the mesh is found beside the program, not the cwd.
     let o = lsyc_in(
         out.path(),
-        &["run", data.join("mesh.lsy").to_str().expect("utf-8"), "-o", obj.to_str().expect("utf-8")],
+        &[
+            "run",
+            data.join("mesh.lsy").to_str().expect("utf-8"),
+            "-o",
+            obj.to_str().expect("utf-8"),
+        ],
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = std::fs::read_to_string(&obj).expect("obj");
@@ -466,7 +489,12 @@ fn mesh_files_are_read_beside_the_program() {
     ] {
         let o = lsyc_in(
             out.path(),
-            &["run", data.join(file).to_str().expect("utf-8"), "-o", obj.to_str().expect("utf-8")],
+            &[
+                "run",
+                data.join(file).to_str().expect("utf-8"),
+                "-o",
+                obj.to_str().expect("utf-8"),
+            ],
         );
         assert_eq!(o.status.code(), Some(1), "{file}");
         let err = String::from_utf8_lossy(&o.stderr);

@@ -36,11 +36,11 @@ pub use text::{MATERIAL_PREFIX, ObjText, material_name, write_mtl};
 
 use crate::compile::Program;
 use crate::compile::organ::Solid;
-use std::sync::Arc;
 use crate::turtle::Sink;
 use glam::DVec3;
 use std::collections::{BTreeSet, HashMap, VecDeque};
 use std::io::{self, Write};
+use std::sync::Arc;
 use tube::{Chain, Joint};
 
 /// Where the built mesh goes. Vertices and normals are numbered from 1, each
@@ -216,7 +216,10 @@ impl<T: MeshTarget> MeshBuilder<T> {
         let circle: Vec<[f64; 4]> = ring_angles.iter().map(|&(c, s)| [c, s, c, s]).collect();
         let mut profiles = vec![Arc::new(circle.clone())];
         for c in &options.contours {
-            profiles.push(Arc::new(c.as_deref().map_or_else(|| circle.clone(), |c| tube::profile(c))));
+            profiles.push(Arc::new(
+                c.as_deref()
+                    .map_or_else(|| circle.clone(), |c| tube::profile(c)),
+            ));
         }
         let mut w = MeshBuilder {
             out,

@@ -298,7 +298,9 @@ pub(super) fn profile(c: &[glam::DVec2]) -> Vec<[f64; 4]> {
                 glam::DVec2::new(e.y, -e.x).normalize_or_zero()
             };
             let n = outward(c[(i + k - 1) % k], c[i]) + outward(c[i], c[(i + 1) % k]);
-            let n = n.try_normalize().unwrap_or(c[i].normalize_or(glam::DVec2::X));
+            let n = n
+                .try_normalize()
+                .unwrap_or(c[i].normalize_or(glam::DVec2::X));
             [c[i].x, c[i].y, n.x, n.y]
         })
         .collect()
