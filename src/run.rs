@@ -181,6 +181,8 @@ pub struct Written {
     pub drawn: Drawn,
     /// The colours the mesh used (OBJ: the materials its `.mtl` must define).
     pub materials: Vec<u32>,
+    /// Their colours and material names.
+    pub palette: render::Palette,
 }
 
 /// Local bounding boxes of the program's elements (for fitting the view).
@@ -298,7 +300,8 @@ pub fn write_output_full(
                         .any(|s| s.action == Action::Element(i as u16))
                 })
                 .collect();
-            let mut w = render::svg::SvgWriter::new(out, view, &bounds, &d.prog.elements, &used)?;
+            let mut w = render::svg::SvgWriter::new(out, view, &bounds, &d.prog.elements, &used)?
+                .with_palette(render::Palette::of(&d.prog));
             let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
             w.finish()?;
             drawn
@@ -324,7 +327,11 @@ pub fn write_output_full(
             }
             let materials = w.colors();
             w.finish()?;
-            return Ok(Written { drawn, materials });
+            return Ok(Written {
+                drawn,
+                materials,
+                palette: render::Palette::of(&d.prog),
+            });
         }
         Format::Glb => {
             let options = render::obj::ObjOptions::for_program(&d.prog);
@@ -337,7 +344,11 @@ pub fn write_output_full(
             }
             let materials = w.colors();
             w.into_target().write(out)?;
-            return Ok(Written { drawn, materials });
+            return Ok(Written {
+                drawn,
+                materials,
+                palette: render::Palette::of(&d.prog),
+            });
         }
         Format::Apng => {
             return Err(OutputError::Io(std::io::Error::other(
@@ -348,6 +359,7 @@ pub fn write_output_full(
     Ok(Written {
         drawn,
         materials: Vec::new(),
+        palette: render::Palette::default(),
     })
 }
 
@@ -366,7 +378,8 @@ fn draw_png(
         &bounds,
         &d.prog.elements,
     )
-    .ok_or_else(|| std::io::Error::other("the image size is not possible"))?;
+    .ok_or_else(|| std::io::Error::other("the image size is not possible"))?
+    .with_palette(render::Palette::of(&d.prog));
     let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
     Ok((drawn, w))
 }
@@ -472,6 +485,7 @@ pub fn write_animation(
     Ok(Written {
         drawn,
         materials: Vec::new(),
+        palette: render::Palette::default(),
     })
 }
 

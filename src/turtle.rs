@@ -109,7 +109,13 @@ fn neg((s, c): (f64, f64)) -> (f64, f64) {
 }
 
 impl State {
-    fn apply(&mut self, action: Action, arg: Option<f64>, angle: f64, step: f64, trig: &mut Trig) {
+    fn apply(
+        &mut self,
+        action: Action,
+        arg: Option<f64>,
+        (angle, step, palette_last): (f64, f64, Option<u32>),
+        trig: &mut Trig,
+    ) {
         let a = arg.unwrap_or(angle);
         let mut sc = || trig.of(a);
         match action {
@@ -144,9 +150,13 @@ impl State {
             Action::Color => {
                 self.color = match arg {
                     Some(c) => c.max(0.0) as u32,
-                    // ABOP's bare `'` steps toward leaves: from ink or bark
-                    // straight to the first green (3), then along the greens to 7.
-                    None => (self.color + 1).clamp(3, 7),
+                    None => match palette_last {
+                        // With a palette: the next colour, up to its last index.
+                        Some(last) => (self.color + 1).min(last.max(self.color)),
+                        // ABOP's bare `'` steps toward leaves: from ink or bark
+                        // straight to the first green (3), then along the greens to 7.
+                        None => (self.color + 1).clamp(3, 7),
+                    },
                 }
             }
             Action::Draw | Action::Move => {
@@ -169,6 +179,12 @@ impl State {
         self.l = (q * self.l).normalize();
         self.u = self.h.cross(self.l);
     }
+}
+
+/// The settings the turtle's moves read: default angle and step, and the
+/// last index of the program's palette (bare `'` stops there).
+fn settings(prog: &Program) -> (f64, f64, Option<u32>) {
+    (prog.angle, prog.step, prog.palette.last().map(|c| c.index))
 }
 
 /// What was drawn.
@@ -440,7 +456,7 @@ impl Turtle<'_> {
             Action::Draw | Action::Move => {
                 let from = self.state.pos;
                 self.state
-                    .apply(action, arg, prog.angle, prog.step, &mut self.trig);
+                    .apply(action, arg, settings(prog), &mut self.trig);
                 let to = self.state.pos;
                 if action == Action::Draw {
                     self.state.bend(self.tropism);
@@ -527,7 +543,7 @@ impl Turtle<'_> {
             Action::None | Action::Cut => {}
             other => self
                 .state
-                .apply(other, arg, prog.angle, prog.step, &mut self.trig),
+                .apply(other, arg, settings(prog), &mut self.trig),
         }
     }
 }

@@ -3,7 +3,7 @@
 
 use super::expr::{Env, Ty, plural};
 use super::{Checker, duplicate, suggest};
-use crate::ast::{EdgeRef, Element, GuideStmt, LinkStmt, PropValue, Scene, SceneStmt};
+use crate::ast::{EdgeRef, Element, GuideStmt, LinkStmt, Palette, PropValue, Scene, SceneStmt};
 use crate::diagnostic::{Code, Diagnostic};
 use crate::span::Span;
 use std::collections::HashMap;
@@ -180,6 +180,46 @@ impl<'a> Checker<'a> {
                 .primary(e.name.span, "an element draws SVG path data")
                 .help("add `path \"M0 0 L0 10\";` (local frame: base at the origin, pointing +y)"),
             );
+        }
+    }
+
+    /// A palette's entries: whole indices 0–255, each once; SVG colours;
+    /// material names each once.
+    pub(super) fn palette(&mut self, p: &'a Palette) {
+        let mut indices: HashMap<i64, Span> = HashMap::new();
+        let mut names: HashMap<&str, Span> = HashMap::new();
+        for n in &p.body.stmts {
+            let e = &n.node;
+            if matches!(e.index.kind, crate::ast::ExprKind::Error) {
+                continue;
+            }
+            if let Some(v) = self.const_num(&e.index, "a colour index") {
+                if !(v.fract() == 0.0 && (0.0..=255.0).contains(&v)) {
+                    self.diags.push(
+                        Diagnostic::error(Code::OutOfRange, "a colour index is a whole number from 0 to 255")
+                            .primary(e.index.span, format!("this is {v}")),
+                    );
+                } else if let Some(first) = indices.insert(v as i64, e.index.span) {
+                    self.diags.push(
+                        Diagnostic::error(Code::DuplicateSetting, format!("colour {v} is given twice"))
+                            .primary(e.index.span, "given again here")
+                            .secondary(first, "first given here")
+                            .help("keep one of them"),
+                    );
+                }
+            }
+            if e.color.parse::<svgtypes::Color>().is_err() {
+                self.diags.push(
+                    Diagnostic::error(Code::PropertyKind, format!("`{}` is not a colour", e.color))
+                        .primary(e.color_span, "not an SVG colour")
+                        .help("use a name such as \"green\", \"#3a7\" or \"rgb(40, 120, 60)\""),
+                );
+            }
+            if let Some(name) = &e.name
+                && let Some(first) = names.insert(&name.name, name.span)
+            {
+                self.diags.push(duplicate("material", &name.name, name.span, first));
+            }
         }
     }
 

@@ -135,6 +135,15 @@ pub struct ElementDef {
     pub contour: Option<Arc<Vec<glam::DVec2>>>,
 }
 
+/// A colour of the program's `palette`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PaletteColor {
+    pub index: u32,
+    pub rgb: [u8; 3],
+    /// The material name of OBJ and glTF, if the palette gives one.
+    pub name: Option<String>,
+}
+
 impl ElementDef {
     /// Whether printing the element selects a contour instead of drawing.
     pub fn is_contour(&self) -> bool {
@@ -172,6 +181,8 @@ pub struct Program {
     pub elements: Vec<ElementDef>,
     /// Whether any 3D symbol (& ^ \ / | $) appears.
     pub is_3d: bool,
+    /// The file's `palette`, by index (empty: the built-in colours).
+    pub palette: Vec<PaletteColor>,
 }
 
 impl Program {
@@ -265,6 +276,7 @@ struct Compiler<'a> {
     symbols: Symbols,
     chunk: Chunk,
     elements: Vec<ElementDef>,
+    palette: Vec<PaletteColor>,
     element_index: HashMap<String, u16>,
     /// Declared arity of query modules' outputs, to pad successors.
     group: u32,
@@ -354,11 +366,36 @@ impl<'a> Compiler<'a> {
                 elements.push(def);
             }
         }
+        let mut palette: Vec<PaletteColor> = Vec::new();
+        for item in &file.items.stmts {
+            if let Item::Palette(p) = &item.node {
+                for e in &p.body.stmts {
+                    let e = &e.node;
+                    let (Some(index), Ok(c)) =
+                        (checked.value_of(&e.index), e.color.parse::<svgtypes::Color>())
+                    else {
+                        continue;
+                    };
+                    if palette.iter().any(|p| p.index == index as u32) {
+                        continue;
+                    }
+                    palette.push(PaletteColor {
+                        index: index as u32,
+                        rgb: [c.red, c.green, c.blue],
+                        name: e.name.as_ref().map(|n| n.name.clone()),
+                    });
+                }
+                // One palette per file (a second is an error).
+                break;
+            }
+        }
+        palette.sort_by_key(|p| p.index);
         Compiler {
             checked,
             symbols: Symbols::default(),
             chunk: Chunk::default(),
             elements,
+            palette,
             element_index,
             group: 0,
         }
@@ -629,6 +666,7 @@ impl<'a> Compiler<'a> {
             params: ls.params.iter().map(|p| p.name.clone()).collect(),
             elements: self.elements,
             is_3d,
+            palette: self.palette,
         })
     }
 }

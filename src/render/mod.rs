@@ -44,6 +44,58 @@ pub fn palette_linear(i: u32) -> [f64; 3] {
     })
 }
 
+/// The colours of a drawing: the program's `palette` where it gives an index,
+/// the built-in [`PALETTE`] elsewhere; and the material name of each colour
+/// in OBJ, MTL and glTF (the palette's name, else `lsyc_color<c>`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Palette {
+    colors: Vec<crate::compile::PaletteColor>,
+}
+
+impl Palette {
+    /// The palette of a program (the built-in one when it has none).
+    pub fn of(prog: &crate::compile::Program) -> Palette {
+        Palette {
+            colors: prog.palette.clone(),
+        }
+    }
+
+    fn own(&self, i: u32) -> Option<&crate::compile::PaletteColor> {
+        self.colors
+            .binary_search_by_key(&i, |c| c.index)
+            .ok()
+            .map(|k| &self.colors[k])
+    }
+
+    pub fn rgb(&self, i: u32) -> [u8; 3] {
+        self.own(i).map_or_else(|| palette_rgb(i), |c| c.rgb)
+    }
+
+    /// `#rrggbb`.
+    pub fn hex(&self, i: u32) -> String {
+        hex(self.rgb(i))
+    }
+
+    /// In linear RGB, 0–1 (glTF's base colour, the MTL `Kd`).
+    pub fn linear(&self, i: u32) -> [f64; 3] {
+        self.rgb(i).map(|c| {
+            let s = f64::from(c) / 255.0;
+            if s <= 0.04045 {
+                s / 12.92
+            } else {
+                ((s + 0.055) / 1.055).powf(2.4)
+            }
+        })
+    }
+
+    /// The material name of colour `i`.
+    pub fn material(&self, i: u32) -> String {
+        self.own(i)
+            .and_then(|c| c.name.clone())
+            .unwrap_or_else(|| obj::material_name(i))
+    }
+}
+
 /// `#rrggbb` to RGB.
 pub fn parse_hex(s: &str) -> Option<[u8; 3]> {
     let h = s.strip_prefix('#')?;
@@ -153,9 +205,9 @@ pub fn organ_facets(
 }
 
 /// The colour an organ is painted in: its element's `fill`, else the turtle's.
-pub fn organ_color(fill: Option<&str>, color: u32) -> [u8; 3] {
+pub fn organ_color(fill: Option<&str>, color: u32, palette: &Palette) -> [u8; 3] {
     fill.and_then(png::parse_color)
-        .unwrap_or_else(|| palette_rgb(color))
+        .unwrap_or_else(|| palette.rgb(color))
 }
 
 /// `#rrggbb` of RGB.

@@ -1,7 +1,7 @@
 //! PNG output through tiny-skia: anti-aliased strokes, filled polygons and
 //! elements, fitted into a square-ish image of `--size` pixels.
 
-use super::{Bounds, View, palette_rgb, parse_hex};
+use super::{Bounds, View, parse_hex};
 use crate::compile::ElementDef;
 use crate::turtle::Sink;
 use glam::{DVec2, DVec3};
@@ -46,6 +46,7 @@ pub struct PngWriter {
     color: u32,
     /// Each element's 3D organ and `fill`, if it is one.
     organs: Vec<Option<(std::sync::Arc<crate::compile::organ::Solid>, Option<String>)>>,
+    palette: super::Palette,
 }
 
 /// A colour name or `#rrggbb`.
@@ -139,6 +140,7 @@ impl PngWriter {
             batches: Vec::new(),
             color: 0,
             organs,
+            palette: super::Palette::default(),
         })
     }
 
@@ -148,6 +150,12 @@ impl PngWriter {
             ((q.x - self.min.x) * self.k + self.off.x) as f32,
             ((self.max.y - q.y) * self.k + self.off.y) as f32,
         )
+    }
+
+    /// Paints `'(c)` colours from `palette` (the built-in one by default).
+    pub fn with_palette(mut self, palette: super::Palette) -> Self {
+        self.palette = palette;
+        self
     }
 
     /// The stroke width in pixels of a segment `width` wide (hairlines 1.2).
@@ -171,7 +179,7 @@ impl PngWriter {
             return;
         }
         let Some(path) = b.path.finish() else { return };
-        let rgb = palette_rgb(self.color);
+        let rgb = self.palette.rgb(self.color);
         let mut paint = Paint::default();
         paint.set_color_rgba8(rgb[0], rgb[1], rgb[2], 255);
         paint.anti_alias = true;
@@ -297,7 +305,7 @@ impl Sink for PngWriter {
         }
         pb.close();
         if let Some(path) = pb.finish() {
-            let rgb = palette_rgb(color);
+            let rgb = self.palette.rgb(color);
             let mut paint = Paint::default();
             paint.set_color_rgba8(rgb[0], rgb[1], rgb[2], 255);
             paint.anti_alias = true;
@@ -314,7 +322,7 @@ impl Sink for PngWriter {
     fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32) {
         self.flush();
         if let Some(Some((solid, fill))) = self.organs.get(index as usize) {
-            let base = super::organ_color(fill.as_deref(), color);
+            let base = super::organ_color(fill.as_deref(), color, &self.palette);
             let facets = super::organ_facets(solid, (at, h, l, scale), &self.view, base);
             self.paint_facets(&facets);
             return;

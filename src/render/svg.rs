@@ -2,7 +2,7 @@
 //! elements are `<use>`s of shared `<defs>`, +y points up, and the viewBox is
 //! fitted to the drawing (found by a first, drawing-free pass of the turtle).
 
-use super::{Bounds, View, palette};
+use super::{Bounds, View};
 use crate::compile::ElementDef;
 use crate::number::{write_decimals, write_fixed};
 use crate::turtle::Sink;
@@ -37,6 +37,7 @@ pub struct SvgWriter<W: Write> {
     error: Option<io::Error>,
     /// Each element's 3D organ and `fill`, if it is one.
     organs: Vec<Option<(std::sync::Arc<crate::compile::organ::Solid>, Option<String>)>>,
+    palette: super::Palette,
 }
 
 impl<W: Write> SvgWriter<W> {
@@ -115,7 +116,14 @@ impl<W: Write> SvgWriter<W> {
                 .iter()
                 .map(|e| e.solid.clone().map(|s| (s, e.fill.clone())))
                 .collect(),
+            palette: super::Palette::default(),
         })
+    }
+
+    /// Paints `'(c)` colours from `palette` (the built-in one by default).
+    pub fn with_palette(mut self, palette: super::Palette) -> Self {
+        self.palette = palette;
+        self
     }
 
     fn write(&mut self, bytes: &[u8]) {
@@ -293,7 +301,7 @@ impl<W: Write> Sink for SvgWriter<W> {
         let mut buf = std::mem::take(&mut self.buf);
         buf.clear();
         buf.extend_from_slice(b"<path stroke=\"");
-        buf.extend_from_slice(palette(color).as_bytes());
+        buf.extend_from_slice(self.palette.hex(color).as_bytes());
         buf.push(b'"');
         if width > 0.0 {
             buf.extend_from_slice(b" stroke-width=\"");
@@ -320,7 +328,7 @@ impl<W: Write> Sink for SvgWriter<W> {
         self.close_path();
         let mut buf = Vec::new();
         buf.extend_from_slice(b"<polygon fill=\"");
-        buf.extend_from_slice(palette(color).as_bytes());
+        buf.extend_from_slice(self.palette.hex(color).as_bytes());
         buf.extend_from_slice(b"\" stroke=\"none\" points=\"");
         self.write_points(&mut buf, points);
         buf.extend_from_slice(b"\"/>\n");
@@ -330,7 +338,7 @@ impl<W: Write> Sink for SvgWriter<W> {
     fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32) {
         self.close_path();
         if let Some(Some((solid, fill))) = self.organs.get(index as usize) {
-            let base = super::organ_color(fill.as_deref(), color);
+            let base = super::organ_color(fill.as_deref(), color, &self.palette);
             let facets = super::organ_facets(solid, (at, h, l, scale), &self.view, base);
             self.organ(index, &facets);
             return;

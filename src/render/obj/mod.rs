@@ -32,7 +32,7 @@ mod text;
 mod tube;
 
 pub use outline::{ElementOutline, outline_from_path};
-pub use text::{MATERIAL_PREFIX, ObjText, material_name, write_mtl};
+pub use text::{MATERIAL_PREFIX, ObjText, material_name, write_mtl, write_mtl_with};
 
 use crate::compile::Program;
 use crate::compile::organ::Solid;
@@ -58,6 +58,8 @@ pub trait MeshTarget {
     /// Faces that follow belong to a new object called `name` (an lsystem, a
     /// scene's guide).
     fn object(&mut self, name: &str);
+    /// The colours and material names of the faces' colours.
+    fn palette(&mut self, _palette: &crate::render::Palette) {}
     /// A remark for a reader of the file (OBJ comments; ignored elsewhere).
     fn comment(&mut self, _text: &str) {}
 }
@@ -90,6 +92,8 @@ pub struct ObjOptions {
     pub solids: Vec<Option<Arc<Solid>>>,
     /// The contour of every element that declares one, by element index.
     pub contours: Vec<Option<Arc<Vec<glam::DVec2>>>>,
+    /// The colours and their material names.
+    pub palette: crate::render::Palette,
 }
 
 impl Default for ObjOptions {
@@ -100,6 +104,7 @@ impl Default for ObjOptions {
             elements: Vec::new(),
             solids: Vec::new(),
             contours: Vec::new(),
+            palette: crate::render::Palette::default(),
         }
     }
 }
@@ -123,6 +128,7 @@ impl ObjOptions {
                 .collect(),
             solids: prog.elements.iter().map(|e| e.solid.clone()).collect(),
             contours: prog.elements.iter().map(|e| e.contour.clone()).collect(),
+            palette: crate::render::Palette::of(prog),
             ..ObjOptions::default()
         }
     }
@@ -195,7 +201,8 @@ impl<W: Write> MeshBuilder<ObjText<W>> {
 }
 
 impl<T: MeshTarget> MeshBuilder<T> {
-    pub fn with_target(out: T, options: ObjOptions) -> Self {
+    pub fn with_target(mut out: T, options: ObjOptions) -> Self {
+        out.palette(&options.palette);
         let sides = options.sides.clamp(3, MAX_SIDES);
         let ring_angles: Vec<(f64, f64)> = (0..sides)
             .map(|i| {
