@@ -112,8 +112,16 @@ impl Dumper {
                 self.line("palette");
                 self.depth += 1;
                 self.block(body, |d, e| {
-                    let name = e.name.as_ref().map_or(String::new(), |n| format!(" {}", d.ident(n)));
-                    let s = format!("color {} = {:?}{}{name}", d.expr(&e.index), e.color, d.sp(e.color_span));
+                    let name = e
+                        .name
+                        .as_ref()
+                        .map_or(String::new(), |n| format!(" {}", d.ident(n)));
+                    let s = format!(
+                        "color {} = {:?}{}{name}",
+                        d.expr(&e.index),
+                        e.color,
+                        d.sp(e.color_span)
+                    );
                     d.line(&s);
                 });
                 self.depth -= 1;

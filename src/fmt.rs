@@ -239,7 +239,9 @@ impl Printer {
                         "{} {}{};",
                         format_expr(&e.index),
                         format_string(&e.color),
-                        e.name.as_ref().map_or(String::new(), |n| format!(" {}", n.name))
+                        e.name
+                            .as_ref()
+                            .map_or(String::new(), |n| format!(" {}", n.name))
                     ))
                 },
             ),

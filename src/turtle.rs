@@ -541,9 +541,7 @@ impl Turtle<'_> {
                 self.state.elasticity = arg.unwrap_or(prog.tropism.map_or(0.0, |t| t.1));
             }
             Action::None | Action::Cut => {}
-            other => self
-                .state
-                .apply(other, arg, settings(prog), &mut self.trig),
+            other => self.state.apply(other, arg, settings(prog), &mut self.trig),
         }
     }
 }

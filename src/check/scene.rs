@@ -196,15 +196,21 @@ impl<'a> Checker<'a> {
             if let Some(v) = self.const_num(&e.index, "a colour index") {
                 if !(v.fract() == 0.0 && (0.0..=255.0).contains(&v)) {
                     self.diags.push(
-                        Diagnostic::error(Code::OutOfRange, "a colour index is a whole number from 0 to 255")
-                            .primary(e.index.span, format!("this is {v}")),
+                        Diagnostic::error(
+                            Code::OutOfRange,
+                            "a colour index is a whole number from 0 to 255",
+                        )
+                        .primary(e.index.span, format!("this is {v}")),
                     );
                 } else if let Some(first) = indices.insert(v as i64, e.index.span) {
                     self.diags.push(
-                        Diagnostic::error(Code::DuplicateSetting, format!("colour {v} is given twice"))
-                            .primary(e.index.span, "given again here")
-                            .secondary(first, "first given here")
-                            .help("keep one of them"),
+                        Diagnostic::error(
+                            Code::DuplicateSetting,
+                            format!("colour {v} is given twice"),
+                        )
+                        .primary(e.index.span, "given again here")
+                        .secondary(first, "first given here")
+                        .help("keep one of them"),
                     );
                 }
             }
@@ -218,7 +224,8 @@ impl<'a> Checker<'a> {
             if let Some(name) = &e.name
                 && let Some(first) = names.insert(&name.name, name.span)
             {
-                self.diags.push(duplicate("material", &name.name, name.span, first));
+                self.diags
+                    .push(duplicate("material", &name.name, name.span, first));
             }
         }
     }

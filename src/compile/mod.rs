@@ -371,9 +371,10 @@ impl<'a> Compiler<'a> {
             if let Item::Palette(p) = &item.node {
                 for e in &p.body.stmts {
                     let e = &e.node;
-                    let (Some(index), Ok(c)) =
-                        (checked.value_of(&e.index), e.color.parse::<svgtypes::Color>())
-                    else {
+                    let (Some(index), Ok(c)) = (
+                        checked.value_of(&e.index),
+                        e.color.parse::<svgtypes::Color>(),
+                    ) else {
                         continue;
                     };
                     if palette.iter().any(|p| p.index == index as u32) {

@@ -555,3 +555,37 @@ fn png_and_svg_agree_on_every_colour() {
         assert!(have.contains(c), "the SVG paints {c:?}, the PNG nowhere");
     }
 }
+
+#[test]
+fn a_palette_states_the_colours_of_every_output() {
+    // Colour 1 is the program's; 2 is not listed and keeps the built-in
+    // colour; bare `'` steps from 1 to 2 and stops at the palette's last index.
+    let program = "palette {\n    1 \"#102030\" bark;\n    2 \"#a0b0c0\";\n}\nlsystem S { axiom '(1) F ' +(90) F ' +(90) F; }\n";
+    let d = derive(program, None).expect("derives");
+    let mut svg = Vec::new();
+    assert!(run::write_output(&d, Format::Svg, Picture::default(), 0, &mut svg).is_ok());
+    let svg = String::from_utf8(svg).expect("utf-8");
+    assert!(svg.contains("stroke=\"#102030\""), "{svg}");
+    assert!(svg.contains("stroke=\"#a0b0c0\""), "{svg}");
+    // The third segment: bare ' past the last index stays at 2.
+    assert_eq!(svg.matches("stroke=\"#a0b0c0\"").count(), 1, "{svg}");
+    let mut obj = Vec::new();
+    let written = run::write_output_full(&d, Format::Obj, &Picture::default(), 0, &mut obj)
+        .unwrap_or_else(|_| panic!("writes OBJ"));
+    let obj = String::from_utf8(obj).expect("utf-8");
+    assert!(obj.contains("usemtl bark"), "{obj}");
+    assert!(obj.contains("usemtl lsyc_color2"), "{obj}");
+    let mut mtl = Vec::new();
+    lsyc::render::obj::write_mtl_with(&mut mtl, &written.materials, &written.palette).expect("mtl");
+    let mtl = String::from_utf8(mtl).expect("utf-8");
+    assert!(
+        mtl.contains("newmtl bark") && mtl.contains("# #102030"),
+        "{mtl}"
+    );
+    // Without a palette, bare ' gives ABOP's greens (3 and on).
+    let plain = derive("lsystem S { axiom F ' F; }\n", None).expect("derives");
+    let mut svg = Vec::new();
+    assert!(run::write_output(&plain, Format::Svg, Picture::default(), 0, &mut svg).is_ok());
+    let want = format!("stroke=\"{}\"", lsyc::render::palette(3));
+    assert!(String::from_utf8(svg).expect("utf-8").contains(&want));
+}

@@ -226,7 +226,9 @@ fn write_one(
         run::write_output_full(d, format, picture, seed, w)
     })
     .ok_or(1u8)?;
-    if format == Format::Obj && !write_mtl(path, &written.materials, &written.palette, reporter, src) {
+    if format == Format::Obj
+        && !write_mtl(path, &written.materials, &written.palette, reporter, src)
+    {
         return Err(1);
     }
     Ok(written)
@@ -258,13 +260,15 @@ pub fn write_scene(
         s.finish_and_clear();
     }
     let stats = stats?;
-    if format == Some(Format::Obj) && !write_mtl(
+    if format == Some(Format::Obj)
+        && !write_mtl(
             path,
             &stats.materials,
             &lsyc::render::Palette::default(),
             reporter,
             src,
-        ) {
+        )
+    {
         return None;
     }
     Some(stats)
