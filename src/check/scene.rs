@@ -138,7 +138,7 @@ impl<'a> Checker<'a> {
                 },
                 (PropValue::Expr(x), false) if key != "width" => {
                     if let Some(v) = self.const_num(x, "a radius")
-                        && !(v > 0.0)
+                        && (v <= 0.0 || v.is_nan())
                     {
                         self.diags.push(
                             Diagnostic::error(

@@ -200,7 +200,9 @@ pub struct MeshError {
 pub fn parse_obj(text: &str) -> Result<Solid, MeshError> {
     let mut s = Solid::default();
     let mut normals: Vec<DVec3> = Vec::new();
-    let mut faces: Vec<(usize, Vec<(u32, Option<u32>)>)> = Vec::new();
+    // Each face: its line, and its corners (vertex, normal if given).
+    type Face = (usize, Vec<(u32, Option<u32>)>);
+    let mut faces: Vec<Face> = Vec::new();
     for (k, line) in text.lines().enumerate() {
         let line_no = k + 1;
         let err = |message: String| MeshError {
@@ -341,7 +343,7 @@ pub fn contour_from_path(d: &str) -> Result<Vec<DVec2>, String> {
         .map(|i| pts[i].perp_dot(pts[(i + 1) % pts.len()]))
         .sum::<f64>()
         * 0.5;
-    if !(area.abs() > 1e-12) {
+    if area.abs() <= 1e-12 || area.is_nan() {
         return Err("the contour encloses no area".to_string());
     }
     if area < 0.0 {
