@@ -422,7 +422,18 @@ impl<T: MeshTarget> MeshBuilder<T> {
             let w = (-l * n.x + h * n.y + u * n.z) * flip;
             self.normal(w.try_normalize().unwrap_or(h));
         }
+        // Triangles the written digits would not resolve (a patch's collapsed
+        // edge, a tiny scale) are left out, as `face` leaves such faces out.
+        let extent = solid
+            .points
+            .iter()
+            .fold(1e-9f64, |m, &p| m.max(world(p).abs().max_element()));
+        let resolution = RESOLUTION * extent;
         for t in &solid.triangles {
+            let [a, b, c] = t.map(|(p, _)| world(solid.points[p as usize]));
+            if 0.5 * (b - a).cross(c - a).length() <= resolution * resolution {
+                continue;
+            }
             let c = t.map(|(p, n)| (v0 + u64::from(p) + 1, n0 + u64::from(n) + 1));
             if scale < 0.0 {
                 self.tri(c[0], c[2], c[1]);
