@@ -98,7 +98,7 @@ pub fn load_meshes(prog: &mut Program, base: Option<&std::path::Path>) -> Result
             return Err(fail("is larger than 64 MiB".to_string()));
         }
         let text = String::from_utf8(text).map_err(|_| fail("is not UTF-8 text".to_string()))?;
-        let solid = compile::organ::parse_obj(&text)
+        let solid = crate::organ::parse_obj(&text)
             .map_err(|m| fail(format!("does not read, line {}: {}", m.line, m.message)))?;
         e.solid = Some(std::sync::Arc::new(solid));
     }

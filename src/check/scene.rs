@@ -87,7 +87,7 @@ impl<'a> Checker<'a> {
                     "contour" => {
                         self.path_data(s, *span);
                         if crate::path::parse(s).is_ok()
-                            && let Err(why) = crate::compile::organ::contour_from_path(s)
+                            && let Err(why) = crate::organ::contour_from_path(s)
                         {
                             self.diags.push(
                                 Diagnostic::error(Code::BadOrgan, "this path is not a contour")
@@ -96,7 +96,7 @@ impl<'a> Checker<'a> {
                             );
                         }
                     }
-                    "patch" => match crate::compile::organ::patch_numbers(s) {
+                    "patch" => match crate::organ::patch_numbers(s) {
                         Err(why) => self.diags.push(
                             Diagnostic::error(Code::BadOrgan, "patch data that is not numbers")
                                 .primary(*span, why)

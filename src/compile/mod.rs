@@ -13,7 +13,7 @@ use crate::vm::{Chunk, Code, ExprCompiler, ExprError, Op};
 use std::collections::HashMap;
 use std::sync::Arc;
 
-pub mod organ;
+use crate::organ;
 
 /// A symbol id: index into `Symbols`.
 pub type Sym = u16;

@@ -172,7 +172,7 @@ const LIGHT: DVec3 = DVec3::new(-0.372_104_203, 0.558_156_305, 0.744_208_407);
 /// and the light (both sides lit alike). The SVG and PNG writers paint exactly
 /// these, so the two pictures agree.
 pub fn organ_facets(
-    solid: &crate::compile::organ::Solid,
+    solid: &crate::organ::Solid,
     frame: (DVec3, DVec3, DVec3, f64),
     view: &View,
     base: [u8; 3],

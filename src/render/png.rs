@@ -45,7 +45,7 @@ pub struct PngWriter {
     batches: Vec<Batch>,
     color: u32,
     /// Each element's 3D organ and `fill`, if it is one.
-    organs: Vec<Option<(std::sync::Arc<crate::compile::organ::Solid>, Option<String>)>>,
+    organs: Vec<Option<(std::sync::Arc<crate::organ::Solid>, Option<String>)>>,
     palette: super::Palette,
 }
 

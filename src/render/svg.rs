@@ -36,7 +36,7 @@ pub struct SvgWriter<W: Write> {
     buf: Vec<u8>,
     error: Option<io::Error>,
     /// Each element's 3D organ and `fill`, if it is one.
-    organs: Vec<Option<(std::sync::Arc<crate::compile::organ::Solid>, Option<String>)>>,
+    organs: Vec<Option<(std::sync::Arc<crate::organ::Solid>, Option<String>)>>,
     palette: super::Palette,
 }
 

@@ -35,7 +35,7 @@ pub use outline::{ElementOutline, outline_from_path};
 pub use text::{MATERIAL_PREFIX, ObjText, material_name, write_mtl, write_mtl_with};
 
 use crate::compile::Program;
-use crate::compile::organ::Solid;
+use crate::organ::Solid;
 use crate::turtle::Sink;
 use glam::DVec3;
 use std::collections::{BTreeSet, HashMap, VecDeque};
