@@ -82,9 +82,28 @@ pub enum Item {
     Module(ModuleDecl),
     Const(ConstDecl),
     Element(Element),
+    Palette(Palette),
     Scene(Scene),
     /// A region the parser skipped after a syntax error.
     Error,
+}
+
+/// `palette { 0 "#263238"; 4 "#4f7f2f" leaf; }`: the colours of `'(c)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Palette {
+    /// The keyword's span (the item has no name).
+    pub keyword: Span,
+    pub body: Block<PaletteEntry>,
+}
+
+/// `INDEX "COLOUR" NAME?;` in a palette.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PaletteEntry {
+    pub index: Expr,
+    pub color: String,
+    pub color_span: Span,
+    /// The material name OBJ and glTF give the colour.
+    pub name: Option<Ident>,
 }
 
 /// `lsystem Name(params) { … }`

@@ -92,7 +92,7 @@ codes! {
     IgnoreAndConsider = "E0606", "`ignore` and `consider` in one lsystem";
     ContextNotAllowed = "E0607", "context on an `interpret` or `decompose` rule";
     InvalidPath = "E0701", "element path data that is not valid SVG";
-    MissingPath = "E0702", "an element without a `path`";
+    MissingPath = "E0702", "an element without a shape (`path`, `sphere`, `disk`, `patch`, `mesh` or `contour`)";
     UnknownProperty = "E0703", "an element property lsyc does not know";
     PropertyKind = "E0704", "an element property with the wrong kind of value";
     PolygonTooSmall = "E0801", "a guide polygon with fewer than three vertices";
@@ -110,7 +110,10 @@ codes! {
     TooMuchDrawing = "E0908", "interpretation that would draw more than the module limit";
     DrawingTooLarge = "E0909", "a drawing with coordinates too large to write";
     DecomposeTooDeep = "E0910", "decomposition rules that expand into each other too deeply";
-    Cancelled = "E0911", "a run stopped because a newer request replaced it (`lsyc studio`)";
+    MeshFile = "E0911", "a `mesh` file that cannot be read as OBJ";
+    Cancelled = "E0912", "a run stopped because a newer request replaced it (`lsyc studio`)";
+    TwoShapes = "E0705", "an element with more than one shape";
+    BadOrgan = "E0706", "organ or contour data that makes no shape";
     Unused = "W0101", "a declaration that nothing uses";
     UnusedParameter = "W0102", "a rule parameter that nothing uses";
     NeverProduced = "W0201", "a rule whose predecessor never appears";

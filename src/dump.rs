@@ -108,6 +108,24 @@ impl Dumper {
                 let s = format!("const {} = {}", self.ident(name), self.expr(value));
                 self.line(&s);
             }
+            Item::Palette(Palette { body, .. }) => {
+                self.line("palette");
+                self.depth += 1;
+                self.block(body, |d, e| {
+                    let name = e
+                        .name
+                        .as_ref()
+                        .map_or(String::new(), |n| format!(" {}", d.ident(n)));
+                    let s = format!(
+                        "color {} = {:?}{}{name}",
+                        d.expr(&e.index),
+                        e.color,
+                        d.sp(e.color_span)
+                    );
+                    d.line(&s);
+                });
+                self.depth -= 1;
+            }
             Item::Element(Element { name, props }) => {
                 let s = format!("element {}", self.ident(name));
                 self.line(&s);

@@ -249,6 +249,22 @@ impl Printer {
                 ));
             }
             Item::Element(e) => self.element(e, level),
+            Item::Palette(p) => self.braced(
+                "palette",
+                &p.body,
+                level,
+                |e| !matches!(e.index.kind, ExprKind::Error),
+                |pr, e, _| {
+                    pr.out.push_str(&format!(
+                        "{} {}{};",
+                        format_expr(&e.index),
+                        format_string(&e.color),
+                        e.name
+                            .as_ref()
+                            .map_or(String::new(), |n| format!(" {}", n.name))
+                    ))
+                },
+            ),
             Item::Scene(s) => self.scene(s, level),
             Item::Error => {}
         }

@@ -34,6 +34,8 @@ pub enum Token {
     Const,
     #[token("element")]
     Element,
+    #[token("palette")]
+    Palette,
     #[token("scene")]
     Scene,
     #[token("guide")]
@@ -451,6 +453,7 @@ impl Token {
             Token::Module => "module",
             Token::Const => "const",
             Token::Element => "element",
+            Token::Palette => "palette",
             Token::Scene => "scene",
             Token::Guide => "guide",
             Token::Link => "link",

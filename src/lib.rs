@@ -20,6 +20,7 @@ pub mod infer;
 pub mod lexer;
 pub mod lsp;
 pub mod number;
+pub mod organ;
 pub mod parser;
 pub mod path;
 pub mod query;

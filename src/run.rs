@@ -24,6 +24,9 @@ pub struct Options {
     pub limits: Limits,
     /// The lsystem to run; the first one when `None`.
     pub system: Option<String>,
+    /// The program's directory, where `mesh` files are found (the current
+    /// directory when `None`).
+    pub base_dir: Option<std::path::PathBuf>,
 }
 
 /// A derived program.
@@ -60,6 +63,8 @@ pub fn derive(
 ) -> Result<Derived, Diagnostic> {
     let prog =
         compile::compile(file, checked, opts.system.as_deref()).map_err(|e| e.diagnostic())?;
+    let mut prog = prog;
+    load_meshes(&mut prog, opts.base_dir.as_deref())?;
     let steps = opts.steps.unwrap_or(prog.derive);
     let start = Instant::now();
     let args = vec![0.0; prog.params.len()];
@@ -73,6 +78,31 @@ pub fn derive(
         derive_ms: start.elapsed().as_secs_f64() * 1000.0,
         limits: opts.limits,
     })
+}
+
+/// Reads the OBJ file of every `mesh` element the program uses; an error
+/// points at the file's name in the source.
+pub fn load_meshes(prog: &mut Program, base: Option<&std::path::Path>) -> Result<(), Diagnostic> {
+    for e in &mut prog.elements {
+        let Some((file, span)) = e.mesh.clone() else {
+            continue;
+        };
+        let path = base.map_or_else(|| std::path::PathBuf::from(&file), |b| b.join(&file));
+        let fail = |what: String| {
+            Diagnostic::error(Code::MeshFile, format!("the mesh `{file}` {what}"))
+                .primary(span, "this mesh file")
+                .note("a mesh is Wavefront OBJ text (`v`, `vn` and `f` lines), found relative to the program's directory")
+        };
+        let text = std::fs::read(&path).map_err(|err| fail(format!("cannot be read: {err}")))?;
+        if text.len() > 64 << 20 {
+            return Err(fail("is larger than 64 MiB".to_string()));
+        }
+        let text = String::from_utf8(text).map_err(|_| fail("is not UTF-8 text".to_string()))?;
+        let solid = crate::organ::parse_obj(&text)
+            .map_err(|m| fail(format!("does not read, line {}: {}", m.line, m.message)))?;
+        e.solid = Some(std::sync::Arc::new(solid));
+    }
+    Ok(())
 }
 
 /// The output formats, by file extension.
@@ -151,14 +181,13 @@ pub struct Written {
     pub drawn: Drawn,
     /// The colours the mesh used (OBJ: the materials its `.mtl` must define).
     pub materials: Vec<u32>,
+    /// Their colours and material names.
+    pub palette: render::Palette,
 }
 
 /// Local bounding boxes of the program's elements (for fitting the view).
-fn element_boxes(prog: &Program) -> Vec<[f64; 4]> {
-    prog.elements
-        .iter()
-        .map(|e| render::path_bounds(&e.path).unwrap_or([0.0, 0.0, 0.0, 0.0]))
-        .collect()
+fn element_boxes(prog: &Program) -> Vec<Option<(glam::DVec3, glam::DVec3)>> {
+    prog.elements.iter().map(turtle::element_box).collect()
 }
 
 /// Draws without output: the counts and bounding box (in the default view).
@@ -271,7 +300,8 @@ pub fn write_output_full(
                         .any(|s| s.action == Action::Element(i as u16))
                 })
                 .collect();
-            let mut w = render::svg::SvgWriter::new(out, view, &bounds, &d.prog.elements, &used)?;
+            let mut w = render::svg::SvgWriter::new(out, view, &bounds, &d.prog.elements, &used)?
+                .with_palette(render::Palette::of(&d.prog));
             let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
             w.finish()?;
             drawn
@@ -297,7 +327,11 @@ pub fn write_output_full(
             }
             let materials = w.colors();
             w.finish()?;
-            return Ok(Written { drawn, materials });
+            return Ok(Written {
+                drawn,
+                materials,
+                palette: render::Palette::of(&d.prog),
+            });
         }
         Format::Glb => {
             let options = render::obj::ObjOptions::for_program(&d.prog);
@@ -310,7 +344,11 @@ pub fn write_output_full(
             }
             let materials = w.colors();
             w.into_target().write(out)?;
-            return Ok(Written { drawn, materials });
+            return Ok(Written {
+                drawn,
+                materials,
+                palette: render::Palette::of(&d.prog),
+            });
         }
         Format::Apng => {
             return Err(OutputError::Io(std::io::Error::other(
@@ -321,6 +359,7 @@ pub fn write_output_full(
     Ok(Written {
         drawn,
         materials: Vec::new(),
+        palette: render::Palette::default(),
     })
 }
 
@@ -339,7 +378,8 @@ fn draw_png(
         &bounds,
         &d.prog.elements,
     )
-    .ok_or_else(|| std::io::Error::other("the image size is not possible"))?;
+    .ok_or_else(|| std::io::Error::other("the image size is not possible"))?
+    .with_palette(render::Palette::of(&d.prog));
     let drawn = d.interpret(seed, &mut w).map_err(OutputError::Diagnostic)?;
     Ok((drawn, w))
 }
@@ -445,6 +485,7 @@ pub fn write_animation(
     Ok(Written {
         drawn,
         materials: Vec::new(),
+        palette: render::Palette::default(),
     })
 }
 
@@ -618,7 +659,7 @@ pub fn write_scene(
     // Elements are items of the file, the same for every system of the scene.
     let elements: &[crate::compile::ElementDef] =
         r.scene.programs.first().map_or(&[], |p| &p.elements);
-    let boxes: Vec<[f64; 4]> = r.scene.programs.first().map_or(Vec::new(), element_boxes);
+    let boxes: Vec<_> = r.scene.programs.first().map_or(Vec::new(), element_boxes);
     let mut bounds_sink = BoundsSink {
         view,
         bounds: Bounds::default(),

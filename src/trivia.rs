@@ -31,6 +31,7 @@ impl Nested for Item {
         match self {
             Item::Lsystem(l) => attach_block(&mut l.body, comments, src),
             Item::Element(e) => attach_block(&mut e.props, comments, src),
+            Item::Palette(p) => attach_block(&mut p.body, comments, src),
             Item::Scene(s) => attach_block(&mut s.body, comments, src),
             _ => return comments,
         }
@@ -69,6 +70,7 @@ macro_rules! leaf {
 leaf!(
     crate::ast::Stmt,
     crate::ast::Prop,
+    crate::ast::PaletteEntry,
     crate::ast::GuideStmt,
     crate::ast::LinkStmt
 );

@@ -30,6 +30,9 @@ pub trait Sink {
     /// Element `index` printed at `at`, its local +y along `h`, its local −x along
     /// `l` (so local +x is −l), scaled by `scale`.
     fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32);
+    /// The branch contour of the segments that follow: the element `Some(i)`
+    /// (declared with `contour`) or `None` for the circle. Only meshes listen.
+    fn contour(&mut self, _element: Option<u16>) {}
     /// Query module number `module` of the string (kind: index into
     /// `query::QUERIES`) met with the turtle in `state`. Only the environment
     /// of a scene listens.
@@ -49,6 +52,8 @@ pub struct State {
     /// The elasticity e of tropism: after each `F` the heading turns toward
     /// the lsystem's tropism vector T by e·|H × T| radians.
     pub elasticity: f64,
+    /// The branch contour: 0 for the circle, element index + 1 otherwise.
+    pub contour: u16,
 }
 
 impl Default for State {
@@ -62,6 +67,7 @@ impl Default for State {
             width: 0.0,
             color: 0,
             elasticity: 0.0,
+            contour: 0,
         }
     }
 }
@@ -103,7 +109,13 @@ fn neg((s, c): (f64, f64)) -> (f64, f64) {
 }
 
 impl State {
-    fn apply(&mut self, action: Action, arg: Option<f64>, angle: f64, step: f64, trig: &mut Trig) {
+    fn apply(
+        &mut self,
+        action: Action,
+        arg: Option<f64>,
+        (angle, step, palette_last): (f64, f64, Option<u32>),
+        trig: &mut Trig,
+    ) {
         let a = arg.unwrap_or(angle);
         let mut sc = || trig.of(a);
         match action {
@@ -138,9 +150,13 @@ impl State {
             Action::Color => {
                 self.color = match arg {
                     Some(c) => c.max(0.0) as u32,
-                    // ABOP's bare `'` steps toward leaves: from ink or bark
-                    // straight to the first green (3), then along the greens to 7.
-                    None => (self.color + 1).clamp(3, 7),
+                    None => match palette_last {
+                        // With a palette: the next colour, up to its last index.
+                        Some(last) => (self.color + 1).min(last.max(self.color)),
+                        // ABOP's bare `'` steps toward leaves: from ink or bark
+                        // straight to the first green (3), then along the greens to 7.
+                        None => (self.color + 1).clamp(3, 7),
+                    },
                 }
             }
             Action::Draw | Action::Move => {
@@ -163,6 +179,12 @@ impl State {
         self.l = (q * self.l).normalize();
         self.u = self.h.cross(self.l);
     }
+}
+
+/// The settings the turtle's moves read: default angle and step, and the
+/// last index of the program's palette (bare `'` stops there).
+fn settings(prog: &Program) -> (f64, f64, Option<u32>) {
+    (prog.angle, prog.step, prog.palette.last().map(|c| c.index))
 }
 
 /// What was drawn.
@@ -245,15 +267,7 @@ pub fn interpret_limited(
             cos: 1.0,
         },
         cands: Vec::new(),
-        element_boxes: prog
-            .elements
-            .iter()
-            .map(|e| {
-                crate::path::parse(&e.path)
-                    .ok()
-                    .and_then(|p| crate::path::control_bounds(&p))
-            })
-            .collect(),
+        element_boxes: prog.elements.iter().map(element_box).collect(),
     };
     let has_interp = prog.interpret.iter().any(|r| !r.is_empty());
     let mut p = 0usize;
@@ -298,8 +312,29 @@ struct Turtle<'a> {
     max_modules: usize,
     /// Modules the current module of the string has expanded into.
     expanded_here: usize,
-    /// Each element's outline box in its own frame, for `Drawn::bbox`.
-    element_boxes: Vec<Option<[f64; 4]>>,
+    /// Each element's box in its own frame, for `Drawn::bbox`.
+    element_boxes: Vec<Option<(DVec3, DVec3)>>,
+}
+
+/// An element's box in its own frame (x along −L, y along H, z along U): its
+/// outline's control points, or its organ's mesh.
+pub fn element_box(e: &crate::compile::ElementDef) -> Option<(DVec3, DVec3)> {
+    if let Some(solid) = &e.solid {
+        return solid.bounds();
+    }
+    let b = crate::path::control_bounds(&crate::path::parse(&e.path).ok()?)?;
+    Some((DVec3::new(b[0], b[1], 0.0), DVec3::new(b[2], b[3], 0.0)))
+}
+
+/// The eight corners of a box.
+pub fn corners((lo, hi): (DVec3, DVec3)) -> [DVec3; 8] {
+    std::array::from_fn(|k| {
+        DVec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
 }
 
 impl Turtle<'_> {
@@ -421,7 +456,7 @@ impl Turtle<'_> {
             Action::Draw | Action::Move => {
                 let from = self.state.pos;
                 self.state
-                    .apply(action, arg, prog.angle, prog.step, &mut self.trig);
+                    .apply(action, arg, settings(prog), &mut self.trig);
                 let to = self.state.pos;
                 if action == Action::Draw {
                     self.state.bend(self.tropism);
@@ -442,7 +477,11 @@ impl Turtle<'_> {
             Action::Push => self.stack.push(self.state),
             Action::Pop => {
                 if let Some(s) = self.stack.pop() {
+                    let contour = self.state.contour;
                     self.state = s;
+                    if s.contour != contour {
+                        self.sink.contour(s.contour.checked_sub(1));
+                    }
                 }
             }
             Action::PolygonStart => self.polygons.push(Vec::new()),
@@ -468,14 +507,28 @@ impl Turtle<'_> {
                     }
                 }
             }
+            Action::Element(i)
+                if prog
+                    .elements
+                    .get(i as usize)
+                    .is_some_and(|e| e.is_contour()) =>
+            {
+                // Selects the contour of the branches that follow (until `]`).
+                if self.state.contour != i + 1 {
+                    self.state.contour = i + 1;
+                    self.sink.contour(Some(i));
+                }
+            }
             Action::Element(i) => {
                 self.drawn.elements += 1;
                 let st = self.state;
                 self.drawn.grow(st.pos);
                 if let Some(&Some(b)) = self.element_boxes.get(i as usize) {
-                    // The outline's box, placed as the sinks place the element.
-                    for (x, y) in [(b[0], b[1]), (b[2], b[1]), (b[0], b[3]), (b[2], b[3])] {
-                        self.drawn.grow(st.pos + (-st.l * x + st.h * y) * st.scale);
+                    // The element's box, placed as the sinks place the element.
+                    let u = st.h.cross(st.l);
+                    for c in corners(b) {
+                        self.drawn
+                            .grow(st.pos + (-st.l * c.x + st.h * c.y + u * c.z) * st.scale);
                     }
                 }
                 self.sink.element(i, st.pos, st.h, st.l, st.scale, st.color);
@@ -488,9 +541,7 @@ impl Turtle<'_> {
                 self.state.elasticity = arg.unwrap_or(prog.tropism.map_or(0.0, |t| t.1));
             }
             Action::None | Action::Cut => {}
-            other => self
-                .state
-                .apply(other, arg, prog.angle, prog.step, &mut self.trig),
+            other => self.state.apply(other, arg, settings(prog), &mut self.trig),
         }
     }
 }

@@ -134,10 +134,23 @@ pub fn check(file: &File, overrides: &[Override], seed: u64) -> Checked {
     };
     c.declarations(file);
     c.constants(file, overrides);
+    let mut palette: Option<Span> = None;
     for item in &file.items.stmts {
         match &item.node {
             Item::Lsystem(ls) => c.lsystem(ls),
             Item::Element(e) => c.element(e),
+            Item::Palette(p) => {
+                if let Some(first) = palette {
+                    c.diags.push(
+                        Diagnostic::error(Code::DuplicateSetting, "a second palette")
+                            .primary(p.keyword, "given again here")
+                            .secondary(first, "first given here")
+                            .help("a file has one palette: merge them"),
+                    );
+                }
+                palette.get_or_insert(p.keyword);
+                c.palette(p);
+            }
             Item::Scene(s) => c.scene(s),
             Item::Module(_) | Item::Const(_) | Item::Error => {}
         }
@@ -209,6 +222,7 @@ impl<'a> Checker<'a> {
                         },
                     );
                 }
+                Item::Palette(_) => {}
                 Item::Lsystem(l) => {
                     if let Some((prev, _)) = self.systems.get(l.name.name.as_str()) {
                         self.diags

@@ -3,7 +3,7 @@
 
 use super::expr::{Env, Ty, plural};
 use super::{Checker, duplicate, suggest};
-use crate::ast::{EdgeRef, Element, GuideStmt, LinkStmt, PropValue, Scene, SceneStmt};
+use crate::ast::{EdgeRef, Element, GuideStmt, LinkStmt, Palette, PropValue, Scene, SceneStmt};
 use crate::diagnostic::{Code, Diagnostic};
 use crate::span::Span;
 use std::collections::HashMap;
@@ -13,7 +13,15 @@ const PROPS: &[(&str, bool)] = &[
     ("fill", true),
     ("stroke", true),
     ("width", false),
+    ("sphere", false),
+    ("disk", false),
+    ("mesh", true),
+    ("patch", true),
+    ("contour", true),
 ];
+
+/// The properties that give an element its shape: exactly one of them.
+const SHAPES: &[&str] = &["path", "sphere", "disk", "mesh", "patch", "contour"];
 
 /// A guide's `system`: where it is named, and its lsystem's parameter count
 /// when that lsystem exists.
@@ -42,7 +50,7 @@ impl<'a> Checker<'a> {
                 if let Some(s) = synonym.or_else(|| suggest(key, PROPS.iter().map(|(k, _)| *k))) {
                     d = d.did_you_mean(p.node.key.span, s);
                 } else {
-                    d = d.note("the properties are path, fill, stroke and width");
+                    d = d.note("the properties are path, sphere, disk, mesh, patch, contour, fill, stroke and width");
                 }
                 self.diags.push(d);
                 continue;
@@ -56,10 +64,68 @@ impl<'a> Checker<'a> {
                 );
                 continue;
             }
+            if SHAPES.contains(&key)
+                && let Some((other, span)) = seen
+                    .iter()
+                    .find(|(k, _)| SHAPES.contains(k))
+                    .map(|(k, s)| (*k, *s))
+            {
+                self.diags.push(
+                    Diagnostic::error(
+                        Code::TwoShapes,
+                        format!("element `{}` has both `{other}` and `{key}`", e.name.name),
+                    )
+                    .primary(p.node.key.span, "a second shape")
+                    .secondary(span, "the first shape")
+                    .help("declare one element per shape, and print them one after the other"),
+                );
+            }
             seen.insert(key, p.node.key.span);
             match (&p.node.value, wants_string) {
                 (PropValue::Str(s, span), true) => match key {
                     "path" => self.path_data(s, *span),
+                    "contour" => {
+                        self.path_data(s, *span);
+                        if crate::path::parse(s).is_ok()
+                            && let Err(why) = crate::organ::contour_from_path(s)
+                        {
+                            self.diags.push(
+                                Diagnostic::error(Code::BadOrgan, "this path is not a contour")
+                                    .primary(*span, why)
+                                    .help("a contour is one closed outline around the branch's axis, e.g. \"M1 0 L0 1 L-1 0 L0 -1 Z\""),
+                            );
+                        }
+                    }
+                    "patch" => match crate::organ::patch_numbers(s) {
+                        Err(why) => self.diags.push(
+                            Diagnostic::error(Code::BadOrgan, "patch data that is not numbers")
+                                .primary(*span, why)
+                                .help("write the 16 control points of each patch as x y z numbers"),
+                        ),
+                        Ok(n) if n.is_empty() || n.len() % 48 != 0 => self.diags.push(
+                            Diagnostic::error(
+                                Code::BadOrgan,
+                                format!(
+                                    "a patch needs 48 numbers (16 points x y z); this has {}",
+                                    n.len()
+                                ),
+                            )
+                            .primary(*span, "not a whole number of patches")
+                            .help("each bicubic patch is 4 rows of 4 control points, 48 numbers"),
+                        ),
+                        Ok(_) => {}
+                    },
+                    "mesh" => {
+                        if s.trim().is_empty() {
+                            self.diags.push(
+                                Diagnostic::error(Code::BadOrgan, "the mesh file is not named")
+                                    .primary(*span, "an empty file name")
+                                    .help(
+                                        "name an OBJ file beside the program: mesh \"leaf.obj\";",
+                                    ),
+                            );
+                        }
+                    }
                     _ => {
                         if s.parse::<svgtypes::Color>().is_err() && s != "none" {
                             self.diags.push(
@@ -70,6 +136,19 @@ impl<'a> Checker<'a> {
                         }
                     }
                 },
+                (PropValue::Expr(x), false) if key != "width" => {
+                    if let Some(v) = self.const_num(x, "a radius")
+                        && (v <= 0.0 || v.is_nan())
+                    {
+                        self.diags.push(
+                            Diagnostic::error(
+                                Code::BadOrgan,
+                                format!("a {key}'s radius must be positive"),
+                            )
+                            .primary(x.span, format!("this is {v}")),
+                        );
+                    }
+                }
                 (PropValue::Expr(x), false) => {
                     if let Some(v) = self.const_num(x, "the width")
                         && v < 0.0
@@ -92,7 +171,7 @@ impl<'a> Checker<'a> {
                 ),
             }
         }
-        if !seen.contains_key("path") {
+        if !SHAPES.iter().any(|k| seen.contains_key(k)) {
             self.diags.push(
                 Diagnostic::error(
                     Code::MissingPath,
@@ -101,6 +180,53 @@ impl<'a> Checker<'a> {
                 .primary(e.name.span, "an element draws SVG path data")
                 .help("add `path \"M0 0 L0 10\";` (local frame: base at the origin, pointing +y)"),
             );
+        }
+    }
+
+    /// A palette's entries: whole indices 0–255, each once; SVG colours;
+    /// material names each once.
+    pub(super) fn palette(&mut self, p: &'a Palette) {
+        let mut indices: HashMap<i64, Span> = HashMap::new();
+        let mut names: HashMap<&str, Span> = HashMap::new();
+        for n in &p.body.stmts {
+            let e = &n.node;
+            if matches!(e.index.kind, crate::ast::ExprKind::Error) {
+                continue;
+            }
+            if let Some(v) = self.const_num(&e.index, "a colour index") {
+                if !(v.fract() == 0.0 && (0.0..=255.0).contains(&v)) {
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::OutOfRange,
+                            "a colour index is a whole number from 0 to 255",
+                        )
+                        .primary(e.index.span, format!("this is {v}")),
+                    );
+                } else if let Some(first) = indices.insert(v as i64, e.index.span) {
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::DuplicateSetting,
+                            format!("colour {v} is given twice"),
+                        )
+                        .primary(e.index.span, "given again here")
+                        .secondary(first, "first given here")
+                        .help("keep one of them"),
+                    );
+                }
+            }
+            if e.color.parse::<svgtypes::Color>().is_err() {
+                self.diags.push(
+                    Diagnostic::error(Code::PropertyKind, format!("`{}` is not a colour", e.color))
+                        .primary(e.color_span, "not an SVG colour")
+                        .help("use a name such as \"green\", \"#3a7\" or \"rgb(40, 120, 60)\""),
+                );
+            }
+            if let Some(name) = &e.name
+                && let Some(first) = names.insert(&name.name, name.span)
+            {
+                self.diags
+                    .push(duplicate("material", &name.name, name.span, first));
+            }
         }
     }
 

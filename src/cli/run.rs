@@ -151,6 +151,11 @@ fn run_inner(args: &Args, reporter: &Reporter) -> Result<(), u8> {
             cancel: None,
         },
         system: args.system.clone(),
+        base_dir: args
+            .file
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .map(std::path::Path::to_path_buf),
     };
     if has_scene && args.system.is_none() && !args.disasm {
         return match run_scene(

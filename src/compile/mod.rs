@@ -11,6 +11,9 @@ use crate::diagnostic::{Code as DiagCode, Diagnostic};
 use crate::span::Span;
 use crate::vm::{Chunk, Code, ExprCompiler, ExprError, Op};
 use std::collections::HashMap;
+use std::sync::Arc;
+
+use crate::organ;
 
 /// A symbol id: index into `Symbols`.
 pub type Sym = u16;
@@ -113,7 +116,8 @@ pub struct CompiledRule {
     pub span: Span,
 }
 
-/// An element: a terminal that prints SVG path data.
+/// An element: a terminal that prints SVG path data, a 3D organ (`sphere`,
+/// `disk`, `mesh`, `patch`) or selects a branch contour (`contour`).
 #[derive(Clone, Debug)]
 pub struct ElementDef {
     pub name: String,
@@ -121,6 +125,30 @@ pub struct ElementDef {
     pub fill: Option<String>,
     pub stroke: Option<String>,
     pub width: Option<f64>,
+    /// A 3D organ's mesh in the element's local frame (for `mesh`, once the
+    /// file is read: see `mesh`).
+    pub solid: Option<Arc<organ::Solid>>,
+    /// `mesh "FILE.obj"`: the file as written and the span of the string,
+    /// read by the run (relative to the program's directory).
+    pub mesh: Option<(String, Span)>,
+    /// `contour "…"`: a closed profile for the branches that follow.
+    pub contour: Option<Arc<Vec<glam::DVec2>>>,
+}
+
+/// A colour of the program's `palette`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PaletteColor {
+    pub index: u32,
+    pub rgb: [u8; 3],
+    /// The material name of OBJ and glTF, if the palette gives one.
+    pub name: Option<String>,
+}
+
+impl ElementDef {
+    /// Whether printing the element selects a contour instead of drawing.
+    pub fn is_contour(&self) -> bool {
+        self.contour.is_some()
+    }
 }
 
 /// One lsystem, ready to derive and interpret.
@@ -153,6 +181,8 @@ pub struct Program {
     pub elements: Vec<ElementDef>,
     /// Whether any 3D symbol (& ^ \ / | $) appears.
     pub is_3d: bool,
+    /// The file's `palette`, by index (empty: the built-in colours).
+    pub palette: Vec<PaletteColor>,
 }
 
 impl Program {
@@ -246,6 +276,7 @@ struct Compiler<'a> {
     symbols: Symbols,
     chunk: Chunk,
     elements: Vec<ElementDef>,
+    palette: Vec<PaletteColor>,
     element_index: HashMap<String, u16>,
     /// Declared arity of query modules' outputs, to pad successors.
     group: u32,
@@ -297,6 +328,9 @@ impl<'a> Compiler<'a> {
                     fill: None,
                     stroke: None,
                     width: None,
+                    solid: None,
+                    mesh: None,
+                    contour: None,
                 };
                 for p in &e.props.stmts {
                     match (&p.node.key.name[..], &p.node.value) {
@@ -308,6 +342,23 @@ impl<'a> Compiler<'a> {
                         ("width", crate::ast::PropValue::Expr(x)) => {
                             def.width = checked.value_of(x)
                         }
+                        ("sphere", crate::ast::PropValue::Expr(x)) => {
+                            def.solid = checked.value_of(x).map(|r| Arc::new(organ::sphere(r)))
+                        }
+                        ("disk", crate::ast::PropValue::Expr(x)) => {
+                            def.solid = checked.value_of(x).map(|r| Arc::new(organ::disk(r)))
+                        }
+                        ("patch", crate::ast::PropValue::Str(s, _)) => {
+                            def.solid = organ::patch_numbers(s)
+                                .ok()
+                                .map(|n| Arc::new(organ::patches(&n)))
+                        }
+                        ("mesh", crate::ast::PropValue::Str(s, span)) => {
+                            def.mesh = Some((s.clone(), *span))
+                        }
+                        ("contour", crate::ast::PropValue::Str(s, _)) => {
+                            def.contour = organ::contour_from_path(s).ok().map(Arc::new)
+                        }
                         _ => {}
                     }
                 }
@@ -315,11 +366,37 @@ impl<'a> Compiler<'a> {
                 elements.push(def);
             }
         }
+        let mut palette: Vec<PaletteColor> = Vec::new();
+        for item in &file.items.stmts {
+            if let Item::Palette(p) = &item.node {
+                for e in &p.body.stmts {
+                    let e = &e.node;
+                    let (Some(index), Ok(c)) = (
+                        checked.value_of(&e.index),
+                        e.color.parse::<svgtypes::Color>(),
+                    ) else {
+                        continue;
+                    };
+                    if palette.iter().any(|p| p.index == index as u32) {
+                        continue;
+                    }
+                    palette.push(PaletteColor {
+                        index: index as u32,
+                        rgb: [c.red, c.green, c.blue],
+                        name: e.name.as_ref().map(|n| n.name.clone()),
+                    });
+                }
+                // One palette per file (a second is an error).
+                break;
+            }
+        }
+        palette.sort_by_key(|p| p.index);
         Compiler {
             checked,
             symbols: Symbols::default(),
             chunk: Chunk::default(),
             elements,
+            palette,
             element_index,
             group: 0,
         }
@@ -560,7 +637,15 @@ impl<'a> Compiler<'a> {
                     | Action::TurnAround
                     | Action::RollHorizontal
             )
-        }) || tropism.is_some_and(|(t, _)| t[2] != 0.0);
+        }) || tropism.is_some_and(|(t, _)| t[2] != 0.0)
+            || self.symbols.info.iter().any(|i| match i.action {
+                // A 3D organ shows its depth only in the oblique view.
+                Action::Element(e) => self
+                    .elements
+                    .get(e as usize)
+                    .is_some_and(|d| d.solid.is_some() || d.mesh.is_some()),
+                _ => false,
+            });
         let d0l = d0l_table(&self.symbols, &by_sym, &self.chunk);
         Ok(Program {
             name: ls.name.name.clone(),
@@ -582,6 +667,7 @@ impl<'a> Compiler<'a> {
             params: ls.params.iter().map(|p| p.name.clone()).collect(),
             elements: self.elements,
             is_3d,
+            palette: self.palette,
         })
     }
 }

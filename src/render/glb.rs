@@ -9,7 +9,7 @@
 //! Polygon faces are split into triangles by ear clipping. Must not build
 //! geometry: that is `render::obj::MeshBuilder`'s.
 
-use super::obj::{MeshTarget, material_name};
+use super::obj::MeshTarget;
 use glam::{DVec2, DVec3};
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
@@ -49,6 +49,7 @@ pub struct GlbMesh {
     budget: usize,
     held: usize,
     over_budget: bool,
+    palette: super::Palette,
 }
 
 /// About how many bytes of memory a position or normal, a distinct corner
@@ -187,7 +188,7 @@ impl GlbMesh {
             .collect();
         let materials: BTreeMap<u32, json::Index<json::Material>> = colors
             .iter()
-            .map(|&c| (c, root.push(material(c))))
+            .map(|&c| (c, root.push(material(c, &self.palette))))
             .collect();
         let mut bin = Vec::new();
         let buffer = json::Index::<json::Buffer>::new(0);
@@ -292,6 +293,10 @@ impl MeshTarget for GlbMesh {
         self.color = color;
     }
 
+    fn palette(&mut self, palette: &super::Palette) {
+        self.palette = palette.clone();
+    }
+
     fn object(&mut self, name: &str) {
         self.objects.push(Object {
             name: name.to_string(),
@@ -301,10 +306,10 @@ impl MeshTarget for GlbMesh {
 }
 
 /// The material of palette colour `c`.
-fn material(c: u32) -> json::Material {
-    let [r, g, b] = super::palette_linear(c);
+fn material(c: u32, palette: &super::Palette) -> json::Material {
+    let [r, g, b] = palette.linear(c);
     let mut m = json::Material {
-        name: Some(material_name(c)),
+        name: Some(palette.material(c)),
         double_sided: true,
         ..Default::default()
     };

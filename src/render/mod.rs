@@ -44,6 +44,58 @@ pub fn palette_linear(i: u32) -> [f64; 3] {
     })
 }
 
+/// The colours of a drawing: the program's `palette` where it gives an index,
+/// the built-in [`PALETTE`] elsewhere; and the material name of each colour
+/// in OBJ, MTL and glTF (the palette's name, else `lsyc_color<c>`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Palette {
+    colors: Vec<crate::compile::PaletteColor>,
+}
+
+impl Palette {
+    /// The palette of a program (the built-in one when it has none).
+    pub fn of(prog: &crate::compile::Program) -> Palette {
+        Palette {
+            colors: prog.palette.clone(),
+        }
+    }
+
+    fn own(&self, i: u32) -> Option<&crate::compile::PaletteColor> {
+        self.colors
+            .binary_search_by_key(&i, |c| c.index)
+            .ok()
+            .map(|k| &self.colors[k])
+    }
+
+    pub fn rgb(&self, i: u32) -> [u8; 3] {
+        self.own(i).map_or_else(|| palette_rgb(i), |c| c.rgb)
+    }
+
+    /// `#rrggbb`.
+    pub fn hex(&self, i: u32) -> String {
+        hex(self.rgb(i))
+    }
+
+    /// In linear RGB, 0–1 (glTF's base colour, the MTL `Kd`).
+    pub fn linear(&self, i: u32) -> [f64; 3] {
+        self.rgb(i).map(|c| {
+            let s = f64::from(c) / 255.0;
+            if s <= 0.04045 {
+                s / 12.92
+            } else {
+                ((s + 0.055) / 1.055).powf(2.4)
+            }
+        })
+    }
+
+    /// The material name of colour `i`.
+    pub fn material(&self, i: u32) -> String {
+        self.own(i)
+            .and_then(|c| c.name.clone())
+            .unwrap_or_else(|| obj::material_name(i))
+    }
+}
+
 /// `#rrggbb` to RGB.
 pub fn parse_hex(s: &str) -> Option<[u8; 3]> {
     let h = s.strip_prefix('#')?;
@@ -91,6 +143,76 @@ impl View {
     pub fn project_dir(&self, v: DVec3) -> DVec2 {
         self.project(v)
     }
+
+    /// How far toward the viewer `p` is (larger is nearer).
+    pub fn depth(&self, p: DVec3) -> f64 {
+        (self.m * p).z
+    }
+
+    /// A direction in camera space (x right, y up, z toward the viewer).
+    pub fn camera_dir(&self, v: DVec3) -> DVec3 {
+        self.m * v
+    }
+}
+
+/// One triangle of a 3D organ as a picture paints it: projected corners and a
+/// flat-shaded colour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Facet {
+    pub points: [DVec2; 3],
+    pub rgb: [u8; 3],
+}
+
+/// The light of organ pictures, in camera space: from the upper left, in front.
+const LIGHT: DVec3 = DVec3::new(-0.372_104_203, 0.558_156_305, 0.744_208_407);
+
+/// The facets of an organ placed at `at` with frame H, L (U = H × L) and
+/// `scale`, as `view` sees them, in painter's order (farthest first, by each
+/// triangle's centroid); each is `base` shaded by the angle between its normal
+/// and the light (both sides lit alike). The SVG and PNG writers paint exactly
+/// these, so the two pictures agree.
+pub fn organ_facets(
+    solid: &crate::organ::Solid,
+    frame: (DVec3, DVec3, DVec3, f64),
+    view: &View,
+    base: [u8; 3],
+) -> Vec<Facet> {
+    let (at, h, l, scale) = frame;
+    let u = h.cross(l);
+    let world = |p: DVec3| at + (-l * p.x + h * p.y + u * p.z) * scale;
+    let mut out: Vec<(f64, Facet)> = Vec::with_capacity(solid.triangles.len());
+    for t in &solid.triangles {
+        let ps = t.map(|(p, _)| world(solid.points[p as usize]));
+        if !ps.iter().all(|p| p.is_finite()) {
+            continue;
+        }
+        let n: DVec3 = t.iter().map(|&(_, n)| solid.normals[n as usize]).sum();
+        let n = view.camera_dir(-l * n.x + h * n.y + u * n.z);
+        let lit = n.try_normalize().map_or(1.0, |n| n.dot(LIGHT).abs());
+        let k = 0.45 + 0.55 * lit;
+        let rgb = base.map(|c| (f64::from(c) * k).round().clamp(0.0, 255.0) as u8);
+        let depth = ps.iter().map(|&p| view.depth(p)).sum::<f64>() / 3.0;
+        out.push((
+            depth,
+            Facet {
+                points: ps.map(|p| view.project(p)),
+                rgb,
+            },
+        ));
+    }
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    out.into_iter().map(|(_, f)| f).collect()
+}
+
+/// The colour an organ is painted in: its element's `fill`, else the turtle's.
+pub fn organ_color(fill: Option<&str>, color: u32, palette: &Palette) -> [u8; 3] {
+    fill.and_then(png::parse_color)
+        .unwrap_or_else(|| palette.rgb(color))
+}
+
+/// `#rrggbb` of RGB.
+pub fn hex(rgb: [u8; 3]) -> String {
+    format!("#{:02x}{:02x}{:02x}", rgb[0], rgb[1], rgb[2])
 }
 
 /// Bounds of drawn geometry as seen by a view.
@@ -145,8 +267,8 @@ impl Bounds {
 pub struct BoundsSink<'a> {
     pub view: View,
     pub bounds: Bounds,
-    /// Local outline bounds of each element: [minx, miny, maxx, maxy].
-    pub element_boxes: &'a [[f64; 4]],
+    /// Each element's box in its own frame (`turtle::element_box`).
+    pub element_boxes: &'a [Option<(DVec3, DVec3)>],
 }
 
 impl Sink for BoundsSink<'_> {
@@ -162,12 +284,13 @@ impl Sink for BoundsSink<'_> {
     }
 
     fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, _: u32) {
-        let Some(b) = self.element_boxes.get(index as usize) else {
+        let Some(&Some(b)) = self.element_boxes.get(index as usize) else {
             self.bounds.add(self.view.project(at));
             return;
         };
-        for (x, y) in [(b[0], b[1]), (b[2], b[1]), (b[0], b[3]), (b[2], b[3])] {
-            let p = at + (-l * x + h * y) * scale;
+        let u = h.cross(l);
+        for c in crate::turtle::corners(b) {
+            let p = at + (-l * c.x + h * c.y + u * c.z) * scale;
             self.bounds.add(self.view.project(p));
         }
     }

@@ -1,7 +1,7 @@
 //! PNG output through tiny-skia: anti-aliased strokes, filled polygons and
 //! elements, fitted into a square-ish image of `--size` pixels.
 
-use super::{Bounds, View, palette_rgb, parse_hex};
+use super::{Bounds, View, parse_hex};
 use crate::compile::ElementDef;
 use crate::turtle::Sink;
 use glam::{DVec2, DVec3};
@@ -11,6 +11,22 @@ use tiny_skia::{
 
 /// Segments batched into one path before it is stroked.
 const BATCH: usize = 4096;
+/// The outline of an organ's facet, in pixels (SVG: the same, non-scaling).
+pub const FACET_SEAM: f32 = 0.6;
+/// Stroke widths (in pixels) batched at once for one colour.
+const WIDTHS: usize = 16;
+
+/// The segments of one colour and one stroke width not yet stroked: opaque
+/// strokes of one colour may be painted in any order, so segments of that
+/// colour are grouped by width and each group is stroked as one path (a tree
+/// whose widths change at every branch would otherwise set up one stroke per
+/// segment).
+struct Batch {
+    width: f32,
+    path: PathBuilder,
+    len: usize,
+    last: Option<(f32, f32)>,
+}
 
 /// An element ready to paint: its outline, fill, and optional stroke colour
 /// with the stroke's width in pixels (the element's `width`, as SVG draws it).
@@ -25,10 +41,12 @@ pub struct PngWriter {
     k: f64,
     off: DVec2,
     elements: Vec<Option<Painted>>,
-    batch: PathBuilder,
-    batch_len: usize,
-    style: (f64, u32),
-    last: Option<DVec2>,
+    /// Open batches, all of colour `color`.
+    batches: Vec<Batch>,
+    color: u32,
+    /// Each element's 3D organ and `fill`, if it is one.
+    organs: Vec<Option<(std::sync::Arc<crate::organ::Solid>, Option<String>)>>,
+    palette: super::Palette,
 }
 
 /// A colour name or `#rrggbb`.
@@ -89,6 +107,10 @@ impl PngWriter {
         ));
         let k = (w as f64 / ext.x).min(h as f64 / ext.y);
         let off = DVec2::new((w as f64 - ext.x * k) / 2.0, (h as f64 - ext.y * k) / 2.0);
+        let organs = elements
+            .iter()
+            .map(|e| e.solid.clone().map(|s| (s, e.fill.clone())))
+            .collect();
         let elements = elements
             .iter()
             .map(|e| {
@@ -115,10 +137,10 @@ impl PngWriter {
             k,
             off,
             elements,
-            batch: PathBuilder::new(),
-            batch_len: 0,
-            style: (0.0, 0),
-            last: None,
+            batches: Vec::new(),
+            color: 0,
+            organs,
+            palette: super::Palette::default(),
         })
     }
 
@@ -130,31 +152,83 @@ impl PngWriter {
         )
     }
 
+    /// Paints `'(c)` colours from `palette` (the built-in one by default).
+    pub fn with_palette(mut self, palette: super::Palette) -> Self {
+        self.palette = palette;
+        self
+    }
+
+    /// The stroke width in pixels of a segment `width` wide (hairlines 1.2).
+    fn stroke_px(&self, width: f64) -> f32 {
+        if width > 0.0 {
+            (width * self.k).max(0.6) as f32
+        } else {
+            1.2
+        }
+    }
+
+    /// Strokes every open batch.
     fn flush(&mut self) {
-        if self.batch_len == 0 {
+        for b in std::mem::take(&mut self.batches) {
+            self.stroke_batch(b);
+        }
+    }
+
+    fn stroke_batch(&mut self, b: Batch) {
+        if b.len == 0 {
             return;
         }
-        let pb = std::mem::replace(&mut self.batch, PathBuilder::new());
-        self.batch_len = 0;
-        self.last = None;
-        let Some(path) = pb.finish() else { return };
-        let (width, color) = self.style;
-        let rgb = palette_rgb(color);
+        let Some(path) = b.path.finish() else { return };
+        let rgb = self.palette.rgb(self.color);
         let mut paint = Paint::default();
         paint.set_color_rgba8(rgb[0], rgb[1], rgb[2], 255);
         paint.anti_alias = true;
         let stroke = Stroke {
-            width: if width > 0.0 {
-                (width * self.k).max(0.6) as f32
-            } else {
-                1.2
-            },
+            width: b.width,
             line_cap: LineCap::Round,
             line_join: LineJoin::Round,
             ..Stroke::default()
         };
         self.pixmap
             .stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+    }
+
+    /// Paints an organ's facets: each filled, and outlined in its own colour
+    /// by a thin line so that neighbouring triangles leave no seam.
+    fn paint_facets(&mut self, facets: &[super::Facet]) {
+        let stroke = Stroke {
+            width: FACET_SEAM,
+            line_join: LineJoin::Round,
+            ..Stroke::default()
+        };
+        for f in facets {
+            let mut pb = PathBuilder::new();
+            for (i, &q) in f.points.iter().enumerate() {
+                let x = ((q.x - self.min.x) * self.k + self.off.x) as f32;
+                let y = ((self.max.y - q.y) * self.k + self.off.y) as f32;
+                if i == 0 {
+                    pb.move_to(x, y);
+                } else {
+                    pb.line_to(x, y);
+                }
+            }
+            pb.close();
+            let Some(path) = pb.finish() else { continue };
+            let mut paint = Paint {
+                anti_alias: true,
+                ..Paint::default()
+            };
+            paint.set_color_rgba8(f.rgb[0], f.rgb[1], f.rgb[2], 255);
+            self.pixmap.fill_path(
+                &path,
+                &paint,
+                FillRule::Winding,
+                Transform::identity(),
+                None,
+            );
+            self.pixmap
+                .stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+        }
     }
 
     /// Finishes drawing and encodes the image.
@@ -174,19 +248,48 @@ impl PngWriter {
 
 impl Sink for PngWriter {
     fn segment(&mut self, a: DVec3, b: DVec3, width: f64, color: u32) {
-        if self.style != (width, color) || self.batch_len >= BATCH {
+        if self.color != color {
             self.flush();
-            self.style = (width, color);
+            self.color = color;
         }
-        let (ax, ay) = self.px(a);
-        let (bx, by) = self.px(b);
-        let start = DVec2::new(ax as f64, ay as f64);
-        if self.last != Some(start) {
-            self.batch.move_to(ax, ay);
+        let px = self.stroke_px(width);
+        let i = match self.batches.iter().position(|b| b.width == px) {
+            Some(i) => i,
+            None => {
+                if self.batches.len() >= WIDTHS {
+                    let b = self.batches.remove(0);
+                    self.stroke_batch(b);
+                }
+                self.batches.push(Batch {
+                    width: px,
+                    path: PathBuilder::new(),
+                    len: 0,
+                    last: None,
+                });
+                self.batches.len() - 1
+            }
+        };
+        if self.batches[i].len >= BATCH {
+            let full = std::mem::replace(
+                &mut self.batches[i],
+                Batch {
+                    width: px,
+                    path: PathBuilder::new(),
+                    len: 0,
+                    last: None,
+                },
+            );
+            self.stroke_batch(full);
         }
-        self.batch.line_to(bx, by);
-        self.last = Some(DVec2::new(bx as f64, by as f64));
-        self.batch_len += 1;
+        let start = self.px(a);
+        let end = self.px(b);
+        let batch = &mut self.batches[i];
+        if batch.last != Some(start) {
+            batch.path.move_to(start.0, start.1);
+        }
+        batch.path.line_to(end.0, end.1);
+        batch.last = Some(end);
+        batch.len += 1;
     }
 
     fn polygon(&mut self, points: &[DVec3], color: u32) {
@@ -202,7 +305,7 @@ impl Sink for PngWriter {
         }
         pb.close();
         if let Some(path) = pb.finish() {
-            let rgb = palette_rgb(color);
+            let rgb = self.palette.rgb(color);
             let mut paint = Paint::default();
             paint.set_color_rgba8(rgb[0], rgb[1], rgb[2], 255);
             paint.anti_alias = true;
@@ -216,8 +319,14 @@ impl Sink for PngWriter {
         }
     }
 
-    fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, _: u32) {
+    fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32) {
         self.flush();
+        if let Some(Some((solid, fill))) = self.organs.get(index as usize) {
+            let base = super::organ_color(fill.as_deref(), color, &self.palette);
+            let facets = super::organ_facets(solid, (at, h, l, scale), &self.view, base);
+            self.paint_facets(&facets);
+            return;
+        }
         let Some(Some((path, fill, stroke))) = self.elements.get(index as usize) else {
             return;
         };

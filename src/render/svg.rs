@@ -2,7 +2,7 @@
 //! elements are `<use>`s of shared `<defs>`, +y points up, and the viewBox is
 //! fitted to the drawing (found by a first, drawing-free pass of the turtle).
 
-use super::{Bounds, View, palette};
+use super::{Bounds, View};
 use crate::compile::ElementDef;
 use crate::number::{write_decimals, write_fixed};
 use crate::turtle::Sink;
@@ -35,6 +35,9 @@ pub struct SvgWriter<W: Write> {
     open: Option<Open>,
     buf: Vec<u8>,
     error: Option<io::Error>,
+    /// Each element's 3D organ and `fill`, if it is one.
+    organs: Vec<Option<(std::sync::Arc<crate::organ::Solid>, Option<String>)>>,
+    palette: super::Palette,
 }
 
 impl<W: Write> SvgWriter<W> {
@@ -79,7 +82,12 @@ impl<W: Write> SvgWriter<W> {
         if used.iter().any(|u| *u) {
             head.push_str("<defs>\n");
             for (i, e) in elements.iter().enumerate() {
-                if !used.get(i).copied().unwrap_or(false) {
+                // Organs are written in place; contours draw nothing.
+                if !used.get(i).copied().unwrap_or(false)
+                    || e.solid.is_some()
+                    || e.mesh.is_some()
+                    || e.is_contour()
+                {
                     continue;
                 }
                 let fill = e.fill.as_deref().unwrap_or("#3f7f3a");
@@ -104,7 +112,18 @@ impl<W: Write> SvgWriter<W> {
             open: None,
             buf: Vec::with_capacity(64),
             error: None,
+            organs: elements
+                .iter()
+                .map(|e| e.solid.clone().map(|s| (s, e.fill.clone())))
+                .collect(),
+            palette: super::Palette::default(),
         })
+    }
+
+    /// Paints `'(c)` colours from `palette` (the built-in one by default).
+    pub fn with_palette(mut self, palette: super::Palette) -> Self {
+        self.palette = palette;
+        self
     }
 
     fn write(&mut self, bytes: &[u8]) {
@@ -165,6 +184,32 @@ impl<W: Write> SvgWriter<W> {
             buf.push(b',');
             write_decimals(buf, -q.y, self.decimals);
         }
+    }
+
+    /// Writes an organ's facets (painter's order) as one group of filled
+    /// triangles, each outlined in its own colour as the PNG writer does.
+    fn organ(&mut self, index: u16, facets: &[super::Facet]) {
+        let mut buf = format!("<g class=\"organ\" data-element-index=\"{index}\" stroke-width=\"{}\" vector-effect=\"non-scaling-stroke\">\n", super::png::FACET_SEAM).into_bytes();
+        for f in facets {
+            let c = super::hex(f.rgb);
+            buf.extend_from_slice(
+                format!(
+                    "<path fill=\"{c}\" stroke=\"{c}\" vector-effect=\"non-scaling-stroke\" d=\"M"
+                )
+                .as_bytes(),
+            );
+            for (i, q) in f.points.iter().enumerate() {
+                if i > 0 {
+                    buf.push(b'L');
+                }
+                write_decimals(&mut buf, q.x, self.decimals);
+                buf.push(b' ');
+                write_decimals(&mut buf, -q.y, self.decimals);
+            }
+            buf.extend_from_slice(b"Z\"/>\n");
+        }
+        buf.extend_from_slice(b"</g>\n");
+        self.write(&buf);
     }
 
     /// Starts the layer of one guide's drawing.
@@ -256,7 +301,7 @@ impl<W: Write> Sink for SvgWriter<W> {
         let mut buf = std::mem::take(&mut self.buf);
         buf.clear();
         buf.extend_from_slice(b"<path stroke=\"");
-        buf.extend_from_slice(palette(color).as_bytes());
+        buf.extend_from_slice(self.palette.hex(color).as_bytes());
         buf.push(b'"');
         if width > 0.0 {
             buf.extend_from_slice(b" stroke-width=\"");
@@ -283,15 +328,21 @@ impl<W: Write> Sink for SvgWriter<W> {
         self.close_path();
         let mut buf = Vec::new();
         buf.extend_from_slice(b"<polygon fill=\"");
-        buf.extend_from_slice(palette(color).as_bytes());
+        buf.extend_from_slice(self.palette.hex(color).as_bytes());
         buf.extend_from_slice(b"\" stroke=\"none\" points=\"");
         self.write_points(&mut buf, points);
         buf.extend_from_slice(b"\"/>\n");
         self.write(&buf);
     }
 
-    fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, _: u32) {
+    fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32) {
         self.close_path();
+        if let Some(Some((solid, fill))) = self.organs.get(index as usize) {
+            let base = super::organ_color(fill.as_deref(), color, &self.palette);
+            let facets = super::organ_facets(solid, (at, h, l, scale), &self.view, base);
+            self.organ(index, &facets);
+            return;
+        }
         // Local (x, y) → world at + scale (−l x + h y), then flip y for SVG.
         let o = self.view.project(at);
         let ex = self.view.project_dir(-l * scale);

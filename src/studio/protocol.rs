@@ -50,7 +50,7 @@ pub struct Program {
     #[serde(skip)]
     pub max_modules: Option<usize>,
     /// Set by the server when a newer request replaces this one: the
-    /// derivation stops at its next step (error E0911). Not the page's.
+    /// derivation stops at its next step (error E0912). Not the page's.
     #[serde(skip)]
     pub cancel: Cancel,
 }

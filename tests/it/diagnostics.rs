@@ -27,6 +27,8 @@ const CLI_ONLY: &[Code] = &[
     Code::DecomposeTooDeep,
     // A run a newer request stopped: tests/it/studio.rs.
     Code::Cancelled,
+    // Mesh files are read by `lsyc run`: tests/it/plants.rs.
+    Code::MeshFile,
     // Only `lsyc run` needs an lsystem: tests/it/hostile.rs.
     Code::NoLsystem,
     // Warnings of a scene's run: tests/it/guided.rs.

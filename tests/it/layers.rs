@@ -14,6 +14,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("geometry", 0),
     ("diagnostic", 1),
     ("path", 1),
+    ("organ", 2),
     ("lexer", 2),
     ("ast", 3),
     ("parser", 5),

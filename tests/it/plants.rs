@@ -316,3 +316,276 @@ fn png_and_svg_agree_on_element_fills() {
         }
     }
 }
+
+/// A mesh target that keeps everything, for checking a mesh's numbers.
+#[derive(Default)]
+struct Mesh {
+    v: Vec<glam::DVec3>,
+    vn: Vec<glam::DVec3>,
+    faces: Vec<Vec<(u64, u64)>>,
+}
+
+impl lsyc::render::obj::MeshTarget for Mesh {
+    fn vertex(&mut self, p: glam::DVec3) {
+        self.v.push(p);
+    }
+    fn normal(&mut self, n: glam::DVec3) {
+        self.vn.push(n);
+    }
+    fn face(&mut self, corners: &[(u64, u64)]) {
+        self.faces.push(corners.to_vec());
+    }
+    fn material(&mut self, _: u32) {}
+    fn object(&mut self, _: &str) {}
+}
+
+fn mesh_of(d: &Derived) -> Mesh {
+    let options = lsyc::render::obj::ObjOptions::for_program(&d.prog);
+    let mut b = lsyc::render::obj::MeshBuilder::with_target(Mesh::default(), options);
+    d.interpret(0, &mut b).expect("draws");
+    b.into_target()
+}
+
+/// Every face index in range, every normal of unit length.
+#[track_caller]
+fn assert_valid_mesh(m: &Mesh) {
+    assert!(!m.faces.is_empty());
+    for f in &m.faces {
+        assert!(f.len() >= 3);
+        for &(v, n) in f {
+            assert!(
+                v >= 1 && v as usize <= m.v.len(),
+                "vertex {v} of {}",
+                m.v.len()
+            );
+            assert!(
+                n >= 1 && n as usize <= m.vn.len(),
+                "normal {n} of {}",
+                m.vn.len()
+            );
+        }
+    }
+    for n in &m.vn {
+        assert!((n.length() - 1.0).abs() < 1e-9, "normal {n}");
+    }
+}
+
+#[test]
+fn organs_are_placed_in_the_turtle_frame() {
+    // After F(2) the turtle stands at (0, 2, 0); +(90) turns H from +y to −x
+    // (L from −x to −y), *(2) doubles the scale. The sphere of radius 1 is then
+    // centred at (0, 2, 0) with radius 2, its local +y pole at (0,2,0) + 2H =
+    // (−2, 2, 0); the disk of radius 1 lies across H: its rim at local +x
+    // (along −L = +y) is at (0, 4, 0).
+    let d = derive(
+        "element B { sphere 1; }\nelement D { disk 1; }\nlsystem S { axiom F(2) +(90) *(2) B D; }\n",
+        None,
+    )
+    .expect("derives");
+    let m = mesh_of(&d);
+    assert_valid_mesh(&m);
+    let centre = glam::DVec3::new(0.0, 2.0, 0.0);
+    let has = |p: glam::DVec3| m.v.iter().any(|v| (*v - p).length() < 1e-9);
+    assert!(has(glam::DVec3::new(-2.0, 2.0, 0.0)), "the sphere's pole");
+    assert!(
+        has(glam::DVec3::new(2.0, 2.0, 0.0)),
+        "the sphere's other pole"
+    );
+    assert!(has(glam::DVec3::new(0.0, 4.0, 0.0)), "the disk's rim");
+    // Sphere vertices are 2 from the centre and their normals point outward.
+    let on_sphere =
+        m.v.iter()
+            .filter(|v| ((**v - centre).length() - 2.0).abs() < 1e-9)
+            .count();
+    assert!(on_sphere >= 50, "{on_sphere} sphere vertices");
+    for f in &m.faces {
+        let p = m.v[f[0].0 as usize - 1];
+        let n = m.vn[f[0].1 as usize - 1];
+        if ((p - centre).length() - 2.0).abs() < 1e-9 && p.x.abs() > 1e-6 {
+            assert!(n.dot(p - centre) > 0.0, "an inward normal at {p}");
+        }
+    }
+    // The disk faces along H (−x).
+    assert!(
+        m.vn.iter()
+            .any(|n| (*n - glam::DVec3::NEG_X).length() < 1e-9)
+    );
+    let (drawn, _) = run::measure(&d, 0).expect("measures");
+    assert_eq!(drawn.elements, 2);
+    let b = drawn.bbox.expect("a box");
+    assert!(
+        (b[0] + 2.0).abs() < 1e-9 && (b[3] - 4.0).abs() < 1e-9,
+        "{b:?}"
+    );
+}
+
+#[test]
+fn contours_shape_the_tube_rings() {
+    // A square contour of half-side 1 and width 2 (radius 1): the ring of
+    // F(3) from the origin has its corners at (±1, y, ±1) in some rotation,
+    // all √2 from the axis; without the contour the ring is a circle.
+    let prog = "element Sq { contour \"M1 1 L-1 1 L-1 -1 L1 -1 Z\"; }\nlsystem S { axiom !(2) Sq F(3) [Sq] F(1); }\n";
+    let d = derive(prog, None).expect("derives");
+    let m = mesh_of(&d);
+    assert_valid_mesh(&m);
+    let off_axis: Vec<f64> =
+        m.v.iter()
+            .filter(|v| v.y.abs() < 1e-9)
+            .map(|v| (v.x * v.x + v.z * v.z).sqrt())
+            .filter(|r| *r > 1e-9)
+            .collect();
+    assert_eq!(off_axis.len(), 4, "a square ring: {off_axis:?}");
+    assert!(off_axis.iter().all(|r| (r - 2f64.sqrt()).abs() < 1e-9));
+    let circle = derive("lsystem S { axiom !(2) F(3); }\n", None).expect("derives");
+    let m = mesh_of(&circle);
+    let ring =
+        m.v.iter()
+            .filter(|v| v.y.abs() < 1e-9 && v.length() > 1e-9)
+            .count();
+    assert_eq!(ring, 8);
+}
+
+#[test]
+fn patches_and_the_gallery_plant_are_valid_meshes() {
+    let text = read_text(&root().join("lang-examples/flowering-plant.lsy"));
+    let d = derive(&text, None).expect("derives");
+    let m = mesh_of(&d);
+    assert_valid_mesh(&m);
+    let (drawn, _) = run::measure(&d, 0).expect("measures");
+    assert!(drawn.elements > 20);
+}
+
+fn lsyc_in(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_lsyc"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("lsyc runs")
+}
+
+#[test]
+fn mesh_files_are_read_beside_the_program() {
+    let out = tempfile::tempdir().expect("tempdir");
+    let data = root().join("tests/data/organs");
+    let obj = out.path().join("m.obj");
+    // Run from elsewhere: the mesh is found beside the program, not the cwd.
+    let o = lsyc_in(
+        out.path(),
+        &[
+            "run",
+            data.join("mesh.lsy").to_str().expect("utf-8"),
+            "-o",
+            obj.to_str().expect("utf-8"),
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&obj).expect("obj");
+    // The leaf's corner (0.5, 1, 0) at scale 3 after F(2): (1.5, 5, 0)
+    // (local +x is −L, which is +x at the start).
+    assert!(text.contains("v 1.5 5 0"), "{text}");
+    for (file, want) in [
+        ("mesh-missing.lsy", "mesh-missing.lsy:1:"),
+        ("mesh-broken.lsy", "line 3"),
+    ] {
+        let o = lsyc_in(
+            out.path(),
+            &[
+                "run",
+                data.join(file).to_str().expect("utf-8"),
+                "-o",
+                obj.to_str().expect("utf-8"),
+            ],
+        );
+        assert_eq!(o.status.code(), Some(1), "{file}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("E0911") && err.contains(want), "{file}: {err}");
+    }
+}
+
+/// The colours usvg reads on every painted path of an SVG (fills and strokes).
+fn svg_colours(svg: &str) -> Vec<[u8; 3]> {
+    let tree = usvg::Tree::from_str(svg, &usvg::Options::default()).expect("usvg reads it");
+    let mut out = Vec::new();
+    fn paint(p: &usvg::Paint, out: &mut Vec<[u8; 3]>) {
+        if let usvg::Paint::Color(c) = p {
+            out.push([c.red, c.green, c.blue]);
+        }
+    }
+    fn walk(g: &usvg::Group, out: &mut Vec<[u8; 3]>) {
+        for n in g.children() {
+            match n {
+                usvg::Node::Group(g) => walk(g, out),
+                usvg::Node::Path(p) => {
+                    if let Some(f) = p.fill() {
+                        paint(f.paint(), out);
+                    }
+                    if let Some(s) = p.stroke() {
+                        paint(s.paint(), out);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    walk(tree.root(), &mut out);
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+#[test]
+fn png_and_svg_agree_on_every_colour() {
+    // Segments of two colours and widths, a polygon, a flat element with its
+    // own fill and stroke, and a 3D organ (one flat-shaded colour: a disk):
+    // every colour the SVG paints is painted, exactly, somewhere in the PNG.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let program = "element Sq { path \"M-2 0 L2 0 L2 4 L-2 4 Z\"; fill \"#d03020\"; stroke \"#2040d0\"; width 3; }\n\
+        element Dk { disk 3; fill \"#e0b000\"; }\n\
+        lsystem S { axiom !(1) '(1) F(10) '(8) [+(90) F(8)] '(10) {. f(6) . -(90) f(6) . -(90) f(6) .} f(12) Sq f(10) Dk; }\n";
+    let (svg, png) = render_both(program, dir.path(), "all");
+    let want = svg_colours(&svg);
+    assert!(want.len() >= 5, "{want:?}");
+    let mut have = std::collections::BTreeSet::new();
+    for p in png.pixels() {
+        if p.alpha() == 255 {
+            have.insert([p.red(), p.green(), p.blue()]);
+        }
+    }
+    for c in &want {
+        assert!(have.contains(c), "the SVG paints {c:?}, the PNG nowhere");
+    }
+}
+
+#[test]
+fn a_palette_states_the_colours_of_every_output() {
+    // Colour 1 is the program's; 2 is not listed and keeps the built-in
+    // colour; bare `'` steps from 1 to 2 and stops at the palette's last index.
+    let program = "palette {\n    1 \"#102030\" bark;\n    2 \"#a0b0c0\";\n}\nlsystem S { axiom '(1) F ' +(90) F ' +(90) F; }\n";
+    let d = derive(program, None).expect("derives");
+    let mut svg = Vec::new();
+    assert!(run::write_output(&d, Format::Svg, Picture::default(), 0, &mut svg).is_ok());
+    let svg = String::from_utf8(svg).expect("utf-8");
+    assert!(svg.contains("stroke=\"#102030\""), "{svg}");
+    assert!(svg.contains("stroke=\"#a0b0c0\""), "{svg}");
+    // The third segment: bare ' past the last index stays at 2.
+    assert_eq!(svg.matches("stroke=\"#a0b0c0\"").count(), 1, "{svg}");
+    let mut obj = Vec::new();
+    let written = run::write_output_full(&d, Format::Obj, &Picture::default(), 0, &mut obj)
+        .unwrap_or_else(|_| panic!("writes OBJ"));
+    let obj = String::from_utf8(obj).expect("utf-8");
+    assert!(obj.contains("usemtl bark"), "{obj}");
+    assert!(obj.contains("usemtl lsyc_color2"), "{obj}");
+    let mut mtl = Vec::new();
+    lsyc::render::obj::write_mtl_with(&mut mtl, &written.materials, &written.palette).expect("mtl");
+    let mtl = String::from_utf8(mtl).expect("utf-8");
+    assert!(
+        mtl.contains("newmtl bark") && mtl.contains("# #102030"),
+        "{mtl}"
+    );
+    // Without a palette, bare ' gives ABOP's greens (3 and on).
+    let plain = derive("lsystem S { axiom F ' F; }\n", None).expect("derives");
+    let mut svg = Vec::new();
+    assert!(run::write_output(&plain, Format::Svg, Picture::default(), 0, &mut svg).is_ok());
+    let want = format!("stroke=\"{}\"", lsyc::render::palette(3));
+    assert!(String::from_utf8(svg).expect("utf-8").contains(&want));
+}

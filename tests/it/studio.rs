@@ -633,7 +633,7 @@ fn a_newer_edit_stops_a_run_in_progress() {
         took < std::time::Duration::from_secs(20),
         "the old run was stopped, not waited for: {took:?}"
     );
-    // The run stops between steps with E0911 when the flag is set.
+    // The run stops between steps with E0912 when the flag is set.
     static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
     let p = Program {
         cancel: protocol::Cancel(Some(&STOP)),
@@ -642,7 +642,7 @@ fn a_newer_edit_stops_a_run_in_progress() {
     let reply = protocol::run(&p, "slow.lsy");
     assert!(!reply.ok);
     assert_eq!(
-        reply.diagnostics[0]["code"], "E0911",
+        reply.diagnostics[0]["code"], "E0912",
         "{:?}",
         reply.diagnostics
     );

@@ -78,9 +78,15 @@ fn frame_path(path: &Path, k: u32, last: u32) -> PathBuf {
 
 /// Writes the `.mtl` of an OBJ's materials atomically; false after reporting
 /// why it failed.
-fn write_mtl(obj: &Path, materials: &[u32], reporter: &Reporter, src: &source::Source) -> bool {
+fn write_mtl(
+    obj: &Path,
+    materials: &[u32],
+    palette: &lsyc::render::Palette,
+    reporter: &Reporter,
+    src: &source::Source,
+) -> bool {
     write_file(&mtl_path(obj), reporter, src, |w| {
-        lsyc::render::obj::write_mtl(w, materials).map_err(OutputError::Io)
+        lsyc::render::obj::write_mtl_with(w, materials, palette).map_err(OutputError::Io)
     })
     .is_some()
 }
@@ -220,7 +226,9 @@ fn write_one(
         run::write_output_full(d, format, picture, seed, w)
     })
     .ok_or(1u8)?;
-    if format == Format::Obj && !write_mtl(path, &written.materials, reporter, src) {
+    if format == Format::Obj
+        && !write_mtl(path, &written.materials, &written.palette, reporter, src)
+    {
         return Err(1);
     }
     Ok(written)
@@ -252,7 +260,15 @@ pub fn write_scene(
         s.finish_and_clear();
     }
     let stats = stats?;
-    if format == Some(Format::Obj) && !write_mtl(path, &stats.materials, reporter, src) {
+    if format == Some(Format::Obj)
+        && !write_mtl(
+            path,
+            &stats.materials,
+            &lsyc::render::Palette::default(),
+            reporter,
+            src,
+        )
+    {
         return None;
     }
     Some(stats)

@@ -32,13 +32,15 @@ mod text;
 mod tube;
 
 pub use outline::{ElementOutline, outline_from_path};
-pub use text::{MATERIAL_PREFIX, ObjText, material_name, write_mtl};
+pub use text::{MATERIAL_PREFIX, ObjText, material_name, write_mtl, write_mtl_with};
 
 use crate::compile::Program;
+use crate::organ::Solid;
 use crate::turtle::Sink;
 use glam::DVec3;
 use std::collections::{BTreeSet, HashMap, VecDeque};
 use std::io::{self, Write};
+use std::sync::Arc;
 use tube::{Chain, Joint};
 
 /// Where the built mesh goes. Vertices and normals are numbered from 1, each
@@ -56,6 +58,8 @@ pub trait MeshTarget {
     /// Faces that follow belong to a new object called `name` (an lsystem, a
     /// scene's guide).
     fn object(&mut self, name: &str);
+    /// The colours and material names of the faces' colours.
+    fn palette(&mut self, _palette: &crate::render::Palette) {}
     /// A remark for a reader of the file (OBJ comments; ignored elsewhere).
     fn comment(&mut self, _text: &str) {}
 }
@@ -84,6 +88,12 @@ pub struct ObjOptions {
     pub default_radius: f64,
     /// The outline of every element, by element index.
     pub elements: Vec<ElementOutline>,
+    /// The 3D organ of every element that is one, by element index.
+    pub solids: Vec<Option<Arc<Solid>>>,
+    /// The contour of every element that declares one, by element index.
+    pub contours: Vec<Option<Arc<Vec<glam::DVec2>>>>,
+    /// The colours and their material names.
+    pub palette: crate::render::Palette,
 }
 
 impl Default for ObjOptions {
@@ -92,6 +102,9 @@ impl Default for ObjOptions {
             sides: 8,
             default_radius: 0.05,
             elements: Vec::new(),
+            solids: Vec::new(),
+            contours: Vec::new(),
+            palette: crate::render::Palette::default(),
         }
     }
 }
@@ -113,6 +126,9 @@ impl ObjOptions {
                 .iter()
                 .map(|e| outline_from_path(&e.path).unwrap_or_default())
                 .collect(),
+            solids: prog.elements.iter().map(|e| e.solid.clone()).collect(),
+            contours: prog.elements.iter().map(|e| e.contour.clone()).collect(),
+            palette: crate::render::Palette::of(prog),
             ..ObjOptions::default()
         }
     }
@@ -139,6 +155,13 @@ pub struct MeshBuilder<T: MeshTarget> {
     default_radius: f64,
     /// Element outlines, cleaned and counter-clockwise.
     elements: Vec<Vec<glam::DVec2>>,
+    /// 3D organs by element index.
+    solids: Vec<Option<Arc<Solid>>>,
+    /// Ring profiles: 0 the circle, element index + 1 a contour; each vertex
+    /// as (offset x, offset y, normal x, normal y) in units of the radius.
+    profiles: Vec<Arc<Vec<[f64; 4]>>>,
+    /// The profile of the segments that follow.
+    profile: usize,
     /// Open chains, the most recently extended last.
     open: Vec<Chain>,
     joints: HashMap<[u64; 3], Joint>,
@@ -178,9 +201,10 @@ impl<W: Write> MeshBuilder<ObjText<W>> {
 }
 
 impl<T: MeshTarget> MeshBuilder<T> {
-    pub fn with_target(out: T, options: ObjOptions) -> Self {
+    pub fn with_target(mut out: T, options: ObjOptions) -> Self {
+        out.palette(&options.palette);
         let sides = options.sides.clamp(3, MAX_SIDES);
-        let ring_angles = (0..sides)
+        let ring_angles: Vec<(f64, f64)> = (0..sides)
             .map(|i| {
                 let t = std::f64::consts::TAU * i as f64 / sides as f64;
                 (t.cos(), t.sin())
@@ -196,12 +220,23 @@ impl<T: MeshTarget> MeshBuilder<T> {
             .into_iter()
             .map(ElementOutline::oriented)
             .collect();
+        let circle: Vec<[f64; 4]> = ring_angles.iter().map(|&(c, s)| [c, s, c, s]).collect();
+        let mut profiles = vec![Arc::new(circle.clone())];
+        for c in &options.contours {
+            profiles.push(Arc::new(
+                c.as_deref()
+                    .map_or_else(|| circle.clone(), |c| tube::profile(c)),
+            ));
+        }
         let mut w = MeshBuilder {
             out,
             sides,
             ring_angles,
             default_radius,
             elements,
+            solids: options.solids,
+            profiles,
+            profile: 0,
             open: Vec::new(),
             joints: HashMap::new(),
             joint_order: VecDeque::new(),
@@ -299,7 +334,7 @@ impl<T: MeshTarget> Sink for MeshBuilder<T> {
         let r = self.radius(width).max(resolution);
         if let Some(i) = self.open.iter().rposition(|c| c.end == a) {
             let chain = self.open.remove(i);
-            if Self::can_mitre(&chain, dir, len, r) {
+            if chain.profile == self.profile && Self::can_mitre(&chain, dir, len, r) {
                 let next = self.mitre(chain, b, dir, len, r, color);
                 self.open.push(next);
                 self.remember(b, r);
@@ -329,7 +364,21 @@ impl<T: MeshTarget> Sink for MeshBuilder<T> {
         }
     }
 
+    fn contour(&mut self, element: Option<u16>) {
+        self.profile = element.map_or(0, |e| e as usize + 1);
+        if self.profile >= self.profiles.len() {
+            self.profile = 0;
+        }
+    }
+
     fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32) {
+        if let Some(Some(solid)) = self.solids.get(index as usize) {
+            let solid = Arc::clone(solid);
+            if self.organ(&solid, (at, h, l, scale), color) {
+                self.counts.elements += 1;
+            }
+            return;
+        }
         let Some(outline) = self.elements.get(index as usize) else {
             return;
         };
@@ -350,6 +399,51 @@ impl<T: MeshTarget> Sink for MeshBuilder<T> {
 }
 
 impl<T: MeshTarget> MeshBuilder<T> {
+    /// A 3D organ's triangles placed in the turtle's frame (U = H × L): points
+    /// scaled, normals turned with the frame. A negative scale mirrors the
+    /// organ through its origin, so its normals and windings turn over.
+    fn organ(&mut self, solid: &Solid, frame: (DVec3, DVec3, DVec3, f64), color: u32) -> bool {
+        let (at, h, l, scale) = frame;
+        let u = h.cross(l);
+        if solid.triangles.is_empty() || !(at.is_finite() && scale.is_finite()) || scale == 0.0 {
+            return false;
+        }
+        let world = |p: DVec3| at + (-l * p.x + h * p.y + u * p.z) * scale;
+        if !solid.points.iter().all(|&p| world(p).is_finite()) {
+            return false;
+        }
+        self.material(color);
+        let (v0, n0) = (self.v, self.vn);
+        for &p in &solid.points {
+            self.vertex(world(p));
+        }
+        let flip = if scale < 0.0 { -1.0 } else { 1.0 };
+        for &n in &solid.normals {
+            let w = (-l * n.x + h * n.y + u * n.z) * flip;
+            self.normal(w.try_normalize().unwrap_or(h));
+        }
+        // Triangles the written digits would not resolve (a patch's collapsed
+        // edge, a tiny scale) are left out, as `face` leaves such faces out.
+        let extent = solid
+            .points
+            .iter()
+            .fold(1e-9f64, |m, &p| m.max(world(p).abs().max_element()));
+        let resolution = RESOLUTION * extent;
+        for t in &solid.triangles {
+            let [a, b, c] = t.map(|(p, _)| world(solid.points[p as usize]));
+            if 0.5 * (b - a).cross(c - a).length() <= resolution * resolution {
+                continue;
+            }
+            let c = t.map(|(p, n)| (v0 + u64::from(p) + 1, n0 + u64::from(n) + 1));
+            if scale < 0.0 {
+                self.tri(c[0], c[2], c[1]);
+            } else {
+                self.tri(c[0], c[1], c[2]);
+            }
+        }
+        true
+    }
+
     /// One n-gon face with a single normal (by default the polygon's own, by
     /// Newell's method). Nothing is written for a face whose area the written
     /// digits would not resolve.

@@ -27,6 +27,7 @@ pub struct ObjText<W: Write> {
     buf: Vec<u8>,
     /// The first write error; nothing is written after it.
     error: Option<io::Error>,
+    palette: crate::render::Palette,
 }
 
 impl<W: Write> ObjText<W> {
@@ -35,6 +36,7 @@ impl<W: Write> ObjText<W> {
             out,
             buf: Vec::with_capacity(BUFFER + 256),
             error: None,
+            palette: crate::render::Palette::default(),
         }
     }
 
@@ -110,7 +112,7 @@ impl<W: Write> MeshTarget for ObjText<W> {
     }
 
     fn material(&mut self, color: u32) {
-        self.text(&format!("usemtl {}\n", material_name(color)));
+        self.text(&format!("usemtl {}\n", self.palette.material(color)));
     }
 
     fn object(&mut self, name: &str) {
@@ -120,6 +122,10 @@ impl<W: Write> MeshTarget for ObjText<W> {
             .map(|c| if c.is_whitespace() { '_' } else { c })
             .collect();
         self.text(&format!("o {name}\n"));
+    }
+
+    fn palette(&mut self, palette: &crate::render::Palette) {
+        self.palette = palette.clone();
     }
 
     fn comment(&mut self, text: &str) {
@@ -133,18 +139,27 @@ impl<W: Write> MeshTarget for ObjText<W> {
 /// named as `usemtl` names it, its `Kd` the palette colour in linear RGB (as
 /// glTF's base colour).
 pub fn write_mtl(out: &mut dyn Write, colors: &[u32]) -> io::Result<()> {
+    write_mtl_with(out, colors, &crate::render::Palette::default())
+}
+
+/// [`write_mtl`] with a program's palette: its colours and material names.
+pub fn write_mtl_with(
+    out: &mut dyn Write,
+    colors: &[u32],
+    palette: &crate::render::Palette,
+) -> io::Result<()> {
     let mut buf = Vec::new();
     buf.extend_from_slice(b"# lsyc MTL: one material per palette colour\n");
     for &c in colors {
-        let [r, g, b] = crate::render::palette_linear(c);
-        buf.extend_from_slice(format!("\nnewmtl {}\n", material_name(c)).as_bytes());
+        let [r, g, b] = palette.linear(c);
+        buf.extend_from_slice(format!("\nnewmtl {}\n", palette.material(c)).as_bytes());
         buf.extend_from_slice(b"Kd");
         for x in [r, g, b] {
             buf.push(b' ');
             write_significant(&mut buf, x);
         }
         buf.extend_from_slice(b"\nKa 0 0 0\nKs 0 0 0\nd 1\nillum 1\n");
-        buf.extend_from_slice(format!("# {}\n", crate::render::palette(c)).as_bytes());
+        buf.extend_from_slice(format!("# {}\n", palette.hex(c)).as_bytes());
     }
     out.write_all(&buf)?;
     out.flush()

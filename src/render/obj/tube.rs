@@ -14,6 +14,8 @@ use glam::{DQuat, DVec3};
 pub(super) struct Ring {
     pub(super) v: u64,
     pub(super) n: u64,
+    /// Vertices (and normals) in the ring.
+    pub(super) k: u64,
 }
 
 /// A tube whose last segment's end ring is not written yet: the next segment
@@ -29,6 +31,8 @@ pub(super) struct Chain {
     pub(super) n: DVec3,
     pub(super) radius: f64,
     pub(super) color: u32,
+    /// The ring profile (the builder's `profiles`).
+    pub(super) profile: usize,
     /// The ring at the start of the last segment.
     pub(super) ring: Ring,
 }
@@ -52,9 +56,12 @@ impl<T: MeshTarget> MeshBuilder<T> {
         }
     }
 
-    /// Writes a ring: vertex i at `point(i)`, normal i `normal(i)`.
+    /// Writes a ring of `profile`: vertex i at `point(offset i)`, normal i
+    /// `normal(normal i)`, offsets and normals in the plane across `dir`
+    /// spanned by `n` and `dir × n`.
     fn ring(
         &mut self,
+        profile: usize,
         point: impl Fn(DVec3) -> DVec3,
         normal: impl Fn(DVec3) -> DVec3,
         n: DVec3,
@@ -63,25 +70,25 @@ impl<T: MeshTarget> MeshBuilder<T> {
         let b = dir.cross(n);
         let first_v = self.v + 1;
         let first_n = self.vn + 1;
-        for i in 0..self.sides {
-            let (c, s) = self.ring_angles[i];
-            self.vertex(point(n * c + b * s));
+        let prof = std::sync::Arc::clone(&self.profiles[profile]);
+        for &[x, y, _, _] in prof.iter() {
+            self.vertex(point(n * x + b * y));
         }
-        for i in 0..self.sides {
-            let (c, s) = self.ring_angles[i];
-            let radial = n * c + b * s;
+        for &[_, _, nx, ny] in prof.iter() {
+            let radial = n * nx + b * ny;
             self.normal(normal(radial).try_normalize().unwrap_or(radial));
         }
         Ring {
             v: first_v,
             n: first_n,
+            k: prof.len() as u64,
         }
     }
 
     /// The side of a tube between two rings (`a` behind `b`): one quad per side
     /// (planar unless the radius changes).
     fn side(&mut self, a: Ring, b: Ring) {
-        let k = self.sides as u64;
+        let k = a.k.min(b.k);
         for i in 0..k {
             let j = (i + 1) % k;
             self.out.face(&[
@@ -99,7 +106,7 @@ impl<T: MeshTarget> MeshBuilder<T> {
     fn cap(&mut self, ring: Ring, centre: DVec3, outward: DVec3, reverse: bool) {
         let c = self.vertex(centre);
         let cn = self.normal(outward);
-        let k = self.sides as u64;
+        let k = ring.k;
         for i in 0..k {
             let j = (i + 1) % k;
             let (p, q) = ((ring.v + i, cn), (ring.v + j, cn));
@@ -157,7 +164,7 @@ impl<T: MeshTarget> MeshBuilder<T> {
     pub(super) fn close(&mut self, chain: Chain) {
         self.material(chain.color);
         let (end, r) = (chain.end, chain.radius);
-        let ring = self.ring(|v| end + v * r, |v| v, chain.n, chain.dir);
+        let ring = self.ring(chain.profile, |v| end + v * r, |v| v, chain.n, chain.dir);
         self.side(chain.ring, ring);
         self.cap(ring, end, chain.dir, false);
         self.counts.tubes += 1;
@@ -194,6 +201,7 @@ impl<T: MeshTarget> MeshBuilder<T> {
         let rj = 0.5 * (chain.radius + r);
         let p = chain.end;
         let ring = self.ring(
+            chain.profile,
             |v| p + v * rj - d0 * (rj * v.dot(m) / cos_half),
             |v| v + rot * v,
             chain.n,
@@ -211,6 +219,7 @@ impl<T: MeshTarget> MeshBuilder<T> {
             n,
             radius: r,
             color,
+            profile: chain.profile,
             ring,
         }
     }
@@ -258,7 +267,8 @@ impl<T: MeshTarget> MeshBuilder<T> {
         }
         self.remember(a, r);
         let n = perpendicular(dir);
-        let ring = self.ring(|v| a + v * r, |v| v, n, dir);
+        let profile = self.profile;
+        let ring = self.ring(profile, |v| a + v * r, |v| v, n, dir);
         self.cap(ring, a, -dir, true);
         self.open.push(Chain {
             end: b,
@@ -267,6 +277,7 @@ impl<T: MeshTarget> MeshBuilder<T> {
             n,
             radius: r,
             color,
+            profile,
             ring,
         });
         if self.open.len() > MAX_OPEN_CHAINS {
@@ -274,6 +285,25 @@ impl<T: MeshTarget> MeshBuilder<T> {
             self.close(oldest);
         }
     }
+}
+
+/// A ring profile from a counter-clockwise contour: each point with the unit
+/// normal of its corner (the mean of its two edges' outward normals).
+pub(super) fn profile(c: &[glam::DVec2]) -> Vec<[f64; 4]> {
+    let k = c.len();
+    (0..k)
+        .map(|i| {
+            let outward = |a: glam::DVec2, b: glam::DVec2| {
+                let e = b - a;
+                glam::DVec2::new(e.y, -e.x).normalize_or_zero()
+            };
+            let n = outward(c[(i + k - 1) % k], c[i]) + outward(c[i], c[(i + 1) % k]);
+            let n = n
+                .try_normalize()
+                .unwrap_or(c[i].normalize_or(glam::DVec2::X));
+            [c[i].x, c[i].y, n.x, n.y]
+        })
+        .collect()
 }
 
 /// The exact position as a map key (−0 and +0 are the same point).
