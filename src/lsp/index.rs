@@ -269,7 +269,8 @@ impl Builder {
                 Item::Element(e) => (Ns::Module, Kind::Element, &e.name),
                 Item::Lsystem(l) => (Ns::Lsystem, Kind::Lsystem, &l.name),
                 Item::Scene(s) => (Ns::Scene, Kind::Scene, &s.name),
-                Item::Error => continue,
+                // A palette names colours and materials, not anything a program refers to.
+                Item::Palette(_) | Item::Error => continue,
             };
             if name.name.is_empty() {
                 continue;
@@ -293,7 +294,7 @@ impl Builder {
                 }
                 Item::Lsystem(l) => self.lsystem(i, l),
                 Item::Scene(s) => self.scene(i, s),
-                Item::Module(_) | Item::Error => {}
+                Item::Module(_) | Item::Palette(_) | Item::Error => {}
             }
         }
     }
