@@ -16,6 +16,7 @@
 
 use super::read::Element;
 use super::{Budget, TooMuchWork};
+use rayon::prelude::*;
 use crate::infer::strokes::Seg;
 use glam::DVec2;
 use std::collections::HashMap;
@@ -514,7 +515,7 @@ pub fn instancing(
 ) -> Result<Instancing, TooMuchWork> {
     let mut budget = Budget::new("comparisons of element outlines", MAX_COMPARISONS);
     let shapes: Vec<Shape> = elements
-        .iter()
+        .par_iter()
         .map(|e| {
             Shape::of(&e.outline).unwrap_or_else(|| {
                 // A point-like element: describe it by its box.

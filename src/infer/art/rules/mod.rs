@@ -26,6 +26,7 @@ use super::space::{Point, Tr, cluster};
 use super::{Budget, TooMuchWork};
 use crate::geometry::index::PointGrid;
 use glam::DVec2;
+use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 
@@ -360,38 +361,44 @@ pub fn infer(
     }
 }
 
-/// Directed edges between each live instance and its nearest neighbours.
+/// Directed edges between each live instance and its nearest neighbours,
+/// by their two ends (the lower live index first), each pair both ways.
 fn edges(insts: &[Inst], live: &[usize], diagonal: f64) -> Vec<Edge> {
     let centres: Vec<DVec2> = live.iter().map(|&i| insts[i].centre()).collect();
     let grid = PointGrid::new(&centres);
-    let mut pairs: BTreeSet<(usize, usize)> = BTreeSet::new();
-    for (a, c) in centres.iter().enumerate() {
-        for b in grid.nearest(*c, NEIGHBOURS + 1) {
-            if a != b {
-                pairs.insert((a.min(b), a.max(b)));
-            }
-        }
-    }
-    let mut out = Vec::with_capacity(pairs.len() * 2);
-    for (a, b) in pairs {
-        let (i, j) = (live[a], live[b]);
-        let gap = {
-            let (p, q) = (&insts[i], &insts[j]);
-            let dx = (q.min.x - p.max.x).max(p.min.x - q.max.x).max(0.0);
-            let dy = (q.min.y - p.max.y).max(p.min.y - q.max.y).max(0.0);
-            (dx * dx + dy * dy).sqrt() / diagonal
-        };
-        for (from, to) in [(i, j), (j, i)] {
-            let size = insts[from].size() / insts[from].frame.scale;
-            out.push(Edge {
-                from,
-                to,
-                t: Tr::between(&insts[from].frame, &insts[to].frame, size),
-                gap,
-            });
-        }
-    }
-    out
+    let mut pairs: Vec<(usize, usize)> = centres
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(a, c)| {
+            grid.nearest(*c, NEIGHBOURS + 1)
+                .into_iter()
+                .filter(move |&b| a != b)
+                .map(move |b| (a.min(b), a.max(b)))
+        })
+        .collect();
+    pairs.par_sort_unstable();
+    pairs.dedup();
+    pairs
+        .par_iter()
+        .flat_map_iter(|&(a, b)| {
+            let (i, j) = (live[a], live[b]);
+            let gap = {
+                let (p, q) = (&insts[i], &insts[j]);
+                let dx = (q.min.x - p.max.x).max(p.min.x - q.max.x).max(0.0);
+                let dy = (q.min.y - p.max.y).max(p.min.y - q.max.y).max(0.0);
+                (dx * dx + dy * dy).sqrt() / diagonal
+            };
+            [(i, j), (j, i)].map(|(from, to)| {
+                let size = insts[from].size() / insts[from].frame.scale;
+                Edge {
+                    from,
+                    to,
+                    t: Tr::between(&insts[from].frame, &insts[to].frame, size),
+                    gap,
+                }
+            })
+        })
+        .collect()
 }
 
 fn point(t: &Tr, tol: Tolerance) -> Point {
@@ -493,12 +500,11 @@ fn candidates(
         }
         let phi = if a == b { 1.0 } else { 0.5 };
         let near = (tol.regular && a == b).then(|| Near::new(insts, *a));
-        for group in &groups {
-            if let Some(c) = sequence(insts, edges, &index, group, a == b, tol, phi, near.as_ref())
-            {
-                out.push(c);
-            }
-        }
+        let found: Vec<Option<Candidate>> = groups
+            .par_iter()
+            .map(|group| sequence(insts, edges, &index, group, a == b, tol, phi, near.as_ref()))
+            .collect();
+        out.extend(found.into_iter().flatten());
         if a == b {
             // Branchings: two or three clusters of one kind, each node with
             // a child in each.
@@ -509,12 +515,21 @@ fn candidates(
             let pairs = (0..n).flat_map(|x| (x + 1..n).map(move |y| vec![x, y]));
             let triples = (0..n)
                 .flat_map(|x| (x + 1..n).flat_map(move |y| (y + 1..n).map(move |z| vec![x, y, z])));
-            for set in pairs.chain(triples) {
-                let groups: Vec<&[usize]> = set.iter().map(|&g| big[g].as_slice()).collect();
-                if let Some(c) = branching(insts, edges, &index, &groups, tol) {
-                    out.push(c);
-                }
-            }
+            let sets: Vec<Vec<usize>> = pairs.chain(triples).collect();
+            // Each cluster's child map and transform, once for all the sets
+            // it is in; the sets are tried in parallel, kept in their order.
+            let children: Vec<Children> = big
+                .par_iter()
+                .map(|g| Children::of(edges, g, tol))
+                .collect();
+            let found: Vec<Option<Candidate>> = sets
+                .par_iter()
+                .map(|set| {
+                    let groups: Vec<&Children> = set.iter().map(|&g| &children[g]).collect();
+                    branching(insts, edges, &index, &groups, tol)
+                })
+                .collect();
+            out.extend(found.into_iter().flatten());
             out.extend(linear::linear(insts, edges, &index, ks, tol, budget)?);
         }
     }
@@ -812,7 +827,7 @@ fn seq_candidate(
 /// one step of the recursive definition `depth(v) = 1 + min_i depth(child[i][v])`.
 fn depth_of(
     v: usize,
-    child: &[HashMap<usize, usize>],
+    child: &[&HashMap<usize, usize>],
     memo: &mut HashMap<usize, u32>,
     open: &mut HashSet<usize>,
 ) -> u32 {
@@ -863,30 +878,44 @@ fn depth_of(
     found
 }
 
+/// One cluster of edges as a transform of branchings: each node's child by
+/// it (the edge of lowest index out of the node), and the transform.
+struct Children {
+    child: HashMap<usize, usize>,
+    t: Tr,
+}
+
+impl Children {
+    fn of(edges: &[Edge], group: &[usize], tol: Tolerance) -> Children {
+        let mut child: HashMap<usize, usize> = HashMap::with_capacity(group.len());
+        let mut sorted = group.to_vec();
+        sorted.sort_unstable();
+        for k in sorted {
+            child.entry(edges[k].from).or_insert(edges[k].to);
+        }
+        let ts: Vec<Tr> = group.iter().map(|&k| edges[k].t).collect();
+        Children {
+            child,
+            t: supported_mean(&ts, tol),
+        }
+    }
+}
+
 /// Complete trees whose children come from `groups` (clusters of edges, one
 /// per transform).
 fn branching(
     insts: &[Inst],
     edges: &[Edge],
     index: &Index,
-    groups: &[&[usize]],
+    groups: &[&Children],
     tol: Tolerance,
 ) -> Option<Candidate> {
-    let child_map = |g: &[usize]| {
-        let mut m: HashMap<usize, usize> = HashMap::new();
-        let mut sorted = g.to_vec();
-        sorted.sort_unstable();
-        for k in sorted {
-            m.entry(edges[k].from).or_insert(edges[k].to);
-        }
-        m
-    };
-    let mut child: Vec<HashMap<usize, usize>> = groups.iter().map(|g| child_map(g)).collect();
+    let maps: Vec<&HashMap<usize, usize>> = groups.iter().map(|g| &g.child).collect();
     let both: Vec<usize> = {
-        let mut v: Vec<usize> = child[0]
+        let mut v: Vec<usize> = maps[0]
             .keys()
             .copied()
-            .filter(|k| child[1..].iter().all(|c| c.contains_key(k)))
+            .filter(|k| maps[1..].iter().all(|c| c.contains_key(k)))
             .collect();
         v.sort_unstable();
         v
@@ -898,7 +927,7 @@ fn branching(
     let mut depth: HashMap<usize, u32> = HashMap::new();
     let mut open = HashSet::new();
     for &v in &both {
-        depth_of(v, &child, &mut depth, &mut open);
+        depth_of(v, &maps, &mut depth, &mut open);
     }
     let mut roots: Vec<(usize, u32)> = both
         .iter()
@@ -906,10 +935,7 @@ fn branching(
         .filter(|&(_, d)| d >= 1)
         .collect();
     roots.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
-    let ts: Vec<Tr> = groups
-        .iter()
-        .map(|g| supported_mean(&g.iter().map(|&k| edges[k].t).collect::<Vec<_>>(), tol))
-        .collect();
+    let ts: Vec<Tr> = groups.iter().map(|g| g.t).collect();
     let mut claimed: HashSet<usize> = HashSet::new();
     let mut trees = Vec::new();
     let mut leaves: Vec<(usize, Frame)> = Vec::new();
@@ -925,7 +951,7 @@ fn branching(
         for _ in 0..d {
             let mut below = Vec::new();
             for &(v, f) in &level {
-                for (map, tr) in child.iter().zip(&ts) {
+                for (map, tr) in maps.iter().zip(&ts) {
                     let c = map[&v];
                     let want = tr.apply(&f);
                     if claimed.contains(&c)
@@ -957,6 +983,7 @@ fn branching(
     if trees.is_empty() {
         return None;
     }
+    let mut child: Vec<HashMap<usize, usize>> = maps.into_iter().cloned().collect();
     if let Some(tips) = tree_tips(insts, edges, &leaves, &ts, &claimed, tol) {
         for (&(leaf, _), below) in leaves.iter().zip(tips) {
             for (map, &c) in child.iter_mut().zip(&below) {
