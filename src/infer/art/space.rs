@@ -20,7 +20,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 /// defence against chosen keys is needed beyond the mixing): the Fx hash
 /// of rustc. Iteration order of the maps is never used.
 #[derive(Clone, Copy, Default)]
-struct CellHasher(u64);
+pub(crate) struct CellHasher(u64);
 
 impl Hasher for CellHasher {
     fn write(&mut self, bytes: &[u8]) {
@@ -48,7 +48,8 @@ impl Hasher for CellHasher {
     }
 }
 
-type CellMap<K, V> = HashMap<K, V, BuildHasherDefault<CellHasher>>;
+/// A map keyed by small numbers lsyc computes (cells, instance indices).
+pub(crate) type CellMap<K, V> = HashMap<K, V, BuildHasherDefault<CellHasher>>;
 
 /// A transform from one frame to another, as turtle commands
 /// `+(alpha) f(d) *(s) +(beta)` (angles in radians).

@@ -22,7 +22,7 @@ mod linear;
 mod regular;
 
 use super::shape::{Frame, wrap};
-use super::space::{Point, Tr, cluster};
+use super::space::{CellMap, Point, Tr, cluster};
 use super::{Budget, TooMuchWork};
 use crate::geometry::index::PointGrid;
 use glam::DVec2;
@@ -268,7 +268,7 @@ struct Candidate {
 }
 
 /// Edges by their two ends.
-type Index = HashMap<(usize, usize), usize>;
+type Index = CellMap<(usize, usize), usize>;
 
 /// The largest change of a turn per step of a linear sequence, radians.
 const LINEAR_STEP_MAX: f64 = 30.0 * std::f64::consts::PI / 180.0;
@@ -562,17 +562,25 @@ fn sequence(
             .then(edges[x].from.cmp(&edges[y].from))
             .then(edges[x].to.cmp(&edges[y].to))
     });
-    let mut next: HashMap<usize, usize> = HashMap::new();
-    let mut prev: HashMap<usize, usize> = HashMap::new();
-    let mut root: HashMap<usize, usize> = HashMap::new();
-    fn find(root: &mut HashMap<usize, usize>, mut i: usize) -> usize {
-        while let Some(&r) = root.get(&i) {
-            if r == i {
+    let mut next: CellMap<usize, usize> = CellMap::default();
+    let mut prev: CellMap<usize, usize> = CellMap::default();
+    let mut root: CellMap<usize, usize> = CellMap::default();
+    fn find(root: &mut CellMap<usize, usize>, i: usize) -> usize {
+        let mut r = i;
+        while let Some(&up) = root.get(&r) {
+            if up == r {
                 break;
             }
-            i = r;
+            r = up;
         }
-        i
+        // Every node on the way points at the root: a long chain is walked once.
+        let mut at = i;
+        while at != r {
+            let up = root[&at];
+            root.insert(at, r);
+            at = up;
+        }
+        r
     }
     for k in order {
         let e = &edges[k];
