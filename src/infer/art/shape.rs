@@ -16,9 +16,9 @@
 
 use super::read::Element;
 use super::{Budget, TooMuchWork};
-use rayon::prelude::*;
 use crate::infer::strokes::Seg;
 use glam::DVec2;
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::f64::consts::{PI, TAU};
 

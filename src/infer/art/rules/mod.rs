@@ -605,6 +605,10 @@ fn sequence(
         .filter(|s| !prev.contains_key(s))
         .collect();
     starts.sort_unstable();
+    // The cluster's edges, sorted: whether a ring's closing edge is one of
+    // them is a search, not a scan per chain.
+    let mut sorted = group.to_vec();
+    sorted.sort_unstable();
     let mut chains: Vec<Vec<usize>> = Vec::new();
     for s in starts {
         let mut chain = vec![s];
@@ -615,7 +619,10 @@ fn sequence(
         }
         // A closed ring (its closing edge is in the cluster) starts at the
         // element turned least, so that equal rings get equal frames.
-        let closed = chain.len() > 2 && index.get(&(at, s)).is_some_and(|k| group.contains(k));
+        let closed = chain.len() > 2
+            && index
+                .get(&(at, s))
+                .is_some_and(|k| sorted.binary_search(k).is_ok());
         if closed {
             let first = (0..chain.len())
                 .min_by(|&x, &y| {
