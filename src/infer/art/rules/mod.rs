@@ -1103,10 +1103,13 @@ fn choose(insts: &[Inst], cands: &mut Vec<Candidate>, w: Weights) -> Option<Cand
         };
         k as f64 / n.max(1) as f64
     };
+    // Each candidate's score and order once (not once per comparison).
+    let scores: Vec<f64> = cands.par_iter().map(score).collect();
+    let forwards: Vec<f64> = cands.par_iter().map(forward).collect();
     let mut best = 0;
     for i in 1..cands.len() {
-        let (a, b) = (score(&cands[i]), score(&cands[best]));
-        let (fa, fb) = (forward(&cands[i]), forward(&cands[best]));
+        let (a, b) = (scores[i], scores[best]);
+        let (fa, fb) = (forwards[i], forwards[best]);
         if (a > b + 1e-12 && !(a < b + TIE && fb > fa)) || (a > b - TIE && fa > fb) {
             best = i;
         }
@@ -1129,14 +1132,14 @@ fn choose(insts: &[Inst], cands: &mut Vec<Candidate>, w: Weights) -> Option<Cand
         if let Some(p) = (0..cands.len())
             .filter(|&i| covers(&cands[i]))
             .max_by(|&x, &y| {
-                let (a, b) = (score(&cands[x]), score(&cands[y]));
+                let (a, b) = (scores[x], scores[y]);
                 let tie = (a - b).abs() <= TIE;
                 (if tie {
                     Ordering::Equal
                 } else {
                     a.total_cmp(&b)
                 })
-                .then(forward(&cands[x]).total_cmp(&forward(&cands[y])))
+                .then(forwards[x].total_cmp(&forwards[y]))
                 .then(a.total_cmp(&b))
                 .then(y.cmp(&x))
             })
