@@ -1,4 +1,4 @@
-//! Inference speed: `lsyc infer ART.svg` on drawings of 300 to 10,000 elements,
+//! Inference speed: `lsyc infer ART.svg` on drawings of 300 to 100,800 elements,
 //! to show how time grows with the element count (the paper: 72 elements in
 //! 16 s, 500 in 209 s, 1,184 in 1,215 s, about n^1.55).
 //!
@@ -13,11 +13,15 @@
 //! - `clutter`: one leaf at random positions, turns and sizes (a fixed
 //!   generator): no regularity, the worst case, coded as pairs.
 //!
-//! Each measurement is the whole pipeline from SVG bytes to the program text.
+//! Each measurement is the whole pipeline from SVG bytes to the program text,
+//! on rayon's global pool (`RAYON_NUM_THREADS=1` for one thread). The
+//! 100,800-element drawings (5,040 blocks of windows, 8,400 rings) are timed
+//! in a group of their own with the fewest samples criterion takes.
 //!
-//! `cargo bench --bench infer`.
+//! `cargo bench --bench infer` (`-- infer-100k` for the largest only).
 
-use criterion::{Criterion, SamplingMode, criterion_group};
+use criterion::measurement::WallTime;
+use criterion::{BenchmarkGroup, Criterion, SamplingMode, criterion_group};
 use lsyc::infer::art::{self, Options};
 use std::fmt::Write;
 use std::hint::black_box;
@@ -93,34 +97,50 @@ fn bench(c: &mut Criterion) {
     group.warm_up_time(Duration::from_millis(500));
     for kind in ["grid", "rings", "clutter"] {
         for n in [300, 1200, 3000, 10_000] {
-            let svg = drawing(kind, n);
-            let name = format!("{kind}-{n}.svg");
-            // Check once that it works and say what it found.
-            let first = art::from_svg(svg.as_bytes(), &name, &Options::default(), &mut |_| {})
-                .expect("infers");
-            eprintln!(
-                "{name}: {} elements, {} kinds, {} rules in {} rounds",
-                first.stats.elements, first.stats.kinds, first.stats.rules, first.stats.rounds
-            );
-            if n >= 3000 {
-                group.measurement_time(Duration::from_secs(30));
-            } else {
-                group.measurement_time(Duration::from_secs(5));
-            }
-            group.bench_function(&name, |b| {
-                b.iter(|| {
-                    art::from_svg(
-                        black_box(svg.as_bytes()),
-                        &name,
-                        &Options::default(),
-                        &mut |_| {},
-                    )
-                    .map(|i| i.text.len())
-                })
-            });
+            measure(&mut group, kind, n);
         }
     }
     group.finish();
+    let mut group = c.benchmark_group("infer-100k");
+    group.sampling_mode(SamplingMode::Flat);
+    group.sample_size(10);
+    group.warm_up_time(Duration::from_millis(1));
+    for kind in ["grid", "rings", "clutter"] {
+        measure(&mut group, kind, 100_800);
+    }
+    group.finish();
+}
+
+/// Checks once that `kind` of `n` elements infers, says what it found, and times it.
+fn measure(group: &mut BenchmarkGroup<WallTime>, kind: &str, n: usize) {
+    let svg = drawing(kind, n);
+    let name = format!("{kind}-{n}.svg");
+    // Check once that it works and say what it found.
+    let first =
+        art::from_svg(svg.as_bytes(), &name, &Options::default(), &mut |_| {}).expect("infers");
+    eprintln!(
+        "{name}: {} elements, {} kinds, {} rules in {} rounds",
+        first.stats.elements, first.stats.kinds, first.stats.rules, first.stats.rounds
+    );
+    if n > 10_000 {
+        // Ten runs of one sample each.
+        group.measurement_time(Duration::from_secs(1));
+    } else if n >= 3000 {
+        group.measurement_time(Duration::from_secs(30));
+    } else {
+        group.measurement_time(Duration::from_secs(5));
+    }
+    group.bench_function(&name, |b| {
+        b.iter(|| {
+            art::from_svg(
+                black_box(svg.as_bytes()),
+                &name,
+                &Options::default(),
+                &mut |_| {},
+            )
+            .map(|i| i.text.len())
+        })
+    });
 }
 
 criterion_group!(benches, bench);

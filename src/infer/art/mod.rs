@@ -47,9 +47,24 @@ impl Budget {
         }
     }
 
+    /// A copy with the same work left, for work done in parallel: what the
+    /// copy spent is charged to this budget afterwards (`spend_u64`).
+    pub(crate) fn copy(&self) -> Budget {
+        Budget {
+            what: self.what,
+            limit: self.limit,
+            left: self.left,
+        }
+    }
+
     /// Spends `n`, or says the limit is reached.
     pub(crate) fn spend(&mut self, n: usize) -> Result<(), TooMuchWork> {
-        match self.left.checked_sub(n as u64) {
+        self.spend_u64(n as u64)
+    }
+
+    /// Spends `n`, or says the limit is reached.
+    pub(crate) fn spend_u64(&mut self, n: u64) -> Result<(), TooMuchWork> {
+        match self.left.checked_sub(n) {
             Some(left) => {
                 self.left = left;
                 Ok(())

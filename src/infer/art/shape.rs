@@ -18,6 +18,7 @@ use super::read::Element;
 use super::{Budget, TooMuchWork};
 use crate::infer::strokes::Seg;
 use glam::DVec2;
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::f64::consts::{PI, TAU};
 
@@ -514,7 +515,7 @@ pub fn instancing(
 ) -> Result<Instancing, TooMuchWork> {
     let mut budget = Budget::new("comparisons of element outlines", MAX_COMPARISONS);
     let shapes: Vec<Shape> = elements
-        .iter()
+        .par_iter()
         .map(|e| {
             Shape::of(&e.outline).unwrap_or_else(|| {
                 // A point-like element: describe it by its box.

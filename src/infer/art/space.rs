@@ -20,7 +20,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 /// defence against chosen keys is needed beyond the mixing): the Fx hash
 /// of rustc. Iteration order of the maps is never used.
 #[derive(Clone, Copy, Default)]
-struct CellHasher(u64);
+pub(crate) struct CellHasher(u64);
 
 impl Hasher for CellHasher {
     fn write(&mut self, bytes: &[u8]) {
@@ -48,7 +48,8 @@ impl Hasher for CellHasher {
     }
 }
 
-type CellMap<K, V> = HashMap<K, V, BuildHasherDefault<CellHasher>>;
+/// A map keyed by small numbers lsyc computes (cells, instance indices).
+pub(crate) type CellMap<K, V> = HashMap<K, V, BuildHasherDefault<CellHasher>>;
 
 /// A transform from one frame to another, as turtle commands
 /// `+(alpha) f(d) *(s) +(beta)` (angles in radians).
@@ -114,6 +115,10 @@ pub type Point = [f64; 4];
 
 /// The clusters of `points`: a label per point and the centres. `turn` is the
 /// period of the two angle coordinates (0 or less: no wrapping).
+///
+/// Points share their cell's neighbourhood: the occupied cells around each
+/// distinct cell are found once (not 3⁴ look-ups per point), and a point's
+/// density and candidate centres come from them.
 pub fn cluster(points: &[Point], turn: f64) -> (Vec<usize>, Vec<Point>) {
     let key = |p: &Point| -> [i64; 4] { [0, 1, 2, 3].map(|k| p[k].floor() as i64) };
     let cells_per_turn = if turn > 0.0 { turn.floor() as i64 } else { 0 };
@@ -151,32 +156,55 @@ pub fn cluster(points: &[Point], turn: f64) -> (Vec<usize>, Vec<Point>) {
         }
         out
     };
-    let mut grid: CellMap<[i64; 4], Vec<usize>> = CellMap::default();
-    for (i, p) in points.iter().enumerate() {
-        grid.entry(wrap_key(key(p))).or_default().push(i);
-    }
-    // Points in the 3⁴ cells around each point's own: one flat-kernel
-    // estimate of density, linear in the number of points.
-    let density: Vec<usize> = points
+    // Occupied cells (wrapped keys), numbered, with their number of points;
+    // and the distinct (unwrapped) keys of the points, numbered.
+    let mut cell_of: CellMap<[i64; 4], usize> = CellMap::default();
+    let mut occupancy: Vec<usize> = Vec::new();
+    let mut key_of: CellMap<[i64; 4], usize> = CellMap::default();
+    let mut keys: Vec<[i64; 4]> = Vec::new();
+    let at: Vec<usize> = points
         .iter()
         .map(|p| {
-            neighbours(key(p))
-                .iter()
-                .filter_map(|k| grid.get(k))
-                .map(Vec::len)
-                .sum()
+            let k = key(p);
+            let c = *cell_of.entry(wrap_key(k)).or_insert_with(|| {
+                occupancy.push(0);
+                occupancy.len() - 1
+            });
+            occupancy[c] += 1;
+            *key_of.entry(k).or_insert_with(|| {
+                keys.push(k);
+                keys.len() - 1
+            })
         })
         .collect();
+    // Per distinct key: the occupied cells of the 3⁴ around it.
+    let around: Vec<Vec<usize>> = keys
+        .iter()
+        .map(|&k| {
+            neighbours(k)
+                .iter()
+                .filter_map(|n| cell_of.get(n).copied())
+                .collect()
+        })
+        .collect();
+    // Points in the 3⁴ cells around each point's own: one flat-kernel
+    // estimate of density, linear in the number of points.
+    let key_density: Vec<usize> = around
+        .iter()
+        .map(|cells| cells.iter().map(|&c| occupancy[c]).sum())
+        .collect();
+    let density = |i: usize| key_density[at[i]];
     let mut order: Vec<usize> = (0..points.len()).collect();
-    order.sort_by(|&a, &b| density[b].cmp(&density[a]).then(a.cmp(&b)));
-    let mut leaders: CellMap<[i64; 4], Vec<usize>> = CellMap::default();
+    order.sort_by(|&a, &b| density(b).cmp(&density(a)).then(a.cmp(&b)));
+    // Centres by the cell of their leader (always an occupied cell).
+    let mut leaders: Vec<Vec<usize>> = vec![Vec::new(); occupancy.len()];
     let mut centres: Vec<Point> = Vec::new();
     let mut label = vec![0; points.len()];
     for i in order {
         let p = &points[i];
         let mut best: Option<(f64, usize)> = None;
-        for k in neighbours(key(p)) {
-            for &c in leaders.get(&k).into_iter().flatten() {
+        for &cell in &around[at[i]] {
+            for &c in &leaders[cell] {
                 if close(p, &centres[c]) {
                     let d: f64 = (0..4)
                         .map(|k| diff(p[k], centres[c][k], k == 0 || k == 3).powi(2))
@@ -191,10 +219,7 @@ pub fn cluster(points: &[Point], turn: f64) -> (Vec<usize>, Vec<Point>) {
             Some((_, c)) => label[i] = c,
             None => {
                 label[i] = centres.len();
-                leaders
-                    .entry(wrap_key(key(p)))
-                    .or_default()
-                    .push(centres.len());
+                leaders[cell_of[&wrap_key(key(p))]].push(centres.len());
                 centres.push(*p);
             }
         }

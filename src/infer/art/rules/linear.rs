@@ -33,6 +33,7 @@ use super::{
 use crate::infer::art::shape::{Frame, wrap};
 use crate::infer::art::space::{Point, Tr, cluster};
 use glam::DVec2;
+use rayon::prelude::*;
 use std::collections::{BTreeMap, HashSet};
 
 /// Which numbers of the transform change along a chain.
@@ -128,11 +129,22 @@ pub(super) fn linear(
         (Vary::Turn, false),
         (Vary::Grow, false),
     ];
-    for (i, &(vary, any_origin)) in searches.iter().enumerate() {
-        if i == 1 && !searches[0].1 {
-            continue;
-        }
-        for cand in search(insts, edges, index, ks, tol, budget, vary, any_origin)? {
+    // The searches run in parallel, each on a copy of the budget; what they
+    // spent is then charged in their order, so the limit is met exactly when
+    // one search after the other would meet it.
+    let runs: Vec<_> = searches
+        .par_iter()
+        .enumerate()
+        .filter(|&(i, _)| i != 1 || searches[0].1)
+        .map(|(_, &(vary, any_origin))| {
+            let mut own = budget.copy();
+            let found = search(insts, edges, index, ks, tol, &mut own, vary, any_origin);
+            (found, budget.left - own.left)
+        })
+        .collect();
+    for (found, spent) in runs {
+        budget.spend_u64(spent)?;
+        for cand in found? {
             if best.as_ref().is_none_or(|b| better(&cand, b)) {
                 best = Some(cand);
             }

@@ -22,10 +22,11 @@ mod linear;
 mod regular;
 
 use super::shape::{Frame, wrap};
-use super::space::{Point, Tr, cluster};
+use super::space::{CellMap, Point, Tr, cluster};
 use super::{Budget, TooMuchWork};
 use crate::geometry::index::PointGrid;
 use glam::DVec2;
+use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 
@@ -267,7 +268,7 @@ struct Candidate {
 }
 
 /// Edges by their two ends.
-type Index = HashMap<(usize, usize), usize>;
+type Index = CellMap<(usize, usize), usize>;
 
 /// The largest change of a turn per step of a linear sequence, radians.
 const LINEAR_STEP_MAX: f64 = 30.0 * std::f64::consts::PI / 180.0;
@@ -360,38 +361,44 @@ pub fn infer(
     }
 }
 
-/// Directed edges between each live instance and its nearest neighbours.
+/// Directed edges between each live instance and its nearest neighbours,
+/// by their two ends (the lower live index first), each pair both ways.
 fn edges(insts: &[Inst], live: &[usize], diagonal: f64) -> Vec<Edge> {
     let centres: Vec<DVec2> = live.iter().map(|&i| insts[i].centre()).collect();
     let grid = PointGrid::new(&centres);
-    let mut pairs: BTreeSet<(usize, usize)> = BTreeSet::new();
-    for (a, c) in centres.iter().enumerate() {
-        for b in grid.nearest(*c, NEIGHBOURS + 1) {
-            if a != b {
-                pairs.insert((a.min(b), a.max(b)));
-            }
-        }
-    }
-    let mut out = Vec::with_capacity(pairs.len() * 2);
-    for (a, b) in pairs {
-        let (i, j) = (live[a], live[b]);
-        let gap = {
-            let (p, q) = (&insts[i], &insts[j]);
-            let dx = (q.min.x - p.max.x).max(p.min.x - q.max.x).max(0.0);
-            let dy = (q.min.y - p.max.y).max(p.min.y - q.max.y).max(0.0);
-            (dx * dx + dy * dy).sqrt() / diagonal
-        };
-        for (from, to) in [(i, j), (j, i)] {
-            let size = insts[from].size() / insts[from].frame.scale;
-            out.push(Edge {
-                from,
-                to,
-                t: Tr::between(&insts[from].frame, &insts[to].frame, size),
-                gap,
-            });
-        }
-    }
-    out
+    let mut pairs: Vec<(usize, usize)> = centres
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(a, c)| {
+            grid.nearest(*c, NEIGHBOURS + 1)
+                .into_iter()
+                .filter(move |&b| a != b)
+                .map(move |b| (a.min(b), a.max(b)))
+        })
+        .collect();
+    pairs.par_sort_unstable();
+    pairs.dedup();
+    pairs
+        .par_iter()
+        .flat_map_iter(|&(a, b)| {
+            let (i, j) = (live[a], live[b]);
+            let gap = {
+                let (p, q) = (&insts[i], &insts[j]);
+                let dx = (q.min.x - p.max.x).max(p.min.x - q.max.x).max(0.0);
+                let dy = (q.min.y - p.max.y).max(p.min.y - q.max.y).max(0.0);
+                (dx * dx + dy * dy).sqrt() / diagonal
+            };
+            [(i, j), (j, i)].map(|(from, to)| {
+                let size = insts[from].size() / insts[from].frame.scale;
+                Edge {
+                    from,
+                    to,
+                    t: Tr::between(&insts[from].frame, &insts[to].frame, size),
+                    gap,
+                }
+            })
+        })
+        .collect()
 }
 
 fn point(t: &Tr, tol: Tolerance) -> Point {
@@ -493,12 +500,11 @@ fn candidates(
         }
         let phi = if a == b { 1.0 } else { 0.5 };
         let near = (tol.regular && a == b).then(|| Near::new(insts, *a));
-        for group in &groups {
-            if let Some(c) = sequence(insts, edges, &index, group, a == b, tol, phi, near.as_ref())
-            {
-                out.push(c);
-            }
-        }
+        let found: Vec<Option<Candidate>> = groups
+            .par_iter()
+            .map(|group| sequence(insts, edges, &index, group, a == b, tol, phi, near.as_ref()))
+            .collect();
+        out.extend(found.into_iter().flatten());
         if a == b {
             // Branchings: two or three clusters of one kind, each node with
             // a child in each.
@@ -509,12 +515,21 @@ fn candidates(
             let pairs = (0..n).flat_map(|x| (x + 1..n).map(move |y| vec![x, y]));
             let triples = (0..n)
                 .flat_map(|x| (x + 1..n).flat_map(move |y| (y + 1..n).map(move |z| vec![x, y, z])));
-            for set in pairs.chain(triples) {
-                let groups: Vec<&[usize]> = set.iter().map(|&g| big[g].as_slice()).collect();
-                if let Some(c) = branching(insts, edges, &index, &groups, tol) {
-                    out.push(c);
-                }
-            }
+            let sets: Vec<Vec<usize>> = pairs.chain(triples).collect();
+            // Each cluster's child map and transform, once for all the sets
+            // it is in; the sets are tried in parallel, kept in their order.
+            let children: Vec<Children> = big
+                .par_iter()
+                .map(|g| Children::of(edges, g, tol))
+                .collect();
+            let found: Vec<Option<Candidate>> = sets
+                .par_iter()
+                .map(|set| {
+                    let groups: Vec<&Children> = set.iter().map(|&g| &children[g]).collect();
+                    branching(insts, edges, &index, &groups, tol)
+                })
+                .collect();
+            out.extend(found.into_iter().flatten());
             out.extend(linear::linear(insts, edges, &index, ks, tol, budget)?);
         }
     }
@@ -547,17 +562,25 @@ fn sequence(
             .then(edges[x].from.cmp(&edges[y].from))
             .then(edges[x].to.cmp(&edges[y].to))
     });
-    let mut next: HashMap<usize, usize> = HashMap::new();
-    let mut prev: HashMap<usize, usize> = HashMap::new();
-    let mut root: HashMap<usize, usize> = HashMap::new();
-    fn find(root: &mut HashMap<usize, usize>, mut i: usize) -> usize {
-        while let Some(&r) = root.get(&i) {
-            if r == i {
+    let mut next: CellMap<usize, usize> = CellMap::default();
+    let mut prev: CellMap<usize, usize> = CellMap::default();
+    let mut root: CellMap<usize, usize> = CellMap::default();
+    fn find(root: &mut CellMap<usize, usize>, i: usize) -> usize {
+        let mut r = i;
+        while let Some(&up) = root.get(&r) {
+            if up == r {
                 break;
             }
-            i = r;
+            r = up;
         }
-        i
+        // Every node on the way points at the root: a long chain is walked once.
+        let mut at = i;
+        while at != r {
+            let up = root[&at];
+            root.insert(at, r);
+            at = up;
+        }
+        r
     }
     for k in order {
         let e = &edges[k];
@@ -582,6 +605,10 @@ fn sequence(
         .filter(|s| !prev.contains_key(s))
         .collect();
     starts.sort_unstable();
+    // The cluster's edges, sorted: whether a ring's closing edge is one of
+    // them is a search, not a scan per chain.
+    let mut sorted = group.to_vec();
+    sorted.sort_unstable();
     let mut chains: Vec<Vec<usize>> = Vec::new();
     for s in starts {
         let mut chain = vec![s];
@@ -592,7 +619,10 @@ fn sequence(
         }
         // A closed ring (its closing edge is in the cluster) starts at the
         // element turned least, so that equal rings get equal frames.
-        let closed = chain.len() > 2 && index.get(&(at, s)).is_some_and(|k| group.contains(k));
+        let closed = chain.len() > 2
+            && index
+                .get(&(at, s))
+                .is_some_and(|k| sorted.binary_search(k).is_ok());
         if closed {
             let first = (0..chain.len())
                 .min_by(|&x, &y| {
@@ -812,7 +842,7 @@ fn seq_candidate(
 /// one step of the recursive definition `depth(v) = 1 + min_i depth(child[i][v])`.
 fn depth_of(
     v: usize,
-    child: &[HashMap<usize, usize>],
+    child: &[&HashMap<usize, usize>],
     memo: &mut HashMap<usize, u32>,
     open: &mut HashSet<usize>,
 ) -> u32 {
@@ -863,30 +893,44 @@ fn depth_of(
     found
 }
 
+/// One cluster of edges as a transform of branchings: each node's child by
+/// it (the edge of lowest index out of the node), and the transform.
+struct Children {
+    child: HashMap<usize, usize>,
+    t: Tr,
+}
+
+impl Children {
+    fn of(edges: &[Edge], group: &[usize], tol: Tolerance) -> Children {
+        let mut child: HashMap<usize, usize> = HashMap::with_capacity(group.len());
+        let mut sorted = group.to_vec();
+        sorted.sort_unstable();
+        for k in sorted {
+            child.entry(edges[k].from).or_insert(edges[k].to);
+        }
+        let ts: Vec<Tr> = group.iter().map(|&k| edges[k].t).collect();
+        Children {
+            child,
+            t: supported_mean(&ts, tol),
+        }
+    }
+}
+
 /// Complete trees whose children come from `groups` (clusters of edges, one
 /// per transform).
 fn branching(
     insts: &[Inst],
     edges: &[Edge],
     index: &Index,
-    groups: &[&[usize]],
+    groups: &[&Children],
     tol: Tolerance,
 ) -> Option<Candidate> {
-    let child_map = |g: &[usize]| {
-        let mut m: HashMap<usize, usize> = HashMap::new();
-        let mut sorted = g.to_vec();
-        sorted.sort_unstable();
-        for k in sorted {
-            m.entry(edges[k].from).or_insert(edges[k].to);
-        }
-        m
-    };
-    let mut child: Vec<HashMap<usize, usize>> = groups.iter().map(|g| child_map(g)).collect();
+    let maps: Vec<&HashMap<usize, usize>> = groups.iter().map(|g| &g.child).collect();
     let both: Vec<usize> = {
-        let mut v: Vec<usize> = child[0]
+        let mut v: Vec<usize> = maps[0]
             .keys()
             .copied()
-            .filter(|k| child[1..].iter().all(|c| c.contains_key(k)))
+            .filter(|k| maps[1..].iter().all(|c| c.contains_key(k)))
             .collect();
         v.sort_unstable();
         v
@@ -898,7 +942,7 @@ fn branching(
     let mut depth: HashMap<usize, u32> = HashMap::new();
     let mut open = HashSet::new();
     for &v in &both {
-        depth_of(v, &child, &mut depth, &mut open);
+        depth_of(v, &maps, &mut depth, &mut open);
     }
     let mut roots: Vec<(usize, u32)> = both
         .iter()
@@ -906,10 +950,7 @@ fn branching(
         .filter(|&(_, d)| d >= 1)
         .collect();
     roots.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
-    let ts: Vec<Tr> = groups
-        .iter()
-        .map(|g| supported_mean(&g.iter().map(|&k| edges[k].t).collect::<Vec<_>>(), tol))
-        .collect();
+    let ts: Vec<Tr> = groups.iter().map(|g| g.t).collect();
     let mut claimed: HashSet<usize> = HashSet::new();
     let mut trees = Vec::new();
     let mut leaves: Vec<(usize, Frame)> = Vec::new();
@@ -925,7 +966,7 @@ fn branching(
         for _ in 0..d {
             let mut below = Vec::new();
             for &(v, f) in &level {
-                for (map, tr) in child.iter().zip(&ts) {
+                for (map, tr) in maps.iter().zip(&ts) {
                     let c = map[&v];
                     let want = tr.apply(&f);
                     if claimed.contains(&c)
@@ -957,6 +998,7 @@ fn branching(
     if trees.is_empty() {
         return None;
     }
+    let mut child: Vec<HashMap<usize, usize>> = maps.into_iter().cloned().collect();
     if let Some(tips) = tree_tips(insts, edges, &leaves, &ts, &claimed, tol) {
         for (&(leaf, _), below) in leaves.iter().zip(tips) {
             for (map, &c) in child.iter_mut().zip(&below) {
@@ -1061,10 +1103,13 @@ fn choose(insts: &[Inst], cands: &mut Vec<Candidate>, w: Weights) -> Option<Cand
         };
         k as f64 / n.max(1) as f64
     };
+    // Each candidate's score and order once (not once per comparison).
+    let scores: Vec<f64> = cands.par_iter().map(score).collect();
+    let forwards: Vec<f64> = cands.par_iter().map(forward).collect();
     let mut best = 0;
     for i in 1..cands.len() {
-        let (a, b) = (score(&cands[i]), score(&cands[best]));
-        let (fa, fb) = (forward(&cands[i]), forward(&cands[best]));
+        let (a, b) = (scores[i], scores[best]);
+        let (fa, fb) = (forwards[i], forwards[best]);
         if (a > b + 1e-12 && !(a < b + TIE && fb > fa)) || (a > b - TIE && fa > fb) {
             best = i;
         }
@@ -1087,14 +1132,14 @@ fn choose(insts: &[Inst], cands: &mut Vec<Candidate>, w: Weights) -> Option<Cand
         if let Some(p) = (0..cands.len())
             .filter(|&i| covers(&cands[i]))
             .max_by(|&x, &y| {
-                let (a, b) = (score(&cands[x]), score(&cands[y]));
+                let (a, b) = (scores[x], scores[y]);
                 let tie = (a - b).abs() <= TIE;
                 (if tie {
                     Ordering::Equal
                 } else {
                     a.total_cmp(&b)
                 })
-                .then(forward(&cands[x]).total_cmp(&forward(&cands[y])))
+                .then(forwards[x].total_cmp(&forwards[y]))
                 .then(a.total_cmp(&b))
                 .then(y.cmp(&x))
             })
