@@ -987,7 +987,7 @@ fn every_resolved_name_has_a_definition() {
         checked += 1;
         let rel = crate::support::rel(&path);
         // Names that declare nothing other names use: `module` parameters
-        // and element property keys.
+        // element property keys and palette material names.
         let mut unused_decl = std::collections::HashSet::new();
         for item in &a.file.items.stmts {
             match &item.node {
@@ -1003,6 +1003,16 @@ fn every_resolved_name_has_a_definition() {
                 }
                 lsyc::ast::Item::Element(e) => {
                     unused_decl.extend(e.props.stmts.iter().map(|p| p.node.key.span.start));
+                }
+                // A palette's material names are written to OBJ and glTF only.
+                lsyc::ast::Item::Palette(p) => {
+                    unused_decl.extend(
+                        p.body
+                            .stmts
+                            .iter()
+                            .filter_map(|e| e.node.name.as_ref())
+                            .map(|n| n.span.start),
+                    );
                 }
                 _ => {}
             }
