@@ -986,7 +986,7 @@ fn every_resolved_name_has_a_definition() {
         }
         checked += 1;
         let rel = crate::support::rel(&path);
-        // Names that declare nothing other names use: `module` parameters
+        // Names that declare nothing other names use: `module` parameters,
         // element property keys and palette material names.
         let mut unused_decl = std::collections::HashSet::new();
         for item in &a.file.items.stmts {
