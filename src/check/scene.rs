@@ -175,10 +175,13 @@ impl<'a> Checker<'a> {
             self.diags.push(
                 Diagnostic::error(
                     Code::MissingPath,
-                    format!("element `{}` has no path", e.name.name),
+                    format!("element `{}` has no shape", e.name.name),
                 )
-                .primary(e.name.span, "an element draws SVG path data")
-                .help("add `path \"M0 0 L0 10\";` (local frame: base at the origin, pointing +y)"),
+                .primary(e.name.span, "an element draws a shape")
+                .help(
+                    "add `path \"M0 0 L0 10\";` (local frame: base at the origin, pointing +y), \
+                     or a 3D organ: `sphere 1;`, `disk 1;`, `patch \"…\";`, `mesh \"leaf.obj\";`",
+                ),
             );
         }
     }
