@@ -105,7 +105,9 @@ fn bench(c: &mut Criterion) {
     group.sampling_mode(SamplingMode::Flat);
     group.sample_size(10);
     group.warm_up_time(Duration::from_millis(1));
-    for kind in ["grid", "rings", "clutter"] {
+    // Not the grid: its windows have five subpaths each, and 504,000 subpaths are
+    // over the reader's limit (`art::read::MAX_SUBPATHS`), so it ends with an error.
+    for kind in ["rings", "clutter"] {
         measure(&mut group, kind, 100_800);
     }
     group.finish();
