@@ -67,19 +67,8 @@ impl Layers<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::index::Lcg;
     use crate::geometry::{closest_on_segment, crossing, ray_hit};
-
-    /// A tiny deterministic generator for test geometry.
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
 
     fn scan_crossing(segs: &[(DVec2, DVec2)], p: DVec2, q: DVec2) -> Option<(f64, usize)> {
         segs.iter()

@@ -248,18 +248,7 @@ impl GrowingGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A tiny deterministic generator for test geometry.
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use crate::geometry::index::Lcg;
 
     /// Grows a drawing step by step (segments inserted at random places, a few
     /// steps that remove or move one) and compares every search with one grid

@@ -16,3 +16,19 @@ pub mod segments;
 pub use growing::GrowingGrid;
 pub use points::PointGrid;
 pub use segments::SegmentGrid;
+
+/// A tiny deterministic generator of test geometry, for the indexes' tests and
+/// their users' (numbers in [0, 1)).
+#[cfg(test)]
+pub(crate) struct Lcg(pub(crate) u64);
+
+#[cfg(test)]
+impl Lcg {
+    pub(crate) fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
