@@ -668,3 +668,47 @@ fn txt_of(d: &Derived) -> String {
     let (bytes, _) = output(d, Format::Txt, &Picture::default());
     String::from_utf8(bytes).expect("utf-8")
 }
+
+#[test]
+fn outputs_through_a_pipe_or_a_link_keep_them_in_place() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let program = example("koch-island.lsy");
+
+    // A named pipe (as `/dev/null` or `/dev/stdout` are devices): written
+    // through, never replaced by a plain file.
+    let pipe = dir.path().join("pipe.svg");
+    let made = Command::new("mkfifo")
+        .arg(&pipe)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+    let reader = {
+        let pipe = pipe.clone();
+        std::thread::spawn(move || std::fs::read(&pipe).expect("read the pipe"))
+    };
+    lsyc_ok(&["run", s(&program), "-o", s(&pipe)]);
+    let through = reader.join().expect("reader");
+    assert!(String::from_utf8_lossy(&through).contains("<svg"));
+    let kind = std::fs::symlink_metadata(&pipe).expect("pipe").file_type();
+    assert!(kind.is_fifo(), "the pipe is still a pipe: {kind:?}");
+
+    // A symbolic link: it stays a link, and its target gets the drawing.
+    let target = dir.path().join("drawing.svg");
+    std::fs::write(&target, "old").expect("write target");
+    let link = dir.path().join("link.svg");
+    std::os::unix::fs::symlink(&target, &link).expect("symlink");
+    lsyc_ok(&["run", s(&program), "-o", s(&link)]);
+    let kind = std::fs::symlink_metadata(&link).expect("link").file_type();
+    assert!(kind.is_symlink(), "the link is still a link");
+    assert_eq!(
+        std::fs::read(&target).expect("target"),
+        through,
+        "the link's target holds the same drawing as went through the pipe"
+    );
+    let names: BTreeSet<_> = std::fs::read_dir(dir.path())
+        .expect("list")
+        .map(|e| e.expect("entry").file_name())
+        .collect();
+    assert_eq!(names.len(), 3, "no temporary file left behind: {names:?}");
+}
