@@ -440,6 +440,27 @@ struct JsonDiagnostic<'a> {
     labels: Vec<JsonLabel<'a>>,
     notes: &'a [String],
     help: Option<&'a str>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    fixes: Vec<JsonFix<'a>>,
+}
+
+/// A machine-applicable fix: apply all its edits (spans of the original text)
+/// at once, as the language server's quick fixes do.
+#[derive(Serialize)]
+struct JsonFix<'a> {
+    title: &'a str,
+    edits: Vec<JsonEdit<'a>>,
+}
+
+#[derive(Serialize)]
+struct JsonEdit<'a> {
+    line: usize,
+    column: usize,
+    end_line: usize,
+    end_column: usize,
+    start: u32,
+    end: u32,
+    replacement: &'a str,
 }
 
 fn render_json(diags: &[Diagnostic], file: &str, source: &str) -> String {
@@ -465,6 +486,30 @@ fn render_json(diags: &[Diagnostic], file: &str, source: &str) -> String {
             })
             .collect();
         let first = labels.iter().find(|l| l.primary);
+        let fixes = d
+            .fixes
+            .iter()
+            .map(|f| JsonFix {
+                title: &f.title,
+                edits: f
+                    .edits
+                    .iter()
+                    .map(|(span, replacement)| {
+                        let (line, column) = index.line_col(source, span.start as usize);
+                        let (end_line, end_column) = index.line_col(source, span.end as usize);
+                        JsonEdit {
+                            line,
+                            column,
+                            end_line,
+                            end_column,
+                            start: span.start,
+                            end: span.end,
+                            replacement,
+                        }
+                    })
+                    .collect(),
+            })
+            .collect();
         let json = JsonDiagnostic {
             file,
             severity: d.severity,
@@ -475,6 +520,7 @@ fn render_json(diags: &[Diagnostic], file: &str, source: &str) -> String {
             notes: &d.notes,
             help: d.help.as_deref(),
             labels,
+            fixes,
         };
         if let Ok(s) = serde_json::to_string(&json) {
             out.push_str(&s);

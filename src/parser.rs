@@ -414,7 +414,22 @@ fn syntax_error_at(
                     "{tok} is a keyword of the language and cannot be used as a name"
                 ));
             }
-            if tok == Token::Assign {
+            let in_condition = tokens
+                .iter()
+                .rev()
+                .skip_while(|t| t.0 >= l)
+                .take_while(|t| !matches!(t.1, Token::Semi | Token::LBrace | Token::RBrace))
+                .any(|t| t.1 == Token::Colon);
+            if tok == Token::Assign && !in_condition && expected.iter().any(|e| e == "\"->\"") {
+                // `X = F[+X]`: the rule arrow of many web L-system tools; `X => F`.
+                let arrow = match tokens.iter().find(|t| t.0 == r) {
+                    Some(gt) if gt.1 == Token::Gt => Span::new(l, gt.2),
+                    _ => span,
+                };
+                d = d
+                    .help("a rule is written `X -> …`; `=` only defines a constant")
+                    .fix("replace with `->`", arrow, "->");
+            } else if tok == Token::Assign {
                 d = d
                     .help("to compare, write `==`; `=` only defines a constant")
                     .fix("replace with `==`", span, "==");

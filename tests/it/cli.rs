@@ -269,6 +269,57 @@ fn json_diagnostics() {
     assert!(v["help"].as_str().is_some_and(|s| s.contains("G(2)")));
 }
 
+/// The fixes of `--error-format json`: applied (all edits of the first fix,
+/// from the end so earlier offsets hold), each program checks clean.
+#[test]
+fn json_fixes_repair_the_program() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cases = [
+        // `=` as a web tool's rule arrow, and `=` in a condition.
+        ("lsystem A {\n    axiom X;\n    X = F[+X];\n}\n", "->"),
+        ("lsystem A {\n    axiom X;\n    X => F[+X];\n}\n", "->"),
+        (
+            "lsystem A {\n    axiom A(2);\n    A(x) : x = 2 -> F;\n}\n",
+            "==",
+        ),
+        // A misspelt constant: did you mean.
+        ("const len = 2;\nlsystem A {\n    axiom F(lem);\n}\n", "len"),
+        // A missing `;`.
+        ("lsystem A {\n    axiom F\n    derive 2;\n}\n", ";"),
+    ];
+    for (i, (text, replacement)) in cases.iter().enumerate() {
+        let f = write(dir.path(), &format!("fix{i}.lsy"), text);
+        let r = run(&["check", &f, "--error-format", "json"]);
+        assert_eq!(r.status, 1, "{text}");
+        let v: serde_json::Value = r
+            .stderr
+            .lines()
+            .map(|l| serde_json::from_str::<serde_json::Value>(l).expect("JSON"))
+            .find(|v| v["fixes"].is_array())
+            .unwrap_or_else(|| panic!("a diagnostic with a fix for {text}: {}", r.stderr));
+        let fix = &v["fixes"][0];
+        let mut edits: Vec<(usize, usize, String)> = fix["edits"]
+            .as_array()
+            .expect("edits")
+            .iter()
+            .map(|e| {
+                let at = |k: &str| e[k].as_u64().expect("offset") as usize;
+                let with = e["replacement"].as_str().expect("replacement");
+                (at("start"), at("end"), with.to_string())
+            })
+            .collect();
+        assert_eq!(edits[0].2, *replacement, "{}", fix["title"]);
+        edits.sort_by_key(|e| std::cmp::Reverse(e.0));
+        let mut fixed = text.to_string();
+        for (start, end, with) in edits {
+            fixed.replace_range(start..end, &with);
+        }
+        let g = write(dir.path(), &format!("fixed{i}.lsy"), &fixed);
+        let r = run(&["check", &g]);
+        assert_eq!(r.status, 0, "{fixed}\n{}", r.stderr);
+    }
+}
+
 #[test]
 fn color_always_uses_ansi() {
     let dir = tempfile::tempdir().expect("tempdir");
