@@ -90,10 +90,18 @@ pub fn outline(a: &Analysis) -> Vec<DocumentSymbol> {
                                 .zip(r.succ.last())
                                 .map(|(f, l)| a.slice(f.span.to(l.span)))
                                 .unwrap_or("ε");
+                            // Which phase the rule belongs to, as the source says it.
+                            let phase = if r.interpret {
+                                "interpret "
+                            } else if r.decompose {
+                                "decompose "
+                            } else {
+                                ""
+                            };
                             children.push(sym(
                                 a,
                                 one_line(&name, 60),
-                                Some(one_line(&format!("-> {succ}"), 60)),
+                                Some(one_line(&format!("{phase}-> {succ}"), 60)),
                                 SymbolKind::METHOD,
                                 st.span,
                                 r.pred.span,
