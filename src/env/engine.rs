@@ -194,12 +194,10 @@ struct Reservation {
     pass: Vec<f64>,
 }
 
-/// A system's drawing: its segments (and elements' axes) in a grid, and the
-/// query modules met, with the turtle there. When the string changes, the grid
-/// is kept until the system is drawn again: growth inserts segments into the
-/// drawing, and only those are indexed anew (`Grid::update`).
+/// A system's drawing: its segments (and elements' axes), and the query
+/// modules met, with the turtle there.
 struct Drawing {
-    grid: Grid,
+    segs: Vec<(DVec2, DVec2)>,
     queries: Vec<(usize, u8, State)>,
 }
 
@@ -208,8 +206,14 @@ struct Live {
     guide: usize,
     run: GuideRun,
     probes: Vec<Option<Drawing>>,
-    /// The grid of the system's last drawing, while it is to be drawn again.
-    stale: Vec<Option<Grid>>,
+    /// One grid over the segments of all its systems' drawings, in system
+    /// order (the ids of `Layers`). Kept from step to step: growth inserts
+    /// segments into the drawings, and only those are indexed anew
+    /// (`Grid::update`), so a query asks one index, however many systems the
+    /// guide holds.
+    index: Option<Grid>,
+    /// A system was drawn since `index` was made.
+    redrawn: bool,
     /// Answer this system's queries in this step.
     fresh: Vec<bool>,
     /// The system's string holds only modules without rules (no query, no
@@ -516,7 +520,8 @@ fn start(scene: &Scene, cfg: Config, unit: &[usize]) -> Result<Vec<Live>, Diagno
             guide: g,
             run: GuideRun::default(),
             probes: Vec::new(),
-            stale: Vec::new(),
+            index: None,
+            redrawn: false,
             fresh: Vec::new(),
             settled: Vec::new(),
             reserved: Vec::new(),
@@ -584,7 +589,6 @@ impl Live {
     fn add(&mut self, inst: Instance) {
         self.run.instances.push(inst);
         self.probes.push(None);
-        self.stale.push(None);
         self.fresh.push(true);
         self.settled.push(false);
     }
@@ -594,7 +598,7 @@ impl Live {
 fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<bool, Diagnostic> {
     type Job<'a> = (
         &'a mut Instance,
-        (&'a mut Option<Drawing>, &'a mut Option<Grid>),
+        &'a mut Option<Drawing>,
         &'a mut bool,
         &'a mut bool,
     );
@@ -607,7 +611,7 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
             .run
             .instances
             .iter_mut()
-            .zip(l.probes.iter_mut().zip(&mut l.stale))
+            .zip(l.probes.iter_mut())
             .zip(&mut l.fresh)
             .zip(&mut l.settled)
         {
@@ -637,7 +641,7 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
             if string != inst.string {
                 inst.string = string;
                 inst.changed = t;
-                outdate(probe.0, probe.1);
+                *probe = None;
             }
             *fresh = true;
             *settled = inst.string.syms.iter().all(|&x| inert(prog, x));
@@ -667,30 +671,22 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
 fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagnostic> {
     let mut jobs = Vec::new();
     for l in live.iter_mut() {
-        for (inst, (probe, stale)) in l
-            .run
-            .instances
-            .iter()
-            .zip(l.probes.iter_mut().zip(&mut l.stale))
-        {
+        for (inst, probe) in l.run.instances.iter().zip(l.probes.iter_mut()) {
             if probe.is_none() {
-                jobs.push((inst, probe, stale));
+                l.redrawn = true;
+                jobs.push((inst, probe));
             }
         }
     }
     let results: Vec<Result<(), Diagnostic>> = jobs
         .into_par_iter()
-        .map(|(inst, probe, stale)| {
+        .map(|(inst, probe)| {
             let prog = &scene.programs[scene.guides[inst.guide].program];
             let mut p = Probe::default();
             turtle::interpret_limited(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut p)
                 .map_err(|e| e.diagnostic(prog))?;
-            let grid = match stale.take() {
-                Some(g) => g.update(p.segments),
-                None => Grid::new(p.segments),
-            };
             *probe = Some(Drawing {
-                grid,
+                segs: p.segments,
                 queries: p.queries,
             });
             Ok(())
@@ -699,12 +695,22 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
     results.into_iter().collect()
 }
 
-/// Marks a system's drawing as out of date, keeping its grid for the next
-/// drawing to update.
-fn outdate(probe: &mut Option<Drawing>, stale: &mut Option<Grid>) {
-    if let Some(d) = probe.take() {
-        *stale = Some(d.grid);
-    }
+/// Brings each guide's index up to its systems' drawings (all drawn): the
+/// segments of all its systems, in order, with the grid of the last index
+/// updated where they grew.
+fn reindex(live: &mut [Live]) {
+    live.par_iter_mut().filter(|l| l.redrawn).for_each(|l| {
+        let total = l.probes.iter().flatten().map(|d| d.segs.len()).sum();
+        let mut segs = Vec::with_capacity(total);
+        for d in l.probes.iter().flatten() {
+            segs.extend_from_slice(&d.segs);
+        }
+        l.index = Some(match l.index.take() {
+            Some(g) => g.update(segs),
+            None => Grid::new(segs),
+        });
+        l.redrawn = false;
+    });
 }
 
 /// Settles the reservations of guide `l` made in the step before `t`.
@@ -719,7 +725,7 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
         // closest to its heading (the first of equals): several branches may
         // start at one point.
         let mut hit: Option<(f64, DVec2, DVec2)> = None;
-        for &(s0, s1) in l.probes[r.instance].iter().flat_map(|p| p.grid.segs()) {
+        for &(s0, s1) in l.probes[r.instance].iter().flat_map(|p| &p.segs) {
             if (s0 - r.from).length() > tol {
                 continue;
             }
@@ -818,6 +824,7 @@ fn answer(
     t: u32,
 ) -> Result<(), Diagnostic> {
     interpret(scene, cfg, live)?;
+    reindex(live);
     let layers = layers(live);
     let answered: Vec<(usize, usize, Answers)> = fresh_drawings(live)
         .into_par_iter()
@@ -842,17 +849,11 @@ fn answer(
     Ok(())
 }
 
-/// Per guide: the grids of its systems' drawings, ids running on.
+/// Per guide: the index of its systems' drawings.
 fn layers(live: &[Live]) -> Vec<Layers<'_>> {
     live.iter()
-        .map(|l| {
-            let mut off = 0;
-            let mut parts = Vec::with_capacity(l.probes.len());
-            for d in l.probes.iter().flatten() {
-                parts.push((off, &d.grid));
-                off += d.grid.segs().len();
-            }
-            Layers { parts }
+        .map(|l| Layers {
+            parts: l.index.iter().map(|g| (0, g)).collect(),
         })
         .collect()
 }
@@ -936,7 +937,7 @@ fn write_answers(
     }
     if queries_interpreted(prog) {
         // Its drawing may read the answers: draw it again when needed.
-        outdate(&mut l.probes[k], &mut l.stale[k]);
+        l.probes[k] = None;
     }
     inst.steps < prog.derive
 }
