@@ -32,6 +32,7 @@
 
 use super::index::{Grid, Layers};
 use super::query::{Answer, Probe, collide, edge_meet, inward, query};
+use super::redraw::{self, Sketch};
 use super::scene::{Link, Scene, seed_state};
 use crate::derive::{self, Limits, ModString};
 use crate::diagnostic::Diagnostic;
@@ -195,17 +196,17 @@ struct Reservation {
 }
 
 /// A system's drawing: its segments (and elements' axes), and the query
-/// modules met, with the turtle there.
-struct Drawing {
-    segs: Vec<(DVec2, DVec2)>,
-    queries: Vec<(usize, u8, State)>,
-}
+/// modules met, with the turtle there (`drawn`).
+type Drawing = Sketch;
 
 /// A unit's guide while it runs.
 struct Live {
     guide: usize,
     run: GuideRun,
     probes: Vec<Option<Drawing>>,
+    /// A system's last drawing, while it is to be drawn again, and the string
+    /// it was drawn from: `redraw` reuses what did not change.
+    prev: Vec<Option<(ModString, Drawing)>>,
     /// One grid over the segments of all its systems' drawings, in system
     /// order (the ids of `Layers`). Kept from step to step: growth inserts
     /// segments into the drawings, and only those are indexed anew
@@ -520,6 +521,7 @@ fn start(scene: &Scene, cfg: Config, unit: &[usize]) -> Result<Vec<Live>, Diagno
             guide: g,
             run: GuideRun::default(),
             probes: Vec::new(),
+            prev: Vec::new(),
             index: None,
             redrawn: false,
             fresh: Vec::new(),
@@ -589,6 +591,7 @@ impl Live {
     fn add(&mut self, inst: Instance) {
         self.run.instances.push(inst);
         self.probes.push(None);
+        self.prev.push(None);
         self.fresh.push(true);
         self.settled.push(false);
     }
@@ -598,7 +601,7 @@ impl Live {
 fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<bool, Diagnostic> {
     type Job<'a> = (
         &'a mut Instance,
-        &'a mut Option<Drawing>,
+        (&'a mut Option<Drawing>, &'a mut Option<(ModString, Drawing)>),
         &'a mut bool,
         &'a mut bool,
     );
@@ -611,7 +614,7 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
             .run
             .instances
             .iter_mut()
-            .zip(l.probes.iter_mut())
+            .zip(l.probes.iter_mut().zip(&mut l.prev))
             .zip(&mut l.fresh)
             .zip(&mut l.settled)
         {
@@ -639,9 +642,11 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
                 .map_err(|e| e.diagnostic(prog))?;
             // An unchanged string draws the same: keep its drawing.
             if string != inst.string {
-                inst.string = string;
+                let old = std::mem::replace(&mut inst.string, string);
                 inst.changed = t;
-                *probe = None;
+                if let Some(d) = probe.0.take() {
+                    *probe.1 = Some((old, d));
+                }
             }
             *fresh = true;
             *settled = inst.string.syms.iter().all(|&x| inert(prog, x));
@@ -671,23 +676,33 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
 fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagnostic> {
     let mut jobs = Vec::new();
     for l in live.iter_mut() {
-        for (inst, probe) in l.run.instances.iter().zip(l.probes.iter_mut()) {
+        for (inst, (probe, prev)) in l
+            .run
+            .instances
+            .iter()
+            .zip(l.probes.iter_mut().zip(&mut l.prev))
+        {
             if probe.is_none() {
                 l.redrawn = true;
-                jobs.push((inst, probe));
+                jobs.push((inst, probe, prev));
             }
         }
     }
     let results: Vec<Result<(), Diagnostic>> = jobs
         .into_par_iter()
-        .map(|(inst, probe)| {
+        .map(|(inst, probe, prev)| {
             let prog = &scene.programs[scene.guides[inst.guide].program];
-            let mut p = Probe::default();
-            turtle::interpret_limited(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut p)
-                .map_err(|e| e.diagnostic(prog))?;
-            *probe = Some(Drawing {
-                segs: p.segments,
-                queries: p.queries,
+            let last = prev.take();
+            if !redraw::redrawable(prog) {
+                let mut p = Probe::default();
+                turtle::interpret_limited(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut p)
+                    .map_err(|e| e.diagnostic(prog))?;
+                *probe = Some(Sketch::whole(p));
+                return Ok(());
+            }
+            *probe = Some(match last {
+                Some((old, d)) => redraw::redraw(prog, &old, d, &inst.string, inst.start),
+                None => redraw::draw(prog, &inst.string, inst.start),
             });
             Ok(())
         })
@@ -700,10 +715,10 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
 /// updated where they grew.
 fn reindex(live: &mut [Live]) {
     live.par_iter_mut().filter(|l| l.redrawn).for_each(|l| {
-        let total = l.probes.iter().flatten().map(|d| d.segs.len()).sum();
+        let total = l.probes.iter().flatten().map(|d| d.drawn.segments.len()).sum();
         let mut segs = Vec::with_capacity(total);
         for d in l.probes.iter().flatten() {
-            segs.extend_from_slice(&d.segs);
+            segs.extend_from_slice(&d.drawn.segments);
         }
         l.index = Some(match l.index.take() {
             Some(g) => g.update(segs),
@@ -725,7 +740,7 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
         // closest to its heading (the first of equals): several branches may
         // start at one point.
         let mut hit: Option<(f64, DVec2, DVec2)> = None;
-        for &(s0, s1) in l.probes[r.instance].iter().flat_map(|p| &p.segs) {
+        for &(s0, s1) in l.probes[r.instance].iter().flat_map(|p| &p.drawn.segments) {
             if (s0 - r.from).length() > tol {
                 continue;
             }
@@ -865,7 +880,7 @@ fn fresh_drawings(live: &[Live]) -> Vec<(usize, usize, &Drawing)> {
     for (li, l) in live.iter().enumerate() {
         for (k, (p, &f)) in l.probes.iter().zip(&l.fresh).enumerate() {
             if let (Some(p), true) = (p, f)
-                && !p.queries.is_empty()
+                && !p.drawn.queries.is_empty()
             {
                 jobs.push((li, k, p));
             }
@@ -885,9 +900,9 @@ fn answer_system(scene: &Scene, l: &Live, layers: &Layers, k: usize, drawing: &D
     let prog = &scene.programs[scene.guides[gi].program];
     let offsets = param_offsets(prog, &inst.string);
     let grid = Some(layers);
-    let mut answers = Vec::with_capacity(drawing.queries.len());
+    let mut answers = Vec::with_capacity(drawing.drawn.queries.len());
     let mut crossings = Vec::new();
-    for &(module, kind, state) in &drawing.queries {
+    for &(module, kind, state) in &drawing.drawn.queries {
         let q = &QUERIES[kind as usize];
         let at = offsets[module] as usize;
         let arity = prog.symbols.arity(inst.string.syms[module]);
