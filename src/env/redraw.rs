@@ -370,3 +370,70 @@ pub(crate) fn redraw(prog: &Program, old: &ModString, last: Sketch, new: &ModStr
         marks,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::derive::{self, Limits};
+    use crate::turtle::State;
+
+    fn program(text: &str) -> Program {
+        let fe = crate::frontend::run(text, vec![], &[]);
+        assert!(!fe.has_errors(), "{:?}", fe.diagnostics);
+        let checked = fe.checked.as_ref().expect("checked");
+        crate::compile::compile(&fe.file, checked, None).expect("compiles")
+    }
+
+    fn bits(p: &Probe) -> (Vec<[u64; 4]>, Vec<(usize, u8, [u64; 3])>) {
+        (
+            p.segments
+                .iter()
+                .map(|(a, b)| [a.x, a.y, b.x, b.y].map(f64::to_bits))
+                .collect(),
+            p.queries
+                .iter()
+                .map(|(m, k, s)| (*m, *k, s.pos.to_array().map(f64::to_bits)))
+                .collect(),
+        )
+    }
+
+    /// Derives each program step by step; every step's redraw must equal a
+    /// whole drawing of the string (segments bit for bit, queries with their
+    /// modules), and the redraws must have copied most of the drawing.
+    #[test]
+    fn a_redraw_is_the_whole_drawing() {
+        let programs = [
+            // Tips that grow inside branches, turn by their parameter, and
+            // stop at random: most of the string stays.
+            "lsystem A { derive 40; axiom [X(0)][+(90) X(1)] F X(2); \
+             X(k) : k < 30 -> F(1) +(k * 3) [-(45) Y(k)] F(2) X(k + 1); \
+             X(k) -> ; Y(k) : k % 3 == 0 -> F(1) Y(k + 1); Y(k) -> F(0.5); }",
+            // Polygons opened before a tip and closed after it; a tip inside a
+            // polygon; branches inside the polygon.
+            "lsystem B { derive 9; axiom A {. f(1) . [B] . B . } C; \
+             A -> F(1) [+(30) A] A; B -> f(1) . +(10) B; C -> F(1) [-(5) C] C; }",
+            // Stochastic rules and a queried tip (?P).
+            "lsystem C { derive 30; axiom ?P X; \
+             ?P(x, y, _) -> F(1) ?P; \
+             X -> (1) F(1) [+(20) X] X; X -> (1) F(1) [-(20) X]; X -> (2) F(1) X; }",
+        ];
+        let mut copied = 0;
+        for text in programs {
+            let prog = program(text);
+            let start = State::default();
+            let mut s = derive::axiom(&prog, &[], 7).expect("axiom");
+            let mut sketch = draw(&prog, &s, start);
+            for step in 1..=prog.derive {
+                let next = derive::step(&prog, &s, step, 7, Limits::default()).expect("step");
+                let whole = draw(&prog, &next, start);
+                let before = sketch.drawn.segments.len();
+                sketch = redraw(&prog, &s, sketch, &next, start);
+                assert_eq!(bits(&sketch.drawn), bits(&whole.drawn), "{text} step {step}");
+                copied += before.min(sketch.drawn.segments.len());
+                s = next;
+            }
+            assert!(sketch.drawn.segments.len() > 20, "{text}");
+        }
+        assert!(copied > 1000, "{copied}");
+    }
+}
