@@ -716,7 +716,8 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
 fn reindex(live: &mut [Live]) {
     live.par_iter_mut().filter(|l| l.redrawn).for_each(|l| {
         let total = l.probes.iter().flatten().map(|d| d.drawn.segments.len()).sum();
-        let mut segs = Vec::with_capacity(total);
+        let mut segs = l.index.as_mut().map_or_else(Vec::new, Grid::buffer);
+        segs.reserve(total);
         for d in l.probes.iter().flatten() {
             segs.extend_from_slice(&d.drawn.segments);
         }

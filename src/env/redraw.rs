@@ -52,12 +52,19 @@ struct Mark {
 pub(crate) struct Sketch {
     pub(crate) drawn: Probe,
     marks: Option<Vec<Mark>>,
+    /// The segment list of the drawing before, emptied: the next redraw
+    /// fills it instead of allocating a list as large.
+    spare: Vec<(glam::DVec2, glam::DVec2)>,
 }
 
 impl Sketch {
     /// A drawing made otherwise, without marks.
     pub(crate) fn whole(drawn: Probe) -> Sketch {
-        Sketch { drawn, marks: None }
+        Sketch {
+            drawn,
+            marks: None,
+            spare: Vec::new(),
+        }
     }
 }
 
@@ -106,7 +113,11 @@ pub(crate) fn draw(prog: &Program, s: &ModString, start: State) -> Sketch {
     let mut marks = Vec::new();
     fresh(prog, &mut st, &mut out, &mut marks, s, 0, s.len(), 0);
     let marks = keep(marks, s.len());
-    Sketch { drawn: out, marks }
+    Sketch {
+        drawn: out,
+        marks,
+        spare: Vec::new(),
+    }
 }
 
 /// Marks are kept when their stacks are not much more than the string.
@@ -265,7 +276,13 @@ fn align(prog: &Program, old: &ModString, marks: &[Mark], new: &ModString) -> Op
 
 /// Draws `new`, the string derived from `old` (drawn as `last`), from the
 /// turtle `start`; see the module note.
-pub(crate) fn redraw(prog: &Program, old: &ModString, last: Sketch, new: &ModString, start: State) -> Sketch {
+pub(crate) fn redraw(
+    prog: &Program,
+    old: &ModString,
+    mut last: Sketch,
+    new: &ModString,
+    start: State,
+) -> Sketch {
     if !redrawable(prog) {
         return draw(prog, new, start);
     }
@@ -284,8 +301,10 @@ pub(crate) fn redraw(prog: &Program, old: &ModString, last: Sketch, new: &ModStr
         segs: 0,
         queries: 0,
     };
+    let mut segments = std::mem::take(&mut last.spare);
+    segments.reserve(drawn.segments.len() + drawn.segments.len() / 8);
     let mut out = Probe {
-        segments: Vec::with_capacity(drawn.segments.len() + drawn.segments.len() / 8),
+        segments,
         queries: Vec::with_capacity(drawn.queries.len() + drawn.queries.len() / 8),
     };
     let mut next = Vec::with_capacity(marks.len() + marks.len() / 4);
@@ -365,9 +384,12 @@ pub(crate) fn redraw(prog: &Program, old: &ModString, last: Sketch, new: &ModStr
         pk = r.pnew + r.plen;
     }
     let marks = keep(next, new.len());
+    let mut spare = std::mem::take(&mut last.drawn.segments);
+    spare.clear();
     Sketch {
         drawn: out,
         marks,
+        spare,
     }
 }
 
