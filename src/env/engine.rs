@@ -601,7 +601,10 @@ impl Live {
 fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<bool, Diagnostic> {
     type Job<'a> = (
         &'a mut Instance,
-        (&'a mut Option<Drawing>, &'a mut Option<(ModString, Drawing)>),
+        (
+            &'a mut Option<Drawing>,
+            &'a mut Option<(ModString, Drawing)>,
+        ),
         &'a mut bool,
         &'a mut bool,
     );
@@ -695,8 +698,15 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
             let last = prev.take();
             if !redraw::redrawable(prog) {
                 let mut p = Probe::default();
-                turtle::interpret_limited(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut p)
-                    .map_err(|e| e.diagnostic(prog))?;
+                turtle::interpret_limited(
+                    prog,
+                    &inst.string,
+                    cfg.seed,
+                    inst.start,
+                    cfg.limits,
+                    &mut p,
+                )
+                .map_err(|e| e.diagnostic(prog))?;
                 *probe = Some(Sketch::whole(p));
                 return Ok(());
             }
@@ -715,7 +725,12 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
 /// updated where they grew.
 fn reindex(live: &mut [Live]) {
     live.par_iter_mut().filter(|l| l.redrawn).for_each(|l| {
-        let total = l.probes.iter().flatten().map(|d| d.drawn.segments.len()).sum();
+        let total = l
+            .probes
+            .iter()
+            .flatten()
+            .map(|d| d.drawn.segments.len())
+            .sum();
         let mut segs = l.index.as_mut().map_or_else(Vec::new, Grid::buffer);
         segs.reserve(total);
         for d in l.probes.iter().flatten() {

@@ -88,8 +88,21 @@ pub(crate) fn redrawable(prog: &Program) -> bool {
 fn same_state(a: &State, b: &State) -> bool {
     let v = |s: &State| {
         [
-            s.pos.x, s.pos.y, s.pos.z, s.h.x, s.h.y, s.h.z, s.l.x, s.l.y, s.l.z, s.u.x, s.u.y,
-            s.u.z, s.scale, s.width, s.elasticity,
+            s.pos.x,
+            s.pos.y,
+            s.pos.z,
+            s.h.x,
+            s.h.y,
+            s.h.z,
+            s.l.x,
+            s.l.y,
+            s.l.z,
+            s.u.x,
+            s.u.y,
+            s.u.z,
+            s.scale,
+            s.width,
+            s.elasticity,
         ]
         .map(f64::to_bits)
     };
@@ -198,7 +211,15 @@ struct Run {
     pnew: usize,
 }
 
-fn equal_at(a: &ModString, ai: usize, pa: usize, b: &ModString, bi: usize, pb: usize, r: Run) -> bool {
+fn equal_at(
+    a: &ModString,
+    ai: usize,
+    pa: usize,
+    b: &ModString,
+    bi: usize,
+    pb: usize,
+    r: Run,
+) -> bool {
     a.syms[ai..ai + r.len] == b.syms[bi..bi + r.len]
         && a.params[pa..pa + r.plen]
             .iter()
@@ -313,7 +334,11 @@ pub(crate) fn redraw(
         // What the rules produced before this run: drawn anew.
         fresh(prog, &mut st, &mut out, &mut next, new, k, r.new, pk);
         let (entry, exit) = (
-            if ri == 0 { &begin } else { &marks[ri - 1].after },
+            if ri == 0 {
+                &begin
+            } else {
+                &marks[ri - 1].after
+            },
             marks.get(ri),
         );
         // Segments and queries the last drawing made in this run from where
@@ -346,9 +371,10 @@ pub(crate) fn redraw(
         };
         match (agree, exit) {
             (Some((_, segs, queries)), exit) if exit.is_none_or(|m| !m.before.polygon) => {
-                let (s_end, q_end) = exit.map_or((drawn.segments.len(), drawn.queries.len()), |m| {
-                    (m.before.segs, m.before.queries)
-                });
+                let (s_end, q_end) = exit
+                    .map_or((drawn.segments.len(), drawn.queries.len()), |m| {
+                        (m.before.segs, m.before.queries)
+                    });
                 out.segments
                     .extend_from_slice(&drawn.segments[entry.segs + segs..s_end]);
                 let shift = r.new as isize - r.old as isize;
@@ -406,7 +432,10 @@ mod tests {
         crate::compile::compile(&fe.file, checked, None).expect("compiles")
     }
 
-    fn bits(p: &Probe) -> (Vec<[u64; 4]>, Vec<(usize, u8, [u64; 3])>) {
+    /// Segments and queries (module, kind, position), bit for bit.
+    type Bits = (Vec<[u64; 4]>, Vec<(usize, u8, [u64; 3])>);
+
+    fn bits(p: &Probe) -> Bits {
         (
             p.segments
                 .iter()
@@ -450,7 +479,11 @@ mod tests {
                 let whole = draw(&prog, &next, start);
                 let before = sketch.drawn.segments.len();
                 sketch = redraw(&prog, &s, sketch, &next, start);
-                assert_eq!(bits(&sketch.drawn), bits(&whole.drawn), "{text} step {step}");
+                assert_eq!(
+                    bits(&sketch.drawn),
+                    bits(&whole.drawn),
+                    "{text} step {step}"
+                );
                 copied += before.min(sketch.drawn.segments.len());
                 s = next;
             }

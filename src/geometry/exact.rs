@@ -295,7 +295,10 @@ mod tests {
             // Lattice points (exact differences), points a few ulps off a
             // line, and points far apart in magnitude.
             let pt = |r: &mut crate::geometry::index::Lcg| match k % 3 {
-                0 => DVec2::new((r.next() * 8.0).floor() * 4.0, (r.next() * 8.0).floor() * 4.0),
+                0 => DVec2::new(
+                    (r.next() * 8.0).floor() * 4.0,
+                    (r.next() * 8.0).floor() * 4.0,
+                ),
                 1 => DVec2::splat(r.next() * 100.0) + DVec2::new(0.0, r.next() * 1e-13),
                 _ => DVec2::new(r.next() * 1e12, (r.next() - 0.5) * 1e-6),
             };
