@@ -14,8 +14,8 @@
 //! state the two drawings share (then the rest of the run is copied). What
 //! the rules produced is drawn anew. The result is always what drawing the
 //! whole string gives: an alignment that is not the derivation's own only
-//! means that less is copied. Programs with interpretation rules are drawn
-//! whole.
+//! means that less is copied. Programs with interpretation rules or `cut` are
+//! drawn whole.
 //!
 //! Owns: `Sketch` (a drawing and its marks), `draw` and `redraw`. Must not
 //! answer queries or index segments.
@@ -80,9 +80,10 @@ fn active(prog: &Program, sym: Sym) -> bool {
 }
 
 /// Whether a program's drawings can be redrawn in part (`draw` and `redraw`
-/// serve it).
+/// serve it). With `cut`, a step removes modules without rules, and their
+/// runs would be searched for in vain.
 pub(crate) fn redrawable(prog: &Program) -> bool {
-    prog.interpret.iter().all(|r| r.is_empty())
+    prog.interpret.iter().all(|r| r.is_empty()) && !prog.has_cut
 }
 
 fn same_state(a: &State, b: &State) -> bool {
