@@ -291,6 +291,100 @@ pub fn interpret_limited(
     Ok(t.drawn)
 }
 
+/// The turtle of `interpret`, driven a run of modules at a time by a caller
+/// that keeps the sink and may set the turtle's state and stack between runs
+/// (the environment redraws only what changed in a string). Only for programs
+/// without interpretation rules; the drawing is the one `interpret_from` makes
+/// when the runs cover the string in order.
+pub struct Stepper<'p> {
+    prog: &'p Program,
+    tropism: DVec3,
+    pub state: State,
+    pub stack: Vec<State>,
+    polygons: Vec<Vec<DVec3>>,
+    trig: Trig,
+}
+
+impl<'p> Stepper<'p> {
+    /// A turtle at `start`, as `interpret_from` starts it.
+    pub fn new(prog: &'p Program, start: State) -> Stepper<'p> {
+        let mut state = start;
+        if let Some((_, e)) = prog.tropism {
+            state.elasticity = e;
+        }
+        Stepper {
+            prog,
+            tropism: DVec3::from(prog.tropism.map_or(DEFAULT_TROPISM, |t| t.0)),
+            state,
+            stack: Vec::new(),
+            polygons: Vec::new(),
+            trig: Trig {
+                deg: 0.0,
+                sin: 0.0,
+                cos: 1.0,
+            },
+        }
+    }
+
+    /// Whether a polygon is open (`{` without its `}`).
+    pub fn in_polygon(&self) -> bool {
+        !self.polygons.is_empty()
+    }
+
+    /// Interprets `syms` (module `first` of the string onwards; `params` are
+    /// theirs, in order) into `sink`. With `below = Some(d)` it stops after
+    /// the first `]` that leaves fewer than `d` states on the stack, outside
+    /// any polygon. Returns how many modules it interpreted.
+    pub fn run(
+        &mut self,
+        sink: &mut dyn Sink,
+        syms: &[Sym],
+        params: &[f64],
+        first: usize,
+        below: Option<usize>,
+    ) -> usize {
+        let mut t = Turtle {
+            prog: self.prog,
+            tropism: self.tropism,
+            sink,
+            state: self.state,
+            stack: std::mem::take(&mut self.stack),
+            polygons: std::mem::take(&mut self.polygons),
+            drawn: Drawn::default(),
+            seed: 0,
+            stack_vm: Vec::new(),
+            trig: self.trig,
+            cands: Vec::new(),
+            module_index: first,
+            expanded: 0,
+            max_modules: usize::MAX,
+            expanded_here: 0,
+            element_boxes: Vec::new(),
+        };
+        let mut p = 0;
+        let mut done = syms.len();
+        for (k, &sym) in syms.iter().enumerate() {
+            let n = t.prog.symbols.arity(sym);
+            t.module_index = first + k;
+            t.module(sym, &params[p..p + n]);
+            p += n;
+            if let Some(d) = below
+                && t.stack.len() < d
+                && t.polygons.is_empty()
+                && t.prog.symbols.info[sym as usize].action == Action::Pop
+            {
+                done = k + 1;
+                break;
+            }
+        }
+        self.state = t.state;
+        self.stack = t.stack;
+        self.polygons = t.polygons;
+        self.trig = t.trig;
+        done
+    }
+}
+
 struct Turtle<'a> {
     prog: &'a Program,
     /// The tropism vector T.

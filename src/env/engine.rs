@@ -32,6 +32,7 @@
 
 use super::index::{Grid, Layers};
 use super::query::{Answer, Probe, collide, edge_meet, inward, query};
+use super::redraw::{self, Sketch};
 use super::scene::{Link, Scene, seed_state};
 use crate::derive::{self, Limits, ModString};
 use crate::diagnostic::Diagnostic;
@@ -194,22 +195,26 @@ struct Reservation {
     pass: Vec<f64>,
 }
 
-/// A system's drawing: its segments (and elements' axes) in a grid, and the
-/// query modules met, with the turtle there. When the string changes, the grid
-/// is kept until the system is drawn again: growth inserts segments into the
-/// drawing, and only those are indexed anew (`Grid::update`).
-struct Drawing {
-    grid: Grid,
-    queries: Vec<(usize, u8, State)>,
-}
+/// A system's drawing: its segments (and elements' axes), and the query
+/// modules met, with the turtle there (`drawn`).
+type Drawing = Sketch;
 
 /// A unit's guide while it runs.
 struct Live {
     guide: usize,
     run: GuideRun,
     probes: Vec<Option<Drawing>>,
-    /// The grid of the system's last drawing, while it is to be drawn again.
-    stale: Vec<Option<Grid>>,
+    /// A system's last drawing, while it is to be drawn again, and the string
+    /// it was drawn from: `redraw` reuses what did not change.
+    prev: Vec<Option<(ModString, Drawing)>>,
+    /// One grid over the segments of all its systems' drawings, in system
+    /// order (the ids of `Layers`). Kept from step to step: growth inserts
+    /// segments into the drawings, and only those are indexed anew
+    /// (`Grid::update`), so a query asks one index, however many systems the
+    /// guide holds.
+    index: Option<Grid>,
+    /// A system was drawn since `index` was made.
+    redrawn: bool,
     /// Answer this system's queries in this step.
     fresh: Vec<bool>,
     /// The system's string holds only modules without rules (no query, no
@@ -516,7 +521,9 @@ fn start(scene: &Scene, cfg: Config, unit: &[usize]) -> Result<Vec<Live>, Diagno
             guide: g,
             run: GuideRun::default(),
             probes: Vec::new(),
-            stale: Vec::new(),
+            prev: Vec::new(),
+            index: None,
+            redrawn: false,
             fresh: Vec::new(),
             settled: Vec::new(),
             reserved: Vec::new(),
@@ -584,7 +591,7 @@ impl Live {
     fn add(&mut self, inst: Instance) {
         self.run.instances.push(inst);
         self.probes.push(None);
-        self.stale.push(None);
+        self.prev.push(None);
         self.fresh.push(true);
         self.settled.push(false);
     }
@@ -594,7 +601,10 @@ impl Live {
 fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<bool, Diagnostic> {
     type Job<'a> = (
         &'a mut Instance,
-        (&'a mut Option<Drawing>, &'a mut Option<Grid>),
+        (
+            &'a mut Option<Drawing>,
+            &'a mut Option<(ModString, Drawing)>,
+        ),
         &'a mut bool,
         &'a mut bool,
     );
@@ -607,7 +617,7 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
             .run
             .instances
             .iter_mut()
-            .zip(l.probes.iter_mut().zip(&mut l.stale))
+            .zip(l.probes.iter_mut().zip(&mut l.prev))
             .zip(&mut l.fresh)
             .zip(&mut l.settled)
         {
@@ -635,9 +645,11 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
                 .map_err(|e| e.diagnostic(prog))?;
             // An unchanged string draws the same: keep its drawing.
             if string != inst.string {
-                inst.string = string;
+                let old = std::mem::replace(&mut inst.string, string);
                 inst.changed = t;
-                outdate(probe.0, probe.1);
+                if let Some(d) = probe.0.take() {
+                    *probe.1 = Some((old, d));
+                }
             }
             *fresh = true;
             *settled = inst.string.syms.iter().all(|&x| inert(prog, x));
@@ -667,31 +679,40 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
 fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagnostic> {
     let mut jobs = Vec::new();
     for l in live.iter_mut() {
-        for (inst, (probe, stale)) in l
+        for (inst, (probe, prev)) in l
             .run
             .instances
             .iter()
-            .zip(l.probes.iter_mut().zip(&mut l.stale))
+            .zip(l.probes.iter_mut().zip(&mut l.prev))
         {
             if probe.is_none() {
-                jobs.push((inst, probe, stale));
+                l.redrawn = true;
+                jobs.push((inst, probe, prev));
             }
         }
     }
     let results: Vec<Result<(), Diagnostic>> = jobs
         .into_par_iter()
-        .map(|(inst, probe, stale)| {
+        .map(|(inst, probe, prev)| {
             let prog = &scene.programs[scene.guides[inst.guide].program];
-            let mut p = Probe::default();
-            turtle::interpret_limited(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut p)
+            let last = prev.take();
+            if !redraw::redrawable(prog) {
+                let mut p = Probe::default();
+                turtle::interpret_limited(
+                    prog,
+                    &inst.string,
+                    cfg.seed,
+                    inst.start,
+                    cfg.limits,
+                    &mut p,
+                )
                 .map_err(|e| e.diagnostic(prog))?;
-            let grid = match stale.take() {
-                Some(g) => g.update(p.segments),
-                None => Grid::new(p.segments),
-            };
-            *probe = Some(Drawing {
-                grid,
-                queries: p.queries,
+                *probe = Some(Sketch::whole(p));
+                return Ok(());
+            }
+            *probe = Some(match last {
+                Some((old, d)) => redraw::redraw(prog, &old, d, &inst.string, inst.start),
+                None => redraw::draw(prog, &inst.string, inst.start),
             });
             Ok(())
         })
@@ -699,12 +720,28 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
     results.into_iter().collect()
 }
 
-/// Marks a system's drawing as out of date, keeping its grid for the next
-/// drawing to update.
-fn outdate(probe: &mut Option<Drawing>, stale: &mut Option<Grid>) {
-    if let Some(d) = probe.take() {
-        *stale = Some(d.grid);
-    }
+/// Brings each guide's index up to its systems' drawings (all drawn): the
+/// segments of all its systems, in order, with the grid of the last index
+/// updated where they grew.
+fn reindex(live: &mut [Live]) {
+    live.par_iter_mut().filter(|l| l.redrawn).for_each(|l| {
+        let total = l
+            .probes
+            .iter()
+            .flatten()
+            .map(|d| d.drawn.segments.len())
+            .sum();
+        let mut segs = l.index.as_mut().map_or_else(Vec::new, Grid::buffer);
+        segs.reserve(total);
+        for d in l.probes.iter().flatten() {
+            segs.extend_from_slice(&d.drawn.segments);
+        }
+        l.index = Some(match l.index.take() {
+            Some(g) => g.update(segs),
+            None => Grid::new(segs),
+        });
+        l.redrawn = false;
+    });
 }
 
 /// Settles the reservations of guide `l` made in the step before `t`.
@@ -719,7 +756,7 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
         // closest to its heading (the first of equals): several branches may
         // start at one point.
         let mut hit: Option<(f64, DVec2, DVec2)> = None;
-        for &(s0, s1) in l.probes[r.instance].iter().flat_map(|p| p.grid.segs()) {
+        for &(s0, s1) in l.probes[r.instance].iter().flat_map(|p| &p.drawn.segments) {
             if (s0 - r.from).length() > tol {
                 continue;
             }
@@ -818,6 +855,7 @@ fn answer(
     t: u32,
 ) -> Result<(), Diagnostic> {
     interpret(scene, cfg, live)?;
+    reindex(live);
     let layers = layers(live);
     let answered: Vec<(usize, usize, Answers)> = fresh_drawings(live)
         .into_par_iter()
@@ -842,17 +880,11 @@ fn answer(
     Ok(())
 }
 
-/// Per guide: the grids of its systems' drawings, ids running on.
+/// Per guide: the index of its systems' drawings.
 fn layers(live: &[Live]) -> Vec<Layers<'_>> {
     live.iter()
-        .map(|l| {
-            let mut off = 0;
-            let mut parts = Vec::with_capacity(l.probes.len());
-            for d in l.probes.iter().flatten() {
-                parts.push((off, &d.grid));
-                off += d.grid.segs().len();
-            }
-            Layers { parts }
+        .map(|l| Layers {
+            parts: l.index.iter().map(|g| (0, g)).collect(),
         })
         .collect()
 }
@@ -864,7 +896,7 @@ fn fresh_drawings(live: &[Live]) -> Vec<(usize, usize, &Drawing)> {
     for (li, l) in live.iter().enumerate() {
         for (k, (p, &f)) in l.probes.iter().zip(&l.fresh).enumerate() {
             if let (Some(p), true) = (p, f)
-                && !p.queries.is_empty()
+                && !p.drawn.queries.is_empty()
             {
                 jobs.push((li, k, p));
             }
@@ -884,9 +916,9 @@ fn answer_system(scene: &Scene, l: &Live, layers: &Layers, k: usize, drawing: &D
     let prog = &scene.programs[scene.guides[gi].program];
     let offsets = param_offsets(prog, &inst.string);
     let grid = Some(layers);
-    let mut answers = Vec::with_capacity(drawing.queries.len());
+    let mut answers = Vec::with_capacity(drawing.drawn.queries.len());
     let mut crossings = Vec::new();
-    for &(module, kind, state) in &drawing.queries {
+    for &(module, kind, state) in &drawing.drawn.queries {
         let q = &QUERIES[kind as usize];
         let at = offsets[module] as usize;
         let arity = prog.symbols.arity(inst.string.syms[module]);
@@ -936,7 +968,7 @@ fn write_answers(
     }
     if queries_interpreted(prog) {
         // Its drawing may read the answers: draw it again when needed.
-        outdate(&mut l.probes[k], &mut l.stale[k]);
+        l.probes[k] = None;
     }
     inst.steps < prog.derive
 }

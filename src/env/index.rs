@@ -1,7 +1,8 @@
 //! The spatial index of the segments drawn in a guide, as the environment
-//! asks it: one `Grid` (the crate's `geometry::index::GrowingGrid`, kept from
-//! step to step while the system grows) per system, and `Layers`, the grids of
-//! all systems of a guide searched as one.
+//! asks it: a `Grid` (the crate's `geometry::index::GrowingGrid`, kept from
+//! step to step while the systems grow; the engine keeps one per guide, over
+//! the segments of all its systems in order), and `Layers`, grids whose ids
+//! run on from one to the next, searched as one.
 //!
 //! Owns: numbering segments across systems and merging the per-grid answers
 //! (the lowest id wins ties). Must not index or search segments itself.

@@ -9,6 +9,8 @@
 //! - `index` — the layers of segments drawn in a guide (`Grid`, `Layers`);
 //! - `query` — the answers to query modules (`Probe`, `Answer`, `query`,
 //!   `collide`);
+//! - `redraw` — a system's drawing for its queries and index, drawn again
+//!   after a step by reusing what did not change (`Sketch`, `draw`, `redraw`);
 //! - `clip` — the centre rule (`Clip`, `element_centres`, `outline_centre`);
 //! - `explain` — what each guide did in a run and the warnings a run
 //!   deserves (`explain`, `warnings`);
@@ -17,7 +19,7 @@
 //!   incremental reruns (`execute`, `Runner`), and the entry `run`.
 //!
 //! Who may call whom (a DAG; an arrow reads "imports"): `explain` → `engine`,
-//! `scene`, `clip`; `engine` → `query`, `scene`, `index`; `query` → `scene`, `index`. `scene`, `index` and `clip`
+//! `scene`, `clip`; `engine` → `query`, `redraw`, `scene`, `index`; `redraw` → `query`; `query` → `scene`, `index`. `scene`, `index` and `clip`
 //! import nothing from `env`. Plane geometry comes from `crate::geometry`.
 //!
 //! Must not parse or print programs.
@@ -27,6 +29,7 @@ pub mod engine;
 pub mod explain;
 pub mod index;
 pub mod query;
+pub mod redraw;
 pub mod scene;
 
 pub use clip::{Clip, element_centres, outline_centre};

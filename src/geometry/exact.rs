@@ -74,6 +74,18 @@ pub fn orient(a: DVec2, b: DVec2, c: DVec2) -> Ordering {
     if -det > bound {
         return Ordering::Less;
     }
+    // Collinear points on a lattice (streets along one line) land here: when
+    // the four differences are exact, the determinant is the difference of two
+    // exact products, an expansion of four terms.
+    let (acx, e1) = two_sum(a.x, -c.x);
+    let (bcy, e2) = two_sum(b.y, -c.y);
+    let (acy, e3) = two_sum(a.y, -c.y);
+    let (bcx, e4) = two_sum(b.x, -c.x);
+    if e1 == 0.0 && e2 == 0.0 && e3 == 0.0 && e4 == 0.0 {
+        let [l, le] = two_product(acx, bcy);
+        let [r, re] = two_product(acy, bcx);
+        return exact_sign(&[le, l, -re, -r]);
+    }
     // ax·by − ax·cy − cx·by − ay·bx + ay·cx + cy·bx, each product exact in two parts.
     let mut terms = [0.0; 12];
     let products = [
@@ -254,5 +266,48 @@ mod tests {
         assert_eq!(orient(a, b, DVec2::new(24.0, 24.0)), Ordering::Equal);
         let c = DVec2::new(0.1, 0.1);
         assert_eq!(orient(a, b, c), Ordering::Equal);
+    }
+
+    /// The sign from the full expansion of the six products, for comparison.
+    fn orient_full(a: DVec2, b: DVec2, c: DVec2) -> Ordering {
+        let mut terms = [0.0; 12];
+        let products = [
+            (a.x, b.y),
+            (-a.x, c.y),
+            (-c.x, b.y),
+            (-a.y, b.x),
+            (a.y, c.x),
+            (c.y, b.x),
+        ];
+        for (k, (u, v)) in products.into_iter().enumerate() {
+            let [x, y] = two_product(u, v);
+            terms[2 * k] = y;
+            terms[2 * k + 1] = x;
+        }
+        exact_sign(&terms)
+    }
+
+    #[test]
+    fn every_stage_agrees_with_the_full_expansion() {
+        let mut r = crate::geometry::index::Lcg(5);
+        let mut stages = [0usize; 3];
+        for k in 0..20_000 {
+            // Lattice points (exact differences), points a few ulps off a
+            // line, and points far apart in magnitude.
+            let pt = |r: &mut crate::geometry::index::Lcg| match k % 3 {
+                0 => DVec2::new(
+                    (r.next() * 8.0).floor() * 4.0,
+                    (r.next() * 8.0).floor() * 4.0,
+                ),
+                1 => DVec2::splat(r.next() * 100.0) + DVec2::new(0.0, r.next() * 1e-13),
+                _ => DVec2::new(r.next() * 1e12, (r.next() - 0.5) * 1e-6),
+            };
+            let (a, b, c) = (pt(&mut r), pt(&mut r), pt(&mut r));
+            let o = orient(a, b, c);
+            assert_eq!(o, orient_full(a, b, c), "{a} {b} {c}");
+            stages[k % 3] += usize::from(o == Ordering::Equal);
+        }
+        // Collinear triples were met, on the lattice and off it.
+        assert!(stages[0] > 100 && stages[1] > 10, "{stages:?}");
     }
 }

@@ -40,6 +40,9 @@ impl Part {
 pub struct GrowingGrid {
     segs: Vec<(DVec2, DVec2)>,
     parts: Vec<Part>,
+    /// The list before the last update, emptied, for the caller to fill with
+    /// the next (`buffer`): a large list is not allocated anew at each step.
+    spare: Vec<(DVec2, DVec2)>,
 }
 
 /// Whether two segments are the same, bit for bit.
@@ -106,7 +109,16 @@ impl GrowingGrid {
                 ids: (0..segs.len() as u32).collect(),
             }]
         };
-        GrowingGrid { segs, parts }
+        GrowingGrid {
+            segs,
+            parts,
+            spare: Vec::new(),
+        }
+    }
+
+    /// An empty list with room, to fill with the segments of the next update.
+    pub fn buffer(&mut self) -> Vec<(DVec2, DVec2)> {
+        std::mem::take(&mut self.spare)
     }
 
     /// The index of `segs`, reusing this one's grids when `segs` holds its
@@ -124,7 +136,9 @@ impl GrowingGrid {
                 *id = at[*id as usize];
             }
         }
-        self.segs = segs;
+        let mut old = std::mem::replace(&mut self.segs, segs);
+        old.clear();
+        self.spare = old;
         if !fresh.is_empty() {
             self.parts.push(Part::over(&self.segs, fresh));
         }

@@ -1,0 +1,495 @@
+//! Drawing a system's string for its queries and index, and drawing it again
+//! after a derivation step by reusing the last drawing where the string did
+//! not change.
+//!
+//! A step rewrites only the modules that have rules (here *active*); the
+//! others are copied. A drawing keeps, at every run of active modules, the
+//! turtle (state, stack) before and after it and how many segments and
+//! queries were drawn up to there (`Mark`). The next string is aligned with
+//! the last one: every run of inactive modules between two active runs must
+//! appear again, in order, equal module for module (parameters bit for bit).
+//! A copied run entered with the turtle it was entered with last time draws
+//! what it drew then, so its segments and queries are copied and the turtle
+//! is set to the one after it; otherwise the run is drawn, until a `]` pops a
+//! state the two drawings share (then the rest of the run is copied). What
+//! the rules produced is drawn anew. The result is always what drawing the
+//! whole string gives: an alignment that is not the derivation's own only
+//! means that less is copied. Programs with interpretation rules or `cut` are
+//! drawn whole.
+//!
+//! Owns: `Sketch` (a drawing and its marks), `draw` and `redraw`. Must not
+//! answer queries or index segments.
+
+use super::query::Probe;
+use crate::compile::{Program, Sym};
+use crate::derive::ModString;
+use crate::turtle::{State, Stepper};
+
+/// The turtle at one place of the string, and what was drawn before it.
+#[derive(Clone)]
+struct Snap {
+    state: State,
+    stack: Vec<State>,
+    /// A polygon was open (the turtle cannot be set to this place).
+    polygon: bool,
+    segs: usize,
+    queries: usize,
+}
+
+/// A run of active modules: where it is (modules and parameters) and the
+/// turtle before and after it.
+struct Mark {
+    start: usize,
+    end: usize,
+    pstart: usize,
+    pend: usize,
+    before: Snap,
+    after: Snap,
+}
+
+/// A system's drawing: its segments (and elements' axes), the query modules
+/// met, and its marks (`None`: the next string is drawn whole).
+pub(crate) struct Sketch {
+    pub(crate) drawn: Probe,
+    marks: Option<Vec<Mark>>,
+    /// The segment list of the drawing before, emptied: the next redraw
+    /// fills it instead of allocating a list as large.
+    spare: Vec<(glam::DVec2, glam::DVec2)>,
+}
+
+impl Sketch {
+    /// A drawing made otherwise, without marks.
+    pub(crate) fn whole(drawn: Probe) -> Sketch {
+        Sketch {
+            drawn,
+            marks: None,
+            spare: Vec::new(),
+        }
+    }
+}
+
+/// Whether the modules of `sym` may be rewritten by a step.
+fn active(prog: &Program, sym: Sym) -> bool {
+    let i = sym as usize;
+    prog.rules.get(i).is_some_and(|r| !r.is_empty())
+        || prog.decompose.get(i).is_some_and(|r| !r.is_empty())
+        || matches!(
+            prog.symbols.info[i].action,
+            crate::compile::Action::Cut | crate::compile::Action::Query(_)
+        )
+}
+
+/// Whether a program's drawings can be redrawn in part (`draw` and `redraw`
+/// serve it). With `cut`, a step removes modules without rules, and their
+/// runs would be searched for in vain.
+pub(crate) fn redrawable(prog: &Program) -> bool {
+    prog.interpret.iter().all(|r| r.is_empty()) && !prog.has_cut
+}
+
+fn same_state(a: &State, b: &State) -> bool {
+    let v = |s: &State| {
+        [
+            s.pos.x,
+            s.pos.y,
+            s.pos.z,
+            s.h.x,
+            s.h.y,
+            s.h.z,
+            s.l.x,
+            s.l.y,
+            s.l.z,
+            s.u.x,
+            s.u.y,
+            s.u.z,
+            s.scale,
+            s.width,
+            s.elasticity,
+        ]
+        .map(f64::to_bits)
+    };
+    v(a) == v(b) && a.color == b.color && a.contour == b.contour
+}
+
+/// How many states at the bottom of two stacks are the same.
+fn shared(a: &[State], b: &[State]) -> usize {
+    a.iter()
+        .zip(b)
+        .take_while(|(x, y)| same_state(x, y))
+        .count()
+}
+
+/// Draws a string whole, from the turtle `start`, as `turtle::interpret_from`
+/// does (segments, elements' axes, queries), with marks when the program has
+/// no interpretation rules.
+pub(crate) fn draw(prog: &Program, s: &ModString, start: State) -> Sketch {
+    let mut st = Stepper::new(prog, start);
+    let mut out = Probe::default();
+    let mut marks = Vec::new();
+    fresh(prog, &mut st, &mut out, &mut marks, s, 0, s.len(), 0);
+    let marks = keep(marks, s.len());
+    Sketch {
+        drawn: out,
+        marks,
+        spare: Vec::new(),
+    }
+}
+
+/// Marks are kept when their stacks are not much more than the string.
+fn keep(marks: Vec<Mark>, len: usize) -> Option<Vec<Mark>> {
+    let held: usize = marks
+        .iter()
+        .map(|m| 2 + m.before.stack.len() + m.after.stack.len())
+        .sum();
+    (held <= len / 2 + 4096).then_some(marks)
+}
+
+fn snap(st: &Stepper, out: &Probe) -> Snap {
+    Snap {
+        state: st.state,
+        stack: st.stack.clone(),
+        polygon: st.in_polygon(),
+        segs: out.segments.len(),
+        queries: out.queries.len(),
+    }
+}
+
+/// Draws modules `from..to` of `s` (parameters from `p`), marking its runs of
+/// active modules.
+#[allow(clippy::too_many_arguments)]
+fn fresh(
+    prog: &Program,
+    st: &mut Stepper,
+    out: &mut Probe,
+    marks: &mut Vec<Mark>,
+    s: &ModString,
+    from: usize,
+    to: usize,
+    mut p: usize,
+) {
+    let params = |a: usize, b: usize, p: usize| -> usize {
+        p + s.syms[a..b]
+            .iter()
+            .map(|&x| prog.symbols.arity(x))
+            .sum::<usize>()
+    };
+    let mut i = from;
+    while i < to {
+        let is_active = active(prog, s.syms[i]);
+        let mut j = i + 1;
+        while j < to && active(prog, s.syms[j]) == is_active {
+            j += 1;
+        }
+        let q = params(i, j, p);
+        if is_active {
+            let before = snap(st, out);
+            st.run(out, &s.syms[i..j], &s.params[p..q], i, None);
+            marks.push(Mark {
+                start: i,
+                end: j,
+                pstart: p,
+                pend: q,
+                before,
+                after: snap(st, out),
+            });
+        } else {
+            st.run(out, &s.syms[i..j], &s.params[p..q], i, None);
+        }
+        i = j;
+        p = q;
+    }
+}
+
+/// A run of inactive modules of the last string and where it is in the new
+/// one: modules `old..old + len` (parameters from `pold`, `plen` of them) at
+/// `new` (parameters from `pnew`).
+#[derive(Clone, Copy)]
+struct Run {
+    old: usize,
+    pold: usize,
+    len: usize,
+    plen: usize,
+    new: usize,
+    pnew: usize,
+}
+
+fn equal_at(
+    a: &ModString,
+    ai: usize,
+    pa: usize,
+    b: &ModString,
+    bi: usize,
+    pb: usize,
+    r: Run,
+) -> bool {
+    a.syms[ai..ai + r.len] == b.syms[bi..bi + r.len]
+        && a.params[pa..pa + r.plen]
+            .iter()
+            .zip(&b.params[pb..pb + r.plen])
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+/// Places the inactive runs of `old` (between its marks) in `new`: the first
+/// at the start, the last at the end, the others each at its first place
+/// after the one before. `None` when they do not all fit.
+fn align(prog: &Program, old: &ModString, marks: &[Mark], new: &ModString) -> Option<Vec<Run>> {
+    let mut runs = Vec::with_capacity(marks.len() + 1);
+    let (mut o, mut po) = (0, 0);
+    for m in marks {
+        runs.push(Run {
+            old: o,
+            pold: po,
+            len: m.start - o,
+            plen: m.pstart - po,
+            new: 0,
+            pnew: 0,
+        });
+        (o, po) = (m.end, m.pend);
+    }
+    runs.push(Run {
+        old: o,
+        pold: po,
+        len: old.len() - o,
+        plen: old.params.len() - po,
+        new: 0,
+        pnew: 0,
+    });
+    let last = runs.len() - 1;
+    let (mut k, mut pk) = (0usize, 0usize);
+    for (ri, r) in runs.iter_mut().enumerate() {
+        if ri == last {
+            // The last run ends the string.
+            let at = new.len().checked_sub(r.len)?;
+            let pat = new.params.len().checked_sub(r.plen)?;
+            if at < k || pat < pk || !equal_at(old, r.old, r.pold, new, at, pat, *r) {
+                return None;
+            }
+            r.new = at;
+            r.pnew = pat;
+            break;
+        }
+        if ri == 0 {
+            if r.len > new.len() || r.plen > new.params.len() {
+                return None;
+            }
+            if !equal_at(old, r.old, r.pold, new, 0, 0, *r) {
+                return None;
+            }
+        } else {
+            loop {
+                if k + r.len > new.len() || pk + r.plen > new.params.len() {
+                    return None;
+                }
+                if (r.len == 0 || new.syms[k] == old.syms[r.old])
+                    && equal_at(old, r.old, r.pold, new, k, pk, *r)
+                {
+                    break;
+                }
+                pk += prog.symbols.arity(new.syms[k]);
+                k += 1;
+            }
+        }
+        r.new = k;
+        r.pnew = pk;
+        k += r.len;
+        pk += r.plen;
+    }
+    Some(runs)
+}
+
+/// Draws `new`, the string derived from `old` (drawn as `last`), from the
+/// turtle `start`; see the module note.
+pub(crate) fn redraw(
+    prog: &Program,
+    old: &ModString,
+    mut last: Sketch,
+    new: &ModString,
+    start: State,
+) -> Sketch {
+    if !redrawable(prog) {
+        return draw(prog, new, start);
+    }
+    let Some(marks) = last.marks.as_deref() else {
+        return draw(prog, new, start);
+    };
+    let Some(runs) = align(prog, old, marks, new) else {
+        return draw(prog, new, start);
+    };
+    let drawn = &last.drawn;
+    let mut st = Stepper::new(prog, start);
+    let begin = Snap {
+        state: st.state,
+        stack: Vec::new(),
+        polygon: false,
+        segs: 0,
+        queries: 0,
+    };
+    let mut segments = std::mem::take(&mut last.spare);
+    segments.reserve(drawn.segments.len() + drawn.segments.len() / 8);
+    let mut out = Probe {
+        segments,
+        queries: Vec::with_capacity(drawn.queries.len() + drawn.queries.len() / 8),
+    };
+    let mut next = Vec::with_capacity(marks.len() + marks.len() / 4);
+    let (mut k, mut pk) = (0usize, 0usize);
+    for (ri, r) in runs.iter().enumerate() {
+        // What the rules produced before this run: drawn anew.
+        fresh(prog, &mut st, &mut out, &mut next, new, k, r.new, pk);
+        let (entry, exit) = (
+            if ri == 0 {
+                &begin
+            } else {
+                &marks[ri - 1].after
+            },
+            marks.get(ri),
+        );
+        // Segments and queries the last drawing made in this run from where
+        // the two drawings agree (`skip` modules in, `segs` and `queries`
+        // drawn by then).
+        let agree = if same_state(&st.state, &entry.state)
+            && shared(&st.stack, &entry.stack) == entry.stack.len()
+            && st.stack.len() == entry.stack.len()
+            && !st.in_polygon()
+            && !entry.polygon
+        {
+            Some((0, 0, 0))
+        } else {
+            let depth = shared(&st.stack, &entry.stack);
+            let below = (st.stack.len() == entry.stack.len()
+                && !st.in_polygon()
+                && !entry.polygon
+                && depth > 0)
+                .then_some(depth);
+            let (s0, q0) = (out.segments.len(), out.queries.len());
+            let end = r.pnew + r.plen;
+            let done = st.run(
+                &mut out,
+                &new.syms[r.new..r.new + r.len],
+                &new.params[r.pnew..end],
+                r.new,
+                below,
+            );
+            (done < r.len).then(|| (done, out.segments.len() - s0, out.queries.len() - q0))
+        };
+        match (agree, exit) {
+            (Some((_, segs, queries)), exit) if exit.is_none_or(|m| !m.before.polygon) => {
+                let (s_end, q_end) = exit
+                    .map_or((drawn.segments.len(), drawn.queries.len()), |m| {
+                        (m.before.segs, m.before.queries)
+                    });
+                out.segments
+                    .extend_from_slice(&drawn.segments[entry.segs + segs..s_end]);
+                let shift = r.new as isize - r.old as isize;
+                out.queries.extend(
+                    drawn.queries[entry.queries + queries..q_end]
+                        .iter()
+                        .map(|&(m, kind, state)| ((m as isize + shift) as usize, kind, state)),
+                );
+                if let Some(m) = exit {
+                    st.state = m.before.state;
+                    st.stack.clone_from(&m.before.stack);
+                }
+            }
+            (Some((skip, _, _)), _) => {
+                // The turtle cannot be set inside a polygon: draw the rest.
+                let from = r.new + skip;
+                let pfrom = r.pnew
+                    + new.syms[r.new..from]
+                        .iter()
+                        .map(|&x| prog.symbols.arity(x))
+                        .sum::<usize>();
+                st.run(
+                    &mut out,
+                    &new.syms[from..r.new + r.len],
+                    &new.params[pfrom..r.pnew + r.plen],
+                    from,
+                    None,
+                );
+            }
+            (None, _) => {}
+        }
+        k = r.new + r.len;
+        pk = r.pnew + r.plen;
+    }
+    let marks = keep(next, new.len());
+    let mut spare = std::mem::take(&mut last.drawn.segments);
+    spare.clear();
+    Sketch {
+        drawn: out,
+        marks,
+        spare,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::derive::{self, Limits};
+    use crate::turtle::State;
+
+    fn program(text: &str) -> Program {
+        let fe = crate::frontend::run(text, vec![], &[]);
+        assert!(!fe.has_errors(), "{:?}", fe.diagnostics);
+        let checked = fe.checked.as_ref().expect("checked");
+        crate::compile::compile(&fe.file, checked, None).expect("compiles")
+    }
+
+    /// Segments and queries (module, kind, position), bit for bit.
+    type Bits = (Vec<[u64; 4]>, Vec<(usize, u8, [u64; 3])>);
+
+    fn bits(p: &Probe) -> Bits {
+        (
+            p.segments
+                .iter()
+                .map(|(a, b)| [a.x, a.y, b.x, b.y].map(f64::to_bits))
+                .collect(),
+            p.queries
+                .iter()
+                .map(|(m, k, s)| (*m, *k, s.pos.to_array().map(f64::to_bits)))
+                .collect(),
+        )
+    }
+
+    /// Derives each program step by step; every step's redraw must equal a
+    /// whole drawing of the string (segments bit for bit, queries with their
+    /// modules), and the redraws must have copied most of the drawing.
+    #[test]
+    fn a_redraw_is_the_whole_drawing() {
+        let programs = [
+            // Tips that grow inside branches, turn by their parameter, and
+            // stop at random: most of the string stays.
+            "lsystem A { derive 40; axiom [X(0)][+(90) X(1)] F X(2); \
+             X(k) : k < 30 -> F(1) +(k * 3) [-(45) Y(k)] F(2) X(k + 1); \
+             X(k) -> ; Y(k) : k % 3 == 0 -> F(1) Y(k + 1); Y(k) -> F(0.5); }",
+            // Polygons opened before a tip and closed after it; a tip inside a
+            // polygon; branches inside the polygon.
+            "lsystem B { derive 9; axiom A {. f(1) . [B] . B . } C; \
+             A -> F(1) [+(30) A] A; B -> f(1) . +(10) B; C -> F(1) [-(5) C] C; }",
+            // Stochastic rules and a queried tip (?P).
+            "lsystem C { derive 30; axiom ?P X; \
+             ?P(x, y, _) -> F(1) ?P; \
+             X -> (1) F(1) [+(20) X] X; X -> (1) F(1) [-(20) X]; X -> (2) F(1) X; }",
+        ];
+        let mut copied = 0;
+        for text in programs {
+            let prog = program(text);
+            let start = State::default();
+            let mut s = derive::axiom(&prog, &[], 7).expect("axiom");
+            let mut sketch = draw(&prog, &s, start);
+            for step in 1..=prog.derive {
+                let next = derive::step(&prog, &s, step, 7, Limits::default()).expect("step");
+                let whole = draw(&prog, &next, start);
+                let before = sketch.drawn.segments.len();
+                sketch = redraw(&prog, &s, sketch, &next, start);
+                assert_eq!(
+                    bits(&sketch.drawn),
+                    bits(&whole.drawn),
+                    "{text} step {step}"
+                );
+                copied += before.min(sketch.drawn.segments.len());
+                s = next;
+            }
+            assert!(sketch.drawn.segments.len() > 20, "{text}");
+        }
+        assert!(copied > 1000, "{copied}");
+    }
+}
