@@ -21,7 +21,8 @@ const NONE: u32 = u32::MAX;
 /// One cluster of edges as a transform of branchings: each node's child by
 /// it (the edge of lowest index out of the node), and the transform.
 pub(super) struct Children {
-    /// Per instance, the edge to its child (`NONE`: it has none).
+    /// Per instance, its child (`NONE`: it has none) and the edge to it.
+    to: Vec<u32>,
     edge: Vec<u32>,
     /// The instances with a child, in increasing order.
     from: Vec<usize>,
@@ -31,31 +32,34 @@ pub(super) struct Children {
 impl Children {
     /// The children of `group` (edge indices) among `n` instances.
     pub(super) fn of(n: usize, edges: &[Edge], group: &[usize], tol: Tolerance) -> Children {
+        let mut to = vec![NONE; n];
         let mut edge = vec![NONE; n];
         let mut sorted = group.to_vec();
         sorted.sort_unstable();
         let mut from = Vec::with_capacity(group.len());
         for k in sorted {
-            let slot = &mut edge[edges[k].from];
-            if *slot == NONE {
-                *slot = k as u32;
-                from.push(edges[k].from);
+            let e = &edges[k];
+            if to[e.from] == NONE {
+                to[e.from] = e.to as u32;
+                edge[e.from] = k as u32;
+                from.push(e.from);
             }
         }
         from.sort_unstable();
         let ts: Vec<Tr> = group.iter().map(|&k| edges[k].t).collect();
         Children {
+            to,
             edge,
             from,
             t: supported_mean(&ts, tol),
         }
     }
 
-    /// The edge from `v` to its child, if it has one.
-    fn edge(&self, v: usize) -> Option<usize> {
-        match self.edge[v] {
+    /// The child of `v`, if it has one.
+    fn child(&self, v: usize) -> Option<usize> {
+        match self.to[v] {
             NONE => None,
-            k => Some(k as usize),
+            c => Some(c as usize),
         }
     }
 }
@@ -98,20 +102,14 @@ impl Outs {
 /// found (`open`: a cycle) counts as a leaf. Iterative, so that a long chain
 /// cannot overflow the stack: each frame is one step of the recursive
 /// definition `depth(v) = 1 + min_i depth(child_i(v))`.
-fn depth_of(
-    v: usize,
-    groups: &[&Children],
-    edges: &[Edge],
-    memo: &mut [u32],
-    open: &mut [bool],
-) -> u32 {
+fn depth_of(v: usize, groups: &[&Children], memo: &mut [u32], open: &mut [bool]) -> u32 {
     enum Step {
         /// Find the depth of this node.
         Enter(usize),
         /// Child `i` of the node is found; the least depth of its children so far.
         After(usize, usize, u32),
     }
-    let child = |i: usize, v: usize| groups[i].edge(v).map(|k| edges[k].to);
+    let child = |i: usize, v: usize| groups[i].child(v);
     let mut calls = vec![Step::Enter(v)];
     let mut found = 0;
     while let Some(step) = calls.pop() {
@@ -172,6 +170,7 @@ pub(super) fn branching(
     edges: &[Edge],
     index: &Index,
     outs: &Outs,
+    spots: &[(Frame, f64)],
     groups: &[&Children],
     tol: Tolerance,
 ) -> Option<Candidate> {
@@ -183,7 +182,7 @@ pub(super) fn branching(
         .from
         .iter()
         .copied()
-        .filter(|&v| groups[1..].iter().all(|c| c.edge[v] != NONE))
+        .filter(|&v| groups[1..].iter().all(|c| c.to[v] != NONE))
         .collect();
     if both.is_empty() {
         return None;
@@ -192,7 +191,7 @@ pub(super) fn branching(
     let mut depth = vec![NONE; n];
     let mut open = vec![false; n];
     for &v in &both {
-        depth_of(v, groups, edges, &mut depth, &mut open);
+        depth_of(v, groups, &mut depth, &mut open);
     }
     let mut roots: Vec<(usize, u32)> = both
         .iter()
@@ -210,7 +209,8 @@ pub(super) fn branching(
     let mut links: Vec<(usize, usize, usize)> = Vec::new();
     let mut pairs = 0;
     let mut gap = 0.0;
-    let (mut nodes, mut level, mut below, mut walked) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut nodes, mut level, mut below, mut walked) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (tag, (r, d)) in roots.into_iter().enumerate() {
         if claimed[r] {
             continue;
@@ -222,28 +222,26 @@ pub(super) fn branching(
         level.clear();
         walked.clear();
         nodes.push(r);
-        level.push((r, insts[r].frame));
+        level.push((r, spots[r].0));
         met[r] = tag;
         let mut ok = true;
-        let mut tree_gap = 0.0;
         'walk: for _ in 0..d {
             below.clear();
             for &(v, f) in &level {
                 for (i, (g, tr)) in groups.iter().zip(&ts).enumerate() {
-                    let Some(k) = g.edge(v) else {
+                    let Some(c) = g.child(v) else {
                         ok = false;
                         break 'walk;
                     };
-                    let c = edges[k].to;
                     let want = tr.apply(&f);
+                    let (frame, size) = &spots[c];
                     if claimed[c]
                         || met[c] == tag
-                        || !close(&want, &insts[c].frame, tr.d * f.scale, insts[c].size(), tol)
+                        || !close(&want, frame, tr.d * f.scale, *size, tol)
                     {
                         ok = false;
                         break 'walk;
                     }
-                    tree_gap += edges[k].gap;
                     below.push((c, want));
                     nodes.push(c);
                     walked.push((i, v, c));
@@ -259,7 +257,10 @@ pub(super) fn branching(
             claimed[v] = true;
         }
         pairs += nodes.len() - 1;
-        gap += tree_gap;
+        // The gaps of its links, in the order the walk met them.
+        gap += walked.iter().fold(0.0, |sum, &(i, v, _)| {
+            sum + edges[groups[i].edge[v] as usize].gap
+        });
         trees.push((r, d));
         leaves.extend(level.iter().copied());
         links.extend(walked.iter().copied());
@@ -335,7 +336,11 @@ fn tree_tips(
             }
         }
         // A leaf without both tips: no tree has tips.
-        tips.push(best.into_iter().map(|x| Some(x?.1)).collect::<Option<_>>()?);
+        tips.push(
+            best.into_iter()
+                .map(|x| Some(x?.1))
+                .collect::<Option<_>>()?,
+        );
     }
     let sym = insts[tips[0][0]].sym;
     let mut seen = HashSet::new();

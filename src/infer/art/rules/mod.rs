@@ -24,9 +24,9 @@ mod regular;
 
 use super::shape::{Frame, wrap};
 use super::space::{CellMap, Point, Tr, cluster};
-use branch::{Children, Outs, branching};
 use super::{Budget, TooMuchWork};
 use crate::geometry::index::PointGrid;
+use branch::{Children, Outs, branching};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::cmp::Ordering;
@@ -492,6 +492,7 @@ fn candidates(
     let mut out = Vec::new();
     let mut count = 0;
     let mut outs = None;
+    let mut spots = None;
     for ((a, b), ks) in &spaces {
         let points: Vec<Point> = ks.iter().map(|&k| point(&edges[k].t, tol)).collect();
         budget.spend(points.len())?;
@@ -526,11 +527,17 @@ fn candidates(
                 .map(|g| Children::of(insts.len(), edges, g, tol))
                 .collect();
             let outs = outs.get_or_insert_with(|| Outs::of(insts.len(), edges));
+            let spots = spots.get_or_insert_with(|| {
+                insts
+                    .iter()
+                    .map(|i| (i.frame, i.size()))
+                    .collect::<Vec<_>>()
+            });
             let found: Vec<Option<Candidate>> = sets
                 .par_iter()
                 .map(|set| {
                     let groups: Vec<&Children> = set.iter().map(|&g| &children[g]).collect();
-                    branching(insts, edges, &index, outs, &groups, tol)
+                    branching(insts, edges, &index, outs, spots, &groups, tol)
                 })
                 .collect();
             out.extend(found.into_iter().flatten());
@@ -554,18 +561,19 @@ fn sequence(
 ) -> Option<Candidate> {
     let ts: Vec<Tr> = group.iter().map(|&k| edges[k].t).collect();
     let centre = mean(&ts);
-    let mut order: Vec<usize> = group.to_vec();
-    let dev = |k: usize| {
-        let p = point(&edges[k].t, tol);
-        let c = point(&centre, tol);
-        (0..4).map(|i| (p[i] - c[i]).powi(2)).sum::<f64>()
-    };
-    order.sort_by(|&x, &y| {
-        dev(x)
-            .total_cmp(&dev(y))
-            .then(edges[x].from.cmp(&edges[y].from))
-            .then(edges[x].to.cmp(&edges[y].to))
-    });
+    // Edges nearest the centre first (each edge's distance found once, not
+    // per comparison; edges differ in their ends, so the order is total).
+    let c = point(&centre, tol);
+    let mut keyed: Vec<(f64, usize, usize, usize)> = group
+        .iter()
+        .map(|&k| {
+            let p = point(&edges[k].t, tol);
+            let dev = (0..4).map(|i| (p[i] - c[i]).powi(2)).sum::<f64>();
+            (dev, edges[k].from, edges[k].to, k)
+        })
+        .collect();
+    keyed.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let order: Vec<usize> = keyed.into_iter().map(|x| x.3).collect();
     let mut next: CellMap<usize, usize> = CellMap::default();
     let mut prev: CellMap<usize, usize> = CellMap::default();
     let mut root: CellMap<usize, usize> = CellMap::default();
