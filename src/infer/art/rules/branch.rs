@@ -15,13 +15,16 @@ use crate::infer::art::shape::Frame;
 use crate::infer::art::space::Tr;
 use std::collections::{HashMap, HashSet};
 
-/// An empty slot of a per-instance array.
-const NONE: u32 = u32::MAX;
+/// An empty slot of a per-instance array. Slots hold a number plus one, so
+/// that the arrays start zeroed: the allocator hands out zeroed pages, and a
+/// set of small clusters touches only the few it uses (a round tries
+/// dozens of sets, and a drawing without repeats has dozens of rounds).
+const NONE: u32 = 0;
 
 /// One cluster of edges as a transform of branchings: each node's child by
 /// it (the edge of lowest index out of the node), and the transform.
 pub(super) struct Children {
-    /// Per instance, its child (`NONE`: it has none) and the edge to it.
+    /// Per instance, its child plus one (`NONE`: it has none) and the edge to it.
     to: Vec<u32>,
     edge: Vec<u32>,
     /// The instances with a child, in increasing order.
@@ -33,14 +36,14 @@ impl Children {
     /// The children of `group` (edge indices) among `n` instances.
     pub(super) fn of(n: usize, edges: &[Edge], group: &[usize], tol: Tolerance) -> Children {
         let mut to = vec![NONE; n];
-        let mut edge = vec![NONE; n];
+        let mut edge = vec![0u32; n];
         let mut sorted = group.to_vec();
         sorted.sort_unstable();
         let mut from = Vec::with_capacity(group.len());
         for k in sorted {
             let e = &edges[k];
             if to[e.from] == NONE {
-                to[e.from] = e.to as u32;
+                to[e.from] = e.to as u32 + 1;
                 edge[e.from] = k as u32;
                 from.push(e.from);
             }
@@ -59,7 +62,7 @@ impl Children {
     fn child(&self, v: usize) -> Option<usize> {
         match self.to[v] {
             NONE => None,
-            c => Some(c as usize),
+            c => Some(c as usize - 1),
         }
     }
 }
@@ -98,7 +101,7 @@ impl Outs {
 
 /// The depth of the complete tree below `v` whose children are the ends of
 /// `groups[i]`'s edges (one per transform; 0 for a leaf), memoised in `memo`
-/// (`NONE`: not known yet). A node met again while its own depth is being
+/// plus one (`NONE`: not known yet). A node met again while its own depth is being
 /// found (`open`: a cycle) counts as a leaf. Iterative, so that a long chain
 /// cannot overflow the stack: each frame is one step of the recursive
 /// definition `depth(v) = 1 + min_i depth(child_i(v))`.
@@ -116,7 +119,7 @@ fn depth_of(v: usize, groups: &[&Children], memo: &mut [u32], open: &mut [bool])
         match step {
             Step::Enter(v) => {
                 if memo[v] != NONE {
-                    found = memo[v];
+                    found = memo[v] - 1;
                     continue;
                 }
                 let mut kids = [0usize; 3];
@@ -134,7 +137,7 @@ fn depth_of(v: usize, groups: &[&Children], memo: &mut [u32], open: &mut [bool])
                     calls.push(Step::After(v, 0, u32::MAX));
                     calls.push(Step::Enter(k[0]));
                 } else {
-                    memo[v] = 0;
+                    memo[v] = 1;
                     found = 0;
                 }
             }
@@ -153,7 +156,7 @@ fn depth_of(v: usize, groups: &[&Children], memo: &mut [u32], open: &mut [bool])
                     None => {
                         let d = least.saturating_add(1);
                         open[v] = false;
-                        memo[v] = d;
+                        memo[v] = d.saturating_add(1);
                         found = d;
                     }
                 }
@@ -195,7 +198,7 @@ pub(super) fn branching(
     }
     let mut roots: Vec<(usize, u32)> = both
         .iter()
-        .map(|&v| (v, depth[v]))
+        .map(|&v| (v, depth[v].saturating_sub(1)))
         .filter(|&(_, d)| d >= 1)
         .collect();
     roots.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
