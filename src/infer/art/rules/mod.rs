@@ -14,7 +14,8 @@
 //! redrawing it with the rule's averaged transform would leave the tolerance,
 //! so what is drawn back stays on the input. With `--symmetrize`
 //! (`Tolerance::regular`) chains also grow at both ends, and a chosen rule is
-//! refitted and made round (`regular`, on the least squares of `fit`). Must not
+//! refitted and made round (`regular`, on the least squares of `fit`).
+//! Branchings are found in `branch`, linear sequences in `linear`. Must not
 //! print or build syntax.
 
 mod branch;
