@@ -14,9 +14,11 @@
 //! redrawing it with the rule's averaged transform would leave the tolerance,
 //! so what is drawn back stays on the input. With `--symmetrize`
 //! (`Tolerance::regular`) chains also grow at both ends, and a chosen rule is
-//! refitted and made round (`regular`, on the least squares of `fit`). Must not
+//! refitted and made round (`regular`, on the least squares of `fit`).
+//! Branchings are found in `branch`, linear sequences in `linear`. Must not
 //! print or build syntax.
 
+mod branch;
 mod fit;
 mod linear;
 mod regular;
@@ -25,6 +27,7 @@ use super::shape::{Frame, wrap};
 use super::space::{CellMap, Point, Tr, cluster};
 use super::{Budget, TooMuchWork};
 use crate::geometry::index::PointGrid;
+use branch::{Children, Outs, branching};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::cmp::Ordering;
@@ -489,6 +492,8 @@ fn candidates(
         .collect();
     let mut out = Vec::new();
     let mut count = 0;
+    let mut outs = None;
+    let mut spots = None;
     for ((a, b), ks) in &spaces {
         let points: Vec<Point> = ks.iter().map(|&k| point(&edges[k].t, tol)).collect();
         budget.spend(points.len())?;
@@ -520,13 +525,20 @@ fn candidates(
             // it is in; the sets are tried in parallel, kept in their order.
             let children: Vec<Children> = big
                 .par_iter()
-                .map(|g| Children::of(edges, g, tol))
+                .map(|g| Children::of(insts.len(), edges, g, tol))
                 .collect();
+            let outs = outs.get_or_insert_with(|| Outs::of(insts.len(), edges));
+            let spots = spots.get_or_insert_with(|| {
+                insts
+                    .iter()
+                    .map(|i| (i.frame, i.size()))
+                    .collect::<Vec<_>>()
+            });
             let found: Vec<Option<Candidate>> = sets
                 .par_iter()
                 .map(|set| {
                     let groups: Vec<&Children> = set.iter().map(|&g| &children[g]).collect();
-                    branching(insts, edges, &index, &groups, tol)
+                    branching(insts, edges, &index, outs, spots, &groups, tol)
                 })
                 .collect();
             out.extend(found.into_iter().flatten());
@@ -550,18 +562,19 @@ fn sequence(
 ) -> Option<Candidate> {
     let ts: Vec<Tr> = group.iter().map(|&k| edges[k].t).collect();
     let centre = mean(&ts);
-    let mut order: Vec<usize> = group.to_vec();
-    let dev = |k: usize| {
-        let p = point(&edges[k].t, tol);
-        let c = point(&centre, tol);
-        (0..4).map(|i| (p[i] - c[i]).powi(2)).sum::<f64>()
-    };
-    order.sort_by(|&x, &y| {
-        dev(x)
-            .total_cmp(&dev(y))
-            .then(edges[x].from.cmp(&edges[y].from))
-            .then(edges[x].to.cmp(&edges[y].to))
-    });
+    // Edges nearest the centre first (each edge's distance found once, not
+    // per comparison; edges differ in their ends, so the order is total).
+    let c = point(&centre, tol);
+    let mut keyed: Vec<(f64, usize, usize, usize)> = group
+        .iter()
+        .map(|&k| {
+            let p = point(&edges[k].t, tol);
+            let dev = (0..4).map(|i| (p[i] - c[i]).powi(2)).sum::<f64>();
+            (dev, edges[k].from, edges[k].to, k)
+        })
+        .collect();
+    keyed.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let order: Vec<usize> = keyed.into_iter().map(|x| x.3).collect();
     let mut next: CellMap<usize, usize> = CellMap::default();
     let mut prev: CellMap<usize, usize> = CellMap::default();
     let mut root: CellMap<usize, usize> = CellMap::default();
@@ -833,248 +846,6 @@ fn seq_candidate(
             fitted: None,
         },
     })
-}
-
-/// The depth of the complete tree below `v` whose children are `child[i][v]`
-/// (one per transform; 0 for a leaf), memoised in `memo`. A node met again
-/// while its own depth is being found (`open`: a cycle) counts as a leaf.
-/// Iterative, so that a long chain cannot overflow the stack: each frame is
-/// one step of the recursive definition `depth(v) = 1 + min_i depth(child[i][v])`.
-fn depth_of(
-    v: usize,
-    child: &[&HashMap<usize, usize>],
-    memo: &mut HashMap<usize, u32>,
-    open: &mut HashSet<usize>,
-) -> u32 {
-    enum Step {
-        /// Find the depth of this node.
-        Enter(usize),
-        /// Child `i` of the node is found; the least depth of its children so far.
-        After(usize, usize, u32),
-    }
-    let mut calls = vec![Step::Enter(v)];
-    let mut found = 0;
-    while let Some(step) = calls.pop() {
-        match step {
-            Step::Enter(v) => {
-                if let Some(&d) = memo.get(&v) {
-                    found = d;
-                    continue;
-                }
-                let kids: Option<Vec<usize>> = child.iter().map(|c| c.get(&v).copied()).collect();
-                let distinct = kids
-                    .as_ref()
-                    .is_some_and(|k| k.iter().enumerate().all(|(i, a)| !k[..i].contains(a)));
-                match kids {
-                    Some(k) if distinct && open.insert(v) => {
-                        calls.push(Step::After(v, 0, u32::MAX));
-                        calls.push(Step::Enter(k[0]));
-                    }
-                    _ => {
-                        memo.insert(v, 0);
-                        found = 0;
-                    }
-                }
-            }
-            Step::After(v, i, least) => {
-                let least = least.min(found);
-                if i + 1 < child.len() {
-                    calls.push(Step::After(v, i + 1, least));
-                    calls.push(Step::Enter(child[i + 1][&v]));
-                } else {
-                    let d = least.saturating_add(1);
-                    open.remove(&v);
-                    memo.insert(v, d);
-                    found = d;
-                }
-            }
-        }
-    }
-    found
-}
-
-/// One cluster of edges as a transform of branchings: each node's child by
-/// it (the edge of lowest index out of the node), and the transform.
-struct Children {
-    child: HashMap<usize, usize>,
-    t: Tr,
-}
-
-impl Children {
-    fn of(edges: &[Edge], group: &[usize], tol: Tolerance) -> Children {
-        let mut child: HashMap<usize, usize> = HashMap::with_capacity(group.len());
-        let mut sorted = group.to_vec();
-        sorted.sort_unstable();
-        for k in sorted {
-            child.entry(edges[k].from).or_insert(edges[k].to);
-        }
-        let ts: Vec<Tr> = group.iter().map(|&k| edges[k].t).collect();
-        Children {
-            child,
-            t: supported_mean(&ts, tol),
-        }
-    }
-}
-
-/// Complete trees whose children come from `groups` (clusters of edges, one
-/// per transform).
-fn branching(
-    insts: &[Inst],
-    edges: &[Edge],
-    index: &Index,
-    groups: &[&Children],
-    tol: Tolerance,
-) -> Option<Candidate> {
-    let maps: Vec<&HashMap<usize, usize>> = groups.iter().map(|g| &g.child).collect();
-    let both: Vec<usize> = {
-        let mut v: Vec<usize> = maps[0]
-            .keys()
-            .copied()
-            .filter(|k| maps[1..].iter().all(|c| c.contains_key(k)))
-            .collect();
-        v.sort_unstable();
-        v
-    };
-    if both.is_empty() {
-        return None;
-    }
-    // Depth of the complete tree below each node.
-    let mut depth: HashMap<usize, u32> = HashMap::new();
-    let mut open = HashSet::new();
-    for &v in &both {
-        depth_of(v, &maps, &mut depth, &mut open);
-    }
-    let mut roots: Vec<(usize, u32)> = both
-        .iter()
-        .map(|&v| (v, depth[&v]))
-        .filter(|&(_, d)| d >= 1)
-        .collect();
-    roots.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
-    let ts: Vec<Tr> = groups.iter().map(|g| g.t).collect();
-    let mut claimed: HashSet<usize> = HashSet::new();
-    let mut trees = Vec::new();
-    let mut leaves: Vec<(usize, Frame)> = Vec::new();
-    let mut pairs = 0;
-    let mut gap = 0.0;
-    for (r, d) in roots {
-        // The tree's nodes, level by level, redrawn from the root.
-        let mut nodes = vec![(r, insts[r].frame)];
-        let mut in_tree: HashSet<usize> = HashSet::from([r]);
-        let mut level = vec![(r, insts[r].frame)];
-        let mut ok = !claimed.contains(&r);
-        let mut tree_gap = 0.0;
-        for _ in 0..d {
-            let mut below = Vec::new();
-            for &(v, f) in &level {
-                for (map, tr) in maps.iter().zip(&ts) {
-                    let c = map[&v];
-                    let want = tr.apply(&f);
-                    if claimed.contains(&c)
-                        || in_tree.contains(&c)
-                        || !close(&want, &insts[c].frame, tr.d * f.scale, insts[c].size(), tol)
-                    {
-                        ok = false;
-                    }
-                    tree_gap += index.get(&(v, c)).map_or(1.0, |&k| edges[k].gap);
-                    below.push((c, want));
-                    nodes.push((c, want));
-                    in_tree.insert(c);
-                }
-            }
-            if !ok {
-                break;
-            }
-            level = below;
-        }
-        if !ok {
-            continue;
-        }
-        claimed.extend(nodes.iter().map(|n| n.0));
-        pairs += nodes.len() - 1;
-        gap += tree_gap;
-        trees.push((r, d));
-        leaves.extend(level);
-    }
-    if trees.is_empty() {
-        return None;
-    }
-    let mut child: Vec<HashMap<usize, usize>> = maps.into_iter().cloned().collect();
-    if let Some(tips) = tree_tips(insts, edges, &leaves, &ts, &claimed, tol) {
-        for (&(leaf, _), below) in leaves.iter().zip(tips) {
-            for (map, &c) in child.iter_mut().zip(&below) {
-                map.insert(leaf, c);
-                gap += index.get(&(leaf, c)).map_or(1.0, |&k| edges[k].gap);
-            }
-        }
-        pairs += ts.len() * leaves.len();
-        for tree in &mut trees {
-            tree.1 += 1;
-        }
-    }
-    let length = trees.iter().map(|t| t.1 as f64 + 1.0).sum::<f64>() / trees.len() as f64;
-    Some(Candidate {
-        h: 1.0 - gap / pairs as f64,
-        phi: 1.0,
-        length,
-        pairs,
-        plan: Plan::Branch { trees, child, ts },
-    })
-}
-
-/// The tips of complete trees: where the transforms `tr` put the children
-/// of every leaf (`leaves`, with their frames as the trees draw them), two
-/// instances of one other kind that no tree claims (buds at the tips: the
-/// `m == 0` rule draws them); `None` unless every leaf has both.
-fn tree_tips(
-    insts: &[Inst],
-    edges: &[Edge],
-    leaves: &[(usize, Frame)],
-    tr: &[Tr],
-    claimed: &HashSet<usize>,
-    tol: Tolerance,
-) -> Option<Vec<Vec<usize>>> {
-    let a = insts[leaves.first()?.0].sym;
-    let at: HashMap<usize, usize> = leaves.iter().enumerate().map(|(k, l)| (l.0, k)).collect();
-    let mut best: Vec<Vec<Option<(f64, usize)>>> = vec![vec![None; tr.len()]; leaves.len()];
-    for e in edges {
-        let Some(&k) = at.get(&e.from) else {
-            continue;
-        };
-        let b = &insts[e.to];
-        if !b.alive || b.sym == a || claimed.contains(&e.to) {
-            continue;
-        }
-        let f = leaves[k].1;
-        for side in 0..tr.len() {
-            let want = tr[side].apply(&f);
-            let step = tr[side].d * f.scale;
-            let Some(have) = b
-                .variants(want.rot)
-                .into_iter()
-                .find(|v| close(&want, v, step, b.size(), tol))
-            else {
-                continue;
-            };
-            let off = want.pos.distance(have.pos);
-            if best[k][side].is_none_or(|(o, _)| off < o) {
-                best[k][side] = Some((off, e.to));
-            }
-        }
-    }
-    let tips: Vec<Vec<usize>> = best
-        .into_iter()
-        .map(|b| {
-            b.into_iter()
-                .map(|x| Some(x?.1))
-                .collect::<Option<Vec<_>>>()
-        })
-        .collect::<Option<_>>()?;
-    let sym = insts[tips[0][0]].sym;
-    let mut seen = HashSet::new();
-    tips.iter()
-        .flatten()
-        .all(|&i| insts[i].sym == sym && seen.insert(i))
-        .then_some(tips)
 }
 
 /// Importances closer than this are equal (the two directions of one chain
