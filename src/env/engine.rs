@@ -685,7 +685,11 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
             let mut p = Probe::default();
             turtle::interpret_limited(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut p)
                 .map_err(|e| e.diagnostic(prog))?;
+            // Only ?D_E, ?N_E and ?X read what a guide's systems drew (and
+            // settling a reservation, which only ?X makes): a program that
+            // asks none of them needs no index of its drawing.
             let grid = match stale.take() {
+                _ if !reads_drawing(prog) => Grid::new(Vec::new()),
                 Some(g) => g.update(p.segments),
                 None => Grid::new(p.segments),
             };
@@ -983,6 +987,18 @@ fn inert(prog: &crate::compile::Program, sym: crate::compile::Sym) -> bool {
             prog.symbols.info[sym as usize].action,
             crate::compile::Action::Query(_) | crate::compile::Action::Cut
         )
+}
+
+/// Whether a query module of the program reads the segments its guide's
+/// systems drew (?D_E, ?N_E, ?X).
+fn reads_drawing(prog: &crate::compile::Program) -> bool {
+    prog.symbols.info.iter().any(|info| match info.action {
+        crate::compile::Action::Query(k) => matches!(
+            QUERIES[k as usize].kind,
+            QueryKind::DistanceElement | QueryKind::AheadElement | QueryKind::Collision
+        ),
+        _ => false,
+    })
 }
 
 /// Whether an interpretation rule rewrites a query module (then a system's
