@@ -683,13 +683,20 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
         .map(|(inst, probe, stale)| {
             let prog = &scene.programs[scene.guides[inst.guide].program];
             let mut p = Probe::default();
-            turtle::interpret_limited(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut p)
-                .map_err(|e| e.diagnostic(prog))?;
             // Only ?D_E, ?N_E and ?X read what a guide's systems drew (and
             // settling a reservation, which only ?X makes): a program that
-            // asks none of them needs no index of its drawing.
+            // asks none of them needs only the turtle at its query modules,
+            // and no index of its drawing.
+            let reads = reads_drawing(prog);
+            let interpret = if reads {
+                turtle::interpret_limited
+            } else {
+                turtle::interpret_queries
+            };
+            interpret(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut p)
+                .map_err(|e| e.diagnostic(prog))?;
             let grid = match stale.take() {
-                _ if !reads_drawing(prog) => Grid::new(Vec::new()),
+                _ if !reads => Grid::new(Vec::new()),
                 Some(g) => g.update(p.segments),
                 None => Grid::new(p.segments),
             };
