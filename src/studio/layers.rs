@@ -57,12 +57,7 @@ impl Sink for Recording {
 impl Recording {
     /// Makes the recorded calls again, in order.
     fn replay(&self, sink: &mut dyn Sink) {
-        self.replay_range(0..self.ops.len(), sink);
-    }
-
-    /// Makes the recorded calls `range` again, in order.
-    fn replay_range(&self, range: std::ops::Range<usize>, sink: &mut dyn Sink) {
-        for op in &self.ops[range] {
+        for op in &self.ops {
             match *op {
                 Op::Segment(a, b, w, c) => sink.segment(a, b, w, c),
                 Op::Polygon(from, to, c) => {
@@ -330,10 +325,7 @@ impl LayerCache {
     }
 }
 
-/// A guide's layer, as the writer of the whole drawing writes it. A large
-/// one is written in parts by writers of their own, in parallel: each part
-/// after the first starts at an element, before which the writer of the
-/// whole closes its path, so the parts put together are the same bytes.
+/// A guide's layer, as the writer of the whole drawing writes it.
 fn write_layer(
     l: &Layer,
     name: &str,
@@ -342,49 +334,12 @@ fn write_layer(
     elements: &[ElementDef],
     used: &[bool],
 ) -> std::io::Result<String> {
-    let ops = &l.recording.ops;
-    let parts = rayon::current_num_threads()
-        .clamp(1, 8)
-        .min(ops.len() / 4096 + 1);
-    let mut cuts = vec![0];
-    for k in 1..parts {
-        let from = (ops.len() * k / parts).max(*cuts.last().unwrap_or(&0));
-        if let Some(at) = ops[from..]
-            .iter()
-            .position(|op| matches!(op, Op::Element(..)))
-        {
-            cuts.push(from + at);
-        }
-    }
-    cuts.push(ops.len());
-    cuts.dedup();
-    if cuts.len() == 1 {
-        cuts.push(ops.len());
-    }
-    let last = cuts.len() - 2;
-    let write = |k: usize| -> std::io::Result<Vec<u8>> {
-        let mut w = SvgWriter::new(Vec::new(), view, bounds, elements, used)?;
-        w.get_mut().clear();
-        if k == 0 {
-            w.begin_guide(name);
-        }
-        l.recording.replay_range(cuts[k]..cuts[k + 1], &mut w);
-        // `end_guide` closes the path; only the last part ends the layer.
-        w.end_guide();
-        let mut bytes = std::mem::take(w.get_mut());
-        if k != last {
-            bytes.truncate(bytes.len() - "</g>\n".len());
-        }
-        Ok(bytes)
-    };
-    let written: Vec<std::io::Result<Vec<u8>>> = {
-        use rayon::prelude::*;
-        (0..=last).into_par_iter().map(write).collect()
-    };
-    let mut bytes = Vec::new();
-    for part in written {
-        bytes.extend_from_slice(&part?);
-    }
+    let mut w = SvgWriter::new(Vec::new(), view, bounds, elements, used)?;
+    w.get_mut().clear();
+    w.begin_guide(name);
+    l.recording.replay(&mut w);
+    w.end_guide();
+    let bytes = std::mem::take(w.get_mut());
     String::from_utf8(bytes).map_err(std::io::Error::other)
 }
 
