@@ -102,8 +102,31 @@ fn studio(c: &mut Criterion) {
             patch.layers.len(),
             serde_json::to_string(&warm).map_or(0, |j| j.len())
         );
+        // Where a move's time goes: the reply's own timings, the mean of ten
+        // moves.
         let mut k = 0;
         let mut have = warm.layers.clone();
+        let mut parts = [0.0; 5];
+        for _ in 0..10 {
+            k ^= 1;
+            let reply = session.drag(&drag(k, &have), file).expect("drags");
+            let st = reply.stats.clone().unwrap_or_default();
+            let keys = [
+                "solve_ms",
+                "check_ms",
+                "derive_ms",
+                "interpret_ms",
+                "total_ms",
+            ];
+            for (p, key) in parts.iter_mut().zip(keys) {
+                *p += st[key].as_f64().unwrap_or(0.0) / 10.0;
+            }
+            have = reply.layers;
+        }
+        eprintln!(
+            "{file}: a move: springs {:.1} ms, check {:.1} ms, scene run {:.1} ms, drawing {:.1} ms; {:.1} ms to the reply (without its JSON)",
+            parts[0], parts[1], parts[2], parts[3], parts[4]
+        );
         g.bench_function("drag to redraw", |b| {
             b.iter(|| {
                 k ^= 1;

@@ -87,7 +87,9 @@ struct Trig {
 
 impl Trig {
     fn of(&mut self, deg: f64) -> (f64, f64) {
-        if deg != self.deg {
+        // Bit for bit: the cache gives what `sin_cos` gives for this very
+        // angle (for −0 too), whatever turned before.
+        if deg.to_bits() != self.deg.to_bits() {
             let (s, c) = deg.to_radians().sin_cos();
             *self = Trig {
                 deg,
@@ -242,6 +244,109 @@ pub fn interpret_limited(
     limits: Limits,
     sink: &mut dyn Sink,
 ) -> Result<Drawn, DeriveError> {
+    run(prog, s, seed, start, limits, sink, &[])
+}
+
+/// Interprets as `interpret_limited` for the query modules only: a branch
+/// `[ … ]` of the string that holds no query module (and no module whose
+/// interpretation rules make one) is passed over, as its state ends where
+/// it began. The sink is asked about every query module with the state
+/// `interpret_limited` has there; it is given only part of the drawing, and
+/// the counts are of that part. (An environment's system whose drawing no
+/// query reads needs no more between its steps.)
+pub fn interpret_queries(
+    prog: &Program,
+    s: &ModString,
+    seed: u64,
+    start: State,
+    limits: Limits,
+    sink: &mut dyn Sink,
+) -> Result<Drawn, DeriveError> {
+    let skip = quiet_branches(prog, s);
+    run(prog, s, seed, start, limits, sink, &skip)
+}
+
+/// The outermost branches of `s` that ask nothing, in order: where each
+/// opens, the module after its `]` and the parameter that one starts at.
+/// None when an interpretation rule makes a bracket or rewrites one (then the
+/// string's brackets need not be the turtle's).
+fn quiet_branches(prog: &Program, s: &ModString) -> Vec<(u32, u32, u32)> {
+    let info = &prog.symbols.info;
+    let rules = |x: usize| prog.interpret.get(x).map_or(&[][..], Vec::as_slice);
+    let bracket = |x: usize| matches!(info[x].action, Action::Push | Action::Pop);
+    // Per symbol: whether interpreting it meets a query module (its own rules'
+    // successors, to any depth), or a bracket.
+    let mut asks: Vec<bool> = info
+        .iter()
+        .map(|i| matches!(i.action, Action::Query(_)))
+        .collect();
+    let mut brackets: Vec<bool> = (0..info.len())
+        .map(|x| bracket(x) && !rules(x).is_empty())
+        .collect();
+    loop {
+        let mut changed = false;
+        for x in 0..info.len() {
+            for e in rules(x).iter().flat_map(|r| &r.succ) {
+                let y = e.sym as usize;
+                let (a, b) = (asks[y], brackets[y] || bracket(y));
+                if (a && !asks[x]) || (b && !brackets[x]) {
+                    asks[x] |= a;
+                    brackets[x] |= b;
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    let mut out: Vec<(u32, u32, u32)> = Vec::new();
+    if brackets.iter().any(|b| *b) {
+        return out;
+    }
+    // Open branches: where each opened and whether it asks.
+    let mut open: Vec<(u32, bool)> = Vec::new();
+    let mut p = 0u32;
+    for (i, &sym) in s.syms.iter().enumerate() {
+        let x = sym as usize;
+        p += prog.symbols.arity(sym) as u32;
+        match info[x].action {
+            Action::Push => open.push((i as u32, false)),
+            Action::Pop => {
+                if let Some((at, asked)) = open.pop() {
+                    if asked {
+                        if let Some(outer) = open.last_mut() {
+                            outer.1 = true;
+                        }
+                    } else {
+                        // The quiet branches inside it closed after it opened.
+                        while out.last().is_some_and(|b| b.0 > at) {
+                            out.pop();
+                        }
+                        out.push((at, i as u32 + 1, p));
+                    }
+                }
+            }
+            _ if asks[x] => {
+                if let Some(inner) = open.last_mut() {
+                    inner.1 = true;
+                }
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+fn run(
+    prog: &Program,
+    s: &ModString,
+    seed: u64,
+    start: State,
+    limits: Limits,
+    sink: &mut dyn Sink,
+    skip: &[(u32, u32, u32)],
+) -> Result<Drawn, DeriveError> {
     let mut start = start;
     if let Some((_, e)) = prog.tropism {
         start.elasticity = e;
@@ -271,7 +376,18 @@ pub fn interpret_limited(
     };
     let has_interp = prog.interpret.iter().any(|r| !r.is_empty());
     let mut p = 0usize;
-    for (i, &sym) in s.syms.iter().enumerate() {
+    let mut i = 0usize;
+    // The next branch to pass over.
+    let mut next = 0usize;
+    while i < s.syms.len() {
+        if let Some(&(_, end, params_end)) = skip.get(next).filter(|b| b.0 as usize == i) {
+            // A branch that asks nothing: its state ends where it began.
+            i = end as usize;
+            p = params_end as usize;
+            next += 1;
+            continue;
+        }
+        let sym = s.syms[i];
         let n = prog.symbols.arity(sym);
         let params = &s.params[p..p + n];
         p += n;
@@ -287,6 +403,7 @@ pub fn interpret_limited(
         } else {
             t.module(sym, params);
         }
+        i += 1;
     }
     Ok(t.drawn)
 }

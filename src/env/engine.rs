@@ -696,6 +696,25 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
         .map(|(inst, probe, prev)| {
             let prog = &scene.programs[scene.guides[inst.guide].program];
             let last = prev.take();
+            // Only ?D_E, ?N_E and ?X read what a guide's systems drew (and
+            // settling a reservation, which only ?X makes): a program that
+            // asks none of them needs only the turtle at its query modules,
+            // and its guide's index stays empty.
+            if !reads_drawing(prog) {
+                let mut p = Probe::default();
+                turtle::interpret_queries(
+                    prog,
+                    &inst.string,
+                    cfg.seed,
+                    inst.start,
+                    cfg.limits,
+                    &mut p,
+                )
+                .map_err(|e| e.diagnostic(prog))?;
+                p.segments.clear();
+                *probe = Some(Sketch::whole(p));
+                return Ok(());
+            }
             if !redraw::redrawable(prog) {
                 let mut p = Probe::default();
                 turtle::interpret_limited(
@@ -1015,6 +1034,18 @@ fn inert(prog: &crate::compile::Program, sym: crate::compile::Sym) -> bool {
             prog.symbols.info[sym as usize].action,
             crate::compile::Action::Query(_) | crate::compile::Action::Cut
         )
+}
+
+/// Whether a query module of the program reads the segments its guide's
+/// systems drew (?D_E, ?N_E, ?X).
+fn reads_drawing(prog: &crate::compile::Program) -> bool {
+    prog.symbols.info.iter().any(|info| match info.action {
+        crate::compile::Action::Query(k) => matches!(
+            QUERIES[k as usize].kind,
+            QueryKind::DistanceElement | QueryKind::AheadElement | QueryKind::Collision
+        ),
+        _ => false,
+    })
 }
 
 /// Whether an interpretation rule rewrites a query module (then a system's

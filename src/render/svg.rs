@@ -259,6 +259,18 @@ impl<W: Write> SvgWriter<W> {
         self.write(&buf);
     }
 
+    /// The decimal places of the coordinates (from the drawing's size).
+    pub fn decimals(&self) -> usize {
+        self.decimals
+    }
+
+    /// The output written so far. Between layers (after `SvgWriter::new`,
+    /// `end_guide` or a guide outline) no path is open: everything drawn is
+    /// in it, and what is taken out is a whole part of the document.
+    pub fn get_mut(&mut self) -> &mut W {
+        &mut self.out
+    }
+
     /// Ends the document and returns the writer.
     pub fn finish(mut self) -> io::Result<W> {
         self.close_path();

@@ -5,12 +5,15 @@
 //!   library as the command line does (no sockets, no files);
 //! - `server` — the HTTP server on 127.0.0.1, the worker thread that runs the
 //!   latest request, the file on disk;
+//! - `layers` — a dragged scene's drawing kept guide by guide, so that a
+//!   move draws again only the guides it changed;
 //! - `assets` — the page (HTML, JavaScript, CSS) compiled into the binary.
 //!
 //! The studio is the top layer: it calls `run`, `edit`, `env`, `fmt` and
 //! `frontend`, and nothing in the library calls it.
 
 pub mod assets;
+pub mod layers;
 pub mod protocol;
 pub mod server;
 

@@ -8,6 +8,7 @@
 //! solver and writer for a drag, `lsyc fmt`'s printer for every source it
 //! writes). Must not touch files or sockets: `server` does that.
 
+use super::layers::{LayerCache, Style};
 use crate::ast::{ExprKind, File, Item};
 use crate::check::{Checked, Override, Value};
 use crate::diagnostic::{self, Diagnostic, Format};
@@ -208,22 +209,6 @@ fn layer_hashes(svg: &str) -> BTreeMap<String, String> {
             .into_iter()
             .map(|(name, text)| (name.to_string(), hash(text.as_bytes())))
             .collect()
-    })
-}
-
-/// `svg` as a patch for a page that shows the layers `have` (guide → hash).
-fn patch(svg: &str, have: &BTreeMap<String, String>) -> Option<Patch> {
-    let (head, layers, tail) = split_layers(svg)?;
-    Some(Patch {
-        head: head.to_string(),
-        layers: layers
-            .into_iter()
-            .map(|(name, text)| {
-                let kept = have.get(name).is_some_and(|h| *h == hash(text.as_bytes()));
-                (name.to_string(), (!kept).then(|| text.to_string()))
-            })
-            .collect(),
-        tail: tail.to_string(),
     })
 }
 
@@ -494,6 +479,8 @@ pub struct DragSession {
     file: File,
     checked: Checked,
     runner: Runner,
+    /// Every guide's drawing, kept while its systems do not change.
+    layers: LayerCache,
 }
 
 impl DragSession {
@@ -519,6 +506,7 @@ impl DragSession {
             file: fe.file,
             checked,
             runner: Runner::new(scene, cfg),
+            layers: LayerCache::default(),
         })
     }
 
@@ -569,41 +557,70 @@ impl DragSession {
         }
         let solved_ms = ms(start);
         let check_ms = solved_ms - springs_ms;
-        let outcome = self.runner.run().map_err(|d| d.message)?;
-        let placeholder = env::Scene {
-            name: String::new(),
-            guides: Vec::new(),
-            links: Vec::new(),
-            programs: Vec::new(),
+        let outcome = match self.runner.run() {
+            Ok(o) => o,
+            Err(d) => {
+                self.layers.clear();
+                return Err(d.message);
+            }
         };
-        let r = SceneRun {
-            scene: std::mem::replace(&mut self.runner.scene, placeholder),
-            outcome,
-            derive_ms: ms(start) - solved_ms,
+        let derive_ms = ms(start) - solved_ms;
+        let scene = &self.runner.scene;
+        let style = Style {
+            seed: self.base.seed,
             limits: self.runner.cfg.limits,
+            view: self
+                .base
+                .picture()
+                .view(scene.programs.iter().any(|p| p.is_3d)),
         };
-        let drawn = scene_svg(&r, &self.base);
-        let guides = outlines(&r.scene);
-        self.runner.scene = r.scene;
-        let (svg, mut stats) = drawn.map_err(|d| d.message)?;
+        let drawing =
+            match self
+                .layers
+                .draw(scene, &outcome, &self.runner.recomputed, style, derive_ms)
+            {
+                Ok(d) => d,
+                Err(d) => {
+                    self.layers.clear();
+                    return Err(d.message);
+                }
+            };
+        let guides = outlines(scene);
+        let mut stats = serde_json::to_value(&drawing.stats).unwrap_or_default();
         let round = |v: f64| (v * 1e3).round() / 1e3;
         stats["solve_ms"] = Json::from(round(springs_ms));
         stats["check_ms"] = Json::from(round(check_ms));
-        stats["total_ms"] = Json::from(ms(start));
-        let recomputed = self
-            .runner
-            .scene
+        let recomputed = scene
             .guides
             .iter()
             .zip(&self.runner.recomputed)
             .filter(|(_, r)| **r)
             .map(|(g, _)| g.name.clone())
             .collect();
-        let layers = layer_hashes(&svg);
-        let (svg, patch) = match d.have.as_ref().and_then(|have| patch(&svg, have)) {
-            Some(p) => (None, Some(p)),
-            None => (Some(svg), None),
+        let layers: BTreeMap<String, String> = drawing
+            .layers
+            .iter()
+            .map(|(name, _, hash)| (name.clone(), hash.to_string()))
+            .collect();
+        let (svg, patch) = match d.have.as_ref().filter(|_| !drawing.layers.is_empty()) {
+            Some(have) => (
+                None,
+                Some(Patch {
+                    head: drawing.head.clone(),
+                    layers: drawing
+                        .layers
+                        .iter()
+                        .map(|(name, text, hash)| {
+                            let kept = have.get(name).is_some_and(|h| h == hash);
+                            (name.clone(), (!kept).then(|| text.to_string()))
+                        })
+                        .collect(),
+                    tail: drawing.tail.clone(),
+                }),
+            ),
+            None => (Some(drawing.svg()), None),
         };
+        stats["total_ms"] = Json::from(ms(start));
         Ok(RunReply {
             ok: true,
             svg,

@@ -24,3 +24,4 @@ mod scene;
 mod sketch;
 mod studio;
 mod support;
+mod turtle_queries;
