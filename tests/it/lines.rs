@@ -637,6 +637,16 @@ fn hostile_line_drawings_end_within_the_budget() {
         let took = start.elapsed();
         // A hang guard (timings are in benches/lines.rs).
         assert!(took < Duration::from_secs(120), "{what}: {took:?}");
-        assert!(!matches!(outcome, Lines::Found(_)), "{what}: a D0L system?");
+        match outcome {
+            // One segment drawn back and forth is drawn exactly by
+            // `F -> F-F-…` at 180°; whether the search reaches it within the
+            // budget depends on the machine, but what it finds must redraw it.
+            Lines::Found(i) if what == "back and forth" => {
+                assert!(i.redraw.chamfer < 1e-6, "{what}: {}", i.text);
+                assert_eq!(i.redraw.drawn, i.redraw.steps, "{what}: {}", i.text);
+            }
+            Lines::Found(i) => panic!("{what}: a D0L system?\n{}", i.text),
+            _ => {}
+        }
     }
 }
