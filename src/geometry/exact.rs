@@ -86,7 +86,12 @@ pub fn orient(a: DVec2, b: DVec2, c: DVec2) -> Ordering {
         let [r, re] = two_product(acy, bcx);
         return exact_sign(&[le, l, -re, -r]);
     }
-    // ax·by − ax·cy − cx·by − ay·bx + ay·cx + cy·bx, each product exact in two parts.
+    orient_expanded(a, b, c)
+}
+
+/// The sign of the full expansion
+/// ax·by − ax·cy − cx·by − ay·bx + ay·cx + cy·bx, each product exact in two parts.
+fn orient_expanded(a: DVec2, b: DVec2, c: DVec2) -> Ordering {
     let mut terms = [0.0; 12];
     let products = [
         (a.x, b.y),
@@ -268,25 +273,6 @@ mod tests {
         assert_eq!(orient(a, b, c), Ordering::Equal);
     }
 
-    /// The sign from the full expansion of the six products, for comparison.
-    fn orient_full(a: DVec2, b: DVec2, c: DVec2) -> Ordering {
-        let mut terms = [0.0; 12];
-        let products = [
-            (a.x, b.y),
-            (-a.x, c.y),
-            (-c.x, b.y),
-            (-a.y, b.x),
-            (a.y, c.x),
-            (c.y, b.x),
-        ];
-        for (k, (u, v)) in products.into_iter().enumerate() {
-            let [x, y] = two_product(u, v);
-            terms[2 * k] = y;
-            terms[2 * k + 1] = x;
-        }
-        exact_sign(&terms)
-    }
-
     #[test]
     fn every_stage_agrees_with_the_full_expansion() {
         let mut r = crate::geometry::index::Lcg(5);
@@ -304,7 +290,7 @@ mod tests {
             };
             let (a, b, c) = (pt(&mut r), pt(&mut r), pt(&mut r));
             let o = orient(a, b, c);
-            assert_eq!(o, orient_full(a, b, c), "{a} {b} {c}");
+            assert_eq!(o, orient_expanded(a, b, c), "{a} {b} {c}");
             stages[k % 3] += usize::from(o == Ordering::Equal);
         }
         // Collinear triples were met, on the lattice and off it.
