@@ -700,32 +700,19 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
             // settling a reservation, which only ?X makes): a program that
             // asks none of them needs only the turtle at its query modules,
             // and its guide's index stays empty.
-            if !reads_drawing(prog) {
+            let reads = reads_drawing(prog);
+            if !reads || !redraw::redrawable(prog) {
+                let interpret = if reads {
+                    turtle::interpret_limited
+                } else {
+                    turtle::interpret_queries
+                };
                 let mut p = Probe::default();
-                turtle::interpret_queries(
-                    prog,
-                    &inst.string,
-                    cfg.seed,
-                    inst.start,
-                    cfg.limits,
-                    &mut p,
-                )
-                .map_err(|e| e.diagnostic(prog))?;
-                p.segments.clear();
-                *probe = Some(Sketch::whole(p));
-                return Ok(());
-            }
-            if !redraw::redrawable(prog) {
-                let mut p = Probe::default();
-                turtle::interpret_limited(
-                    prog,
-                    &inst.string,
-                    cfg.seed,
-                    inst.start,
-                    cfg.limits,
-                    &mut p,
-                )
-                .map_err(|e| e.diagnostic(prog))?;
+                interpret(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut p)
+                    .map_err(|e| e.diagnostic(prog))?;
+                if !reads {
+                    p.segments.clear();
+                }
                 *probe = Some(Sketch::whole(p));
                 return Ok(());
             }
