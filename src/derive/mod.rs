@@ -386,7 +386,15 @@ pub fn step(
     }
     let out = match &prog.d0l {
         Some(table) => d0l_step(table, s, step, limits)?,
-        None => parametric_step(prog, s, step, seed, limits)?,
+        None => parametric_step(
+            prog,
+            &Plan::new(prog),
+            s,
+            Place::default(),
+            step,
+            seed,
+            limits,
+        )?,
     };
     let out = if prog.has_cut {
         apply_cut(prog, out)
@@ -398,6 +406,98 @@ pub fn step(
     } else {
         Ok(out)
     }
+}
+
+/// Whether `step_piece` serves the program: each module is rewritten on its
+/// own (no context, no `cut`, no decomposition), so a string can be stepped
+/// piece by piece, and a piece that holds no module with rules is copied
+/// unchanged by a step.
+pub fn piecewise(prog: &Program) -> bool {
+    prog.d0l.is_none() && !prog.has_context && !prog.has_cut && !decompose::has_rules(prog)
+}
+
+/// Where a piece of a string is: the place of its first module in the whole
+/// string (random draws are made by place), and how many modules and
+/// parameters the rest of the string holds (counted against the limits).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Place {
+    pub origin: usize,
+    pub other_modules: usize,
+    pub other_params: usize,
+}
+
+/// What `step` makes of the piece `s` of a string (see `Place`), for a
+/// program `piecewise` serves: the pieces' results, in order, are `step`'s
+/// result. An error here may name the piece's places, not the string's: step
+/// the whole string for the message.
+#[allow(clippy::too_many_arguments)]
+pub fn step_piece(
+    prog: &Program,
+    plan: &Plan,
+    s: &ModString,
+    at: Place,
+    step_no: u32,
+    seed: u64,
+    limits: Limits,
+) -> Result<ModString, DeriveError> {
+    if limits.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+        return Err(DeriveError::Cancelled { step: step_no });
+    }
+    if s.len() > CHUNK {
+        return parametric_step(prog, plan, s, at, step_no, seed, limits);
+    }
+    // One chunk, on this thread.
+    let mut n = count(&plan.table, &s.syms);
+    let view = View {
+        prog,
+        s,
+        offsets: Vec::new(),
+        growth: Vec::new(),
+    };
+    let choices = if n.choose {
+        choose_chunk(&view, plan, at.origin, &s.syms, 0, step_no, seed, &mut n)
+            .map_err(|_| first_error(&view, step_no, seed))?
+    } else {
+        Vec::new()
+    };
+    check_limits(
+        step_no,
+        n.mods.saturating_add(at.other_modules),
+        n.params.saturating_add(at.other_params),
+        limits,
+        false,
+    )?;
+    let mut syms = vec![0 as Sym; n.mods];
+    let mut params = vec![0.0; n.params];
+    let ok = fill_chunk(
+        &view,
+        plan,
+        at.origin,
+        &s.syms,
+        0,
+        &choices,
+        step_no,
+        seed,
+        &mut syms,
+        &mut params,
+    );
+    if !ok {
+        return Err(first_error(&view, step_no, seed));
+    }
+    Ok(ModString { syms, params })
+}
+
+/// What a chunk of modules holds and makes, by the plan's table.
+fn count(table: &[Entry], chunk: &[Sym]) -> Counts {
+    let mut n = Counts::default();
+    for &x in chunk {
+        let e = &table[x as usize];
+        n.params_in += e.arity as usize;
+        n.mods += e.mods as usize;
+        n.params += e.params as usize;
+        n.choose |= e.kind == Kind::Choose;
+    }
+    n
 }
 
 /// Checks a step's size against the limits. `exact`: the counts are the
@@ -612,15 +712,16 @@ impl Flat {
     }
 }
 
-/// The step's plan: an entry per symbol and the flattened rules.
-struct Plan {
+/// The step's plan: an entry per symbol and the flattened rules (made once
+/// for many pieces: `Plan::new`, `step_piece`).
+pub struct Plan {
     table: Vec<Entry>,
     /// `flat[sym][k]`: rule k of the symbol.
     flat: Vec<Vec<Flat>>,
 }
 
 impl Plan {
-    fn new(prog: &Program) -> Plan {
+    pub fn new(prog: &Program) -> Plan {
         let table = prog
             .rules
             .iter()
@@ -689,32 +790,23 @@ struct Counts {
 /// totals; then every chunk writes its share of the output directly. On an
 /// expression error the step is rewritten again in module order, so the error
 /// reported is the first in the string on any thread count.
+/// Rewrites the modules of `s`, a piece of a string at `at` (the whole
+/// string: `Place::default()`).
 fn parametric_step(
     prog: &Program,
+    plan: &Plan,
     s: &ModString,
+    at: Place,
     step: u32,
     seed: u64,
     limits: Limits,
 ) -> Result<ModString, DeriveError> {
-    let plan = Plan::new(prog);
     let table = &plan.table;
-    let mut counts: Vec<Counts> = s
-        .syms
-        .par_chunks(CHUNK)
-        .map(|c| {
-            let mut n = Counts::default();
-            for &x in c {
-                let e = &table[x as usize];
-                n.params_in += e.arity as usize;
-                n.mods += e.mods as usize;
-                n.params += e.params as usize;
-                n.choose |= e.kind == Kind::Choose;
-            }
-            n
-        })
-        .collect();
+    let from = at.origin;
+    let syms = &s.syms[..];
+    let mut counts: Vec<Counts> = syms.par_chunks(CHUNK).map(|c| count(table, c)).collect();
     let mut starts = Vec::with_capacity(counts.len());
-    let mut acc = 0usize;
+    let mut acc = 0;
     for c in &counts {
         starts.push(acc);
         acc += c.params_in;
@@ -731,8 +823,7 @@ fn parametric_step(
         growth: Vec::new(),
     };
     // Choices, for the chunks that have modules to choose for.
-    let choices: Vec<Result<Vec<Choice>, ()>> = s
-        .syms
+    let choices: Vec<Result<Vec<Choice>, ()>> = syms
         .par_chunks(CHUNK)
         .zip(counts.par_iter_mut())
         .enumerate()
@@ -740,7 +831,16 @@ fn parametric_step(
             if !n.choose {
                 return Ok(Vec::new());
             }
-            choose_chunk(&view, &plan, ci * CHUNK, chunk, starts[ci], step, seed, n)
+            choose_chunk(
+                &view,
+                plan,
+                from + ci * CHUNK,
+                chunk,
+                starts[ci],
+                step,
+                seed,
+                n,
+            )
         })
         .collect();
     if choices.iter().any(Result::is_err) {
@@ -757,11 +857,17 @@ fn parametric_step(
         .unwrap_or(usize::MAX);
     // The message does not give the count, as it did not when the limit was
     // checked on running totals: it stays the same across versions.
-    check_limits(step, total, total_params, limits, false)?;
-    let mut syms = vec![0 as Sym; total];
+    check_limits(
+        step,
+        total.saturating_add(at.other_modules),
+        total_params.saturating_add(at.other_params),
+        limits,
+        false,
+    )?;
+    let mut out_syms = vec![0 as Sym; total];
     let mut params = vec![0.0; total_params];
     let mut parts = Vec::with_capacity(counts.len());
-    let (mut rs, mut rp): (&mut [Sym], &mut [f64]) = (&mut syms, &mut params);
+    let (mut rs, mut rp): (&mut [Sym], &mut [f64]) = (&mut out_syms, &mut params);
     for c in &counts {
         let (a, b) = rs.split_at_mut(c.mods);
         rs = b;
@@ -769,8 +875,7 @@ fn parametric_step(
         rp = pb;
         parts.push((a, pa));
     }
-    let failed = s
-        .syms
+    let failed = syms
         .par_chunks(CHUNK)
         .zip(parts.into_par_iter())
         .zip(choices.par_iter())
@@ -778,8 +883,8 @@ fn parametric_step(
         .map(|(ci, ((chunk, (out_syms, out_params)), choices))| {
             fill_chunk(
                 &view,
-                &plan,
-                ci * CHUNK,
+                plan,
+                from + ci * CHUNK,
                 chunk,
                 starts[ci],
                 choices,
@@ -793,7 +898,10 @@ fn parametric_step(
     if failed {
         return Err(first_error(&view, step, seed));
     }
-    Ok(ModString { syms, params })
+    Ok(ModString {
+        syms: out_syms,
+        params,
+    })
 }
 
 /// Chooses the rule of every module of a chunk whose symbol must choose, and

@@ -30,9 +30,10 @@
 //! Seeds start at step 0 (answered before the first derivation). A unit ends
 //! when none of its systems derives and no message is still to come.
 
-use super::index::{Grid, Layers};
+use super::grown::{Grown, Piece};
+use super::index::{Grid, Layers, key};
 use super::query::{Answer, Probe, collide, edge_meet, inward, query};
-use super::redraw::{self, Sketch};
+use super::redraw::Sketch;
 use super::scene::{Link, Scene, seed_state};
 use crate::derive::{self, Limits, ModString};
 use crate::diagnostic::Diagnostic;
@@ -195,24 +196,24 @@ struct Reservation {
     pass: Vec<f64>,
 }
 
-/// A system's drawing: its segments (and elements' axes), and the query
-/// modules met, with the turtle there (`drawn`).
-type Drawing = Sketch;
-
 /// A unit's guide while it runs.
 struct Live {
     guide: usize,
     run: GuideRun,
-    probes: Vec<Option<Drawing>>,
-    /// A system's last drawing, while it is to be drawn again, and the string
-    /// it was drawn from: `redraw` reuses what did not change.
-    prev: Vec<Option<(ModString, Drawing)>>,
-    /// One grid over the segments of all its systems' drawings, in system
-    /// order (the ids of `Layers`). Kept from step to step: growth inserts
-    /// segments into the drawings, and only those are indexed anew
-    /// (`Grid::update`), so a query asks one index, however many systems the
+    /// Each system's string and drawing, in pieces (the instances' strings
+    /// are written from them when the unit ends).
+    grown: Vec<Grown>,
+    /// Pieces are numbered in the guide as they are made.
+    next_piece: usize,
+    /// One grid over the segments of all its systems' drawings: the kept
+    /// pieces' segments (indexed once, when a piece is kept) and the live
+    /// pieces' as its live part, replaced at each step; keys are (piece,
+    /// place in it), so a query asks one index however many systems the
     /// guide holds.
-    index: Option<Grid>,
+    index: Grid,
+    /// Per piece: the id of its first segment (segments numbered in the
+    /// order of the systems and their strings; see `Layers`).
+    offsets: Vec<usize>,
     /// A system was drawn since `index` was made.
     redrawn: bool,
     /// Answer this system's queries in this step.
@@ -508,7 +509,15 @@ fn run_unit(
         t += 1;
     }
     release_all(&mut live, t.min(cfg.cap));
-    Ok(live.into_iter().map(|l| l.run).collect())
+    Ok(live
+        .into_iter()
+        .map(|mut l| {
+            for (inst, grown) in l.run.instances.iter_mut().zip(&l.grown) {
+                inst.string = grown.string();
+            }
+            l.run
+        })
+        .collect())
 }
 
 /// The guides of a unit with their explicit seeds' systems.
@@ -520,9 +529,10 @@ fn start(scene: &Scene, cfg: Config, unit: &[usize]) -> Result<Vec<Live>, Diagno
         let mut l = Live {
             guide: g,
             run: GuideRun::default(),
-            probes: Vec::new(),
-            prev: Vec::new(),
-            index: None,
+            grown: Vec::new(),
+            next_piece: 0,
+            index: Grid::default(),
+            offsets: Vec::new(),
             redrawn: false,
             fresh: Vec::new(),
             settled: Vec::new(),
@@ -589,9 +599,10 @@ fn release_all(live: &mut [Live], step: u32) {
 
 impl Live {
     fn add(&mut self, inst: Instance) {
+        self.grown
+            .push(Grown::new(inst.string.clone(), self.next_piece));
+        self.next_piece += 1;
         self.run.instances.push(inst);
-        self.probes.push(None);
-        self.prev.push(None);
         self.fresh.push(true);
         self.settled.push(false);
     }
@@ -599,25 +610,17 @@ impl Live {
 
 /// Derives every system with steps left, once; whether any did.
 fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<bool, Diagnostic> {
-    type Job<'a> = (
-        &'a mut Instance,
-        (
-            &'a mut Option<Drawing>,
-            &'a mut Option<(ModString, Drawing)>,
-        ),
-        &'a mut bool,
-        &'a mut bool,
-    );
+    type Job<'a> = (&'a mut Instance, &'a mut Grown, &'a mut bool, &'a mut bool);
     let mut jobs: Vec<Job> = Vec::new();
     let mut any = false;
     for l in live.iter_mut() {
         let prog = &scene.programs[scene.guides[l.guide].program];
         let mut n = 0;
-        for (((inst, probe), fresh), settled) in l
+        for (((inst, grown), fresh), settled) in l
             .run
             .instances
             .iter_mut()
-            .zip(l.probes.iter_mut().zip(&mut l.prev))
+            .zip(&mut l.grown)
             .zip(&mut l.fresh)
             .zip(&mut l.settled)
         {
@@ -626,7 +629,7 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
                 if *settled {
                     inst.steps += 1;
                 } else {
-                    jobs.push((inst, probe, fresh, settled));
+                    jobs.push((inst, grown, fresh, settled));
                 }
             }
         }
@@ -636,32 +639,26 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
             l.run.last_step = t;
         }
     }
+    let plans: Vec<derive::Plan> = scene.programs.iter().map(derive::Plan::new).collect();
     let results: Vec<Result<(), Diagnostic>> = jobs
         .into_par_iter()
-        .map(|(inst, probe, fresh, settled)| {
-            let prog = &scene.programs[scene.guides[inst.guide].program];
+        .map(|(inst, grown, fresh, settled)| {
+            let program = scene.guides[inst.guide].program;
+            let prog = &scene.programs[program];
             inst.steps += 1;
-            let string = derive::step(prog, &inst.string, inst.steps, cfg.seed, cfg.limits)
+            let changed = grown
+                .derive(prog, &plans[program], inst.steps, cfg.seed, cfg.limits)
                 .map_err(|e| e.diagnostic(prog))?;
-            // An unchanged string draws the same: keep its drawing.
-            if string != inst.string {
-                let old = std::mem::replace(&mut inst.string, string);
+            if changed {
                 inst.changed = t;
-                if let Some(d) = probe.0.take() {
-                    *probe.1 = Some((old, d));
-                }
             }
             *fresh = true;
-            *settled = inst.string.syms.iter().all(|&x| inert(prog, x));
+            *settled = grown.all(|x| inert(prog, x));
             Ok(())
         })
         .collect();
     results.into_iter().collect::<Result<(), _>>()?;
-    let modules: usize = live
-        .iter()
-        .flat_map(|l| &l.run.instances)
-        .map(|i| i.string.len())
-        .sum();
+    let modules: usize = live.iter().flat_map(|l| &l.grown).map(Grown::len).sum();
     if modules > cfg.limits.max_modules {
         return Err(Diagnostic::error(
             crate::diagnostic::Code::TooManyModules,
@@ -679,73 +676,100 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
 fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagnostic> {
     let mut jobs = Vec::new();
     for l in live.iter_mut() {
-        for (inst, (probe, prev)) in l
-            .run
-            .instances
-            .iter()
-            .zip(l.probes.iter_mut().zip(&mut l.prev))
-        {
-            if probe.is_none() {
+        for (inst, grown) in l.run.instances.iter().zip(&mut l.grown) {
+            if !grown.drawn() {
                 l.redrawn = true;
-                jobs.push((inst, probe, prev));
+                jobs.push((inst, grown));
             }
         }
     }
     let results: Vec<Result<(), Diagnostic>> = jobs
         .into_par_iter()
-        .map(|(inst, probe, prev)| {
+        .map(|(inst, grown)| {
             let prog = &scene.programs[scene.guides[inst.guide].program];
-            let last = prev.take();
             // Only ?D_E, ?N_E and ?X read what a guide's systems drew (and
             // settling a reservation, which only ?X makes): a program that
             // asks none of them needs only the turtle at its query modules,
             // and its guide's index stays empty.
             let reads = reads_drawing(prog);
-            if !reads || !redraw::redrawable(prog) {
-                let interpret = if reads {
-                    turtle::interpret_limited
-                } else {
-                    turtle::interpret_queries
-                };
+            if Grown::splits(prog, reads) || (reads && super::redraw::redrawable(prog)) {
+                grown.draw(prog, inst.start);
+                return Ok(());
+            }
+            let interpret = if reads {
+                turtle::interpret_limited
+            } else {
+                turtle::interpret_queries
+            };
+            let mut result = Ok(());
+            grown.draw_whole(|s| {
                 let mut p = Probe::default();
-                interpret(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut p)
-                    .map_err(|e| e.diagnostic(prog))?;
+                if let Err(e) = interpret(prog, s, cfg.seed, inst.start, cfg.limits, &mut p) {
+                    result = Err(e.diagnostic(prog));
+                }
                 if !reads {
                     p.segments.clear();
                 }
-                *probe = Some(Sketch::whole(p));
-                return Ok(());
-            }
-            *probe = Some(match last {
-                Some((old, d)) => redraw::redraw(prog, &old, d, &inst.string, inst.start),
-                None => redraw::draw(prog, &inst.string, inst.start),
+                Sketch::whole(p)
             });
-            Ok(())
+            result
         })
         .collect();
     results.into_iter().collect()
 }
 
-/// Brings each guide's index up to its systems' drawings (all drawn): the
-/// segments of all its systems, in order, with the grid of the last index
-/// updated where they grew.
-fn reindex(live: &mut [Live]) {
+/// Brings each guide's index up to its systems' drawings (all drawn): first
+/// the live pieces are cut and the segments of the pieces kept indexed for
+/// good, then the live pieces' segments become the index's live part.
+fn reindex(scene: &Scene, live: &mut [Live]) {
     live.par_iter_mut().filter(|l| l.redrawn).for_each(|l| {
-        let total = l
-            .probes
-            .iter()
-            .flatten()
-            .map(|d| d.drawn.segments.len())
-            .sum();
-        let mut segs = l.index.as_mut().map_or_else(Vec::new, Grid::buffer);
-        segs.reserve(total);
-        for d in l.probes.iter().flatten() {
-            segs.extend_from_slice(&d.drawn.segments);
+        let prog = &scene.programs[scene.guides[l.guide].program];
+        if Grown::splits(prog, reads_drawing(prog)) {
+            for (inst, grown) in l.run.instances.iter().zip(&mut l.grown) {
+                grown.cut(prog, inst.start, &mut l.next_piece);
+            }
         }
-        l.index = Some(match l.index.take() {
-            Some(g) => g.update(segs),
-            None => Grid::new(segs),
-        });
+        // Number the segments: per piece, the id of its first.
+        l.offsets.resize(l.next_piece, 0);
+        let mut off = 0;
+        for p in l.grown.iter().flat_map(|g| &g.pieces) {
+            match p {
+                Piece::Kept(k) => {
+                    for x in &k.parts {
+                        l.offsets[x.id] = off;
+                        off += x.segments.len();
+                    }
+                }
+                Piece::Live(x) => {
+                    l.offsets[x.id] = off;
+                    off += x.drawing.as_ref().map_or(0, |d| d.drawn.segments.len());
+                }
+            }
+        }
+        let (mut segs, mut keys) = (Vec::new(), Vec::new());
+        for p in l.grown.iter_mut().flat_map(|g| &mut g.pieces) {
+            let Piece::Kept(k) = p else { continue };
+            for x in k.parts.iter_mut().filter(|x| !x.indexed) {
+                keys.extend((0..x.segments.len()).map(|i| key(x.id, i)));
+                segs.extend_from_slice(&x.segments);
+                x.indexed = true;
+            }
+        }
+        let offsets = &l.offsets;
+        let rank =
+            |k: u64| (offsets[(k >> 32) as usize] + (k & u64::from(u32::MAX)) as usize) as u64;
+        l.index
+            .push(std::mem::take(&mut segs), std::mem::take(&mut keys), &rank);
+
+        for p in l.grown.iter().flat_map(|g| &g.pieces) {
+            if let Piece::Live(x) = p
+                && let Some(d) = &x.drawing
+            {
+                keys.extend((0..d.drawn.segments.len()).map(|i| key(x.id, i)));
+                segs.extend_from_slice(&d.drawn.segments);
+            }
+        }
+        l.index.set_live(segs, keys);
         l.redrawn = false;
     });
 }
@@ -762,7 +786,7 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
         // closest to its heading (the first of equals): several branches may
         // start at one point.
         let mut hit: Option<(f64, DVec2, DVec2)> = None;
-        for &(s0, s1) in l.probes[r.instance].iter().flat_map(|p| &p.drawn.segments) {
+        for &(s0, s1) in l.grown[r.instance].segments() {
             if (s0 - r.from).length() > tol {
                 continue;
             }
@@ -861,17 +885,11 @@ fn answer(
     t: u32,
 ) -> Result<(), Diagnostic> {
     interpret(scene, cfg, live)?;
-    reindex(live);
+    reindex(scene, live);
     let layers = layers(live);
     let answered: Vec<(usize, usize, Answers)> = fresh_drawings(live)
         .into_par_iter()
-        .map(|(li, k, drawing)| {
-            (
-                li,
-                k,
-                answer_system(scene, &live[li], &layers[li], k, drawing),
-            )
-        })
+        .map(|(li, k)| (li, k, answer_system(scene, &live[li], &layers[li], k)))
         .collect();
     for (li, k, (answers, crossings)) in answered {
         let l = &mut live[li];
@@ -890,65 +908,77 @@ fn answer(
 fn layers(live: &[Live]) -> Vec<Layers<'_>> {
     live.iter()
         .map(|l| Layers {
-            parts: l.index.iter().map(|g| (0, g)).collect(),
+            grid: Some(&l.index),
+            offsets: &l.offsets,
         })
         .collect()
 }
 
 /// The drawings of the fresh systems that met query modules: (guide in the
 /// unit, system in the guide, drawing).
-fn fresh_drawings(live: &[Live]) -> Vec<(usize, usize, &Drawing)> {
+fn fresh_drawings(live: &[Live]) -> Vec<(usize, usize)> {
     let mut jobs = Vec::new();
     for (li, l) in live.iter().enumerate() {
-        for (k, (p, &f)) in l.probes.iter().zip(&l.fresh).enumerate() {
-            if let (Some(p), true) = (p, f)
-                && !p.drawn.queries.is_empty()
-            {
-                jobs.push((li, k, p));
+        for (k, (g, &f)) in l.grown.iter().zip(&l.fresh).enumerate() {
+            let asks = |(i, _, _): (usize, usize, _)| {
+                g.drawing(i).is_some_and(|d| !d.drawn.queries.is_empty())
+            };
+            if f && g.live().any(asks) {
+                jobs.push((li, k));
             }
         }
     }
     jobs
 }
 
-/// A system's answers, each with where its parameters start and how many
-/// they are, and the `?X` that would cross a guide edge.
-type Answers = (Vec<(usize, usize, Answer)>, Vec<Crossing>);
+/// A system's answers, each with its piece, where its parameters start in
+/// the piece and how many they are, and the `?X` that would cross a guide
+/// edge.
+type Answers = (Vec<(usize, usize, usize, Answer)>, Vec<Crossing>);
 
-/// Answers every query module that system `k` of guide `l` met in `drawing`.
-fn answer_system(scene: &Scene, l: &Live, layers: &Layers, k: usize, drawing: &Drawing) -> Answers {
+/// Answers every query module that system `k` of guide `l` met in its
+/// drawing, in the order of its string.
+fn answer_system(scene: &Scene, l: &Live, layers: &Layers, k: usize) -> Answers {
     let gi = l.guide;
-    let inst = &l.run.instances[k];
+    let grown = &l.grown[k];
     let prog = &scene.programs[scene.guides[gi].program];
-    let offsets = param_offsets(prog, &inst.string);
     let grid = Some(layers);
-    let mut answers = Vec::with_capacity(drawing.drawn.queries.len());
+    let mut answers = Vec::new();
     let mut crossings = Vec::new();
-    for &(module, kind, state) in &drawing.drawn.queries {
-        let q = &QUERIES[kind as usize];
-        let at = offsets[module] as usize;
-        let arity = prog.symbols.arity(inst.string.syms[module]);
-        let own = &inst.string.params[at..at + arity];
-        let ans = match q.kind {
-            QueryKind::Collision => {
-                let delta = own.get(q.outputs.len()).copied().unwrap_or(0.0);
-                let (ans, edge) = collide(scene, grid, gi, &state, delta);
-                if let Some(edge) = edge {
-                    crossings.push(Crossing {
-                        module,
-                        edge,
-                        from: state.pos.truncate(),
-                        dir: state.h.truncate().normalize_or_zero(),
-                        pass: own
-                            .get(q.outputs.len()..)
-                            .map_or(Vec::new(), <[f64]>::to_vec),
-                    });
-                }
-                ans
-            }
-            kind => query(scene, grid, gi, kind, &state),
+    for (pi, origin, piece) in grown.live() {
+        let Some(drawing) = grown.drawing(pi) else {
+            continue;
         };
-        answers.push((at, arity, ans));
+        if drawing.drawn.queries.is_empty() {
+            continue;
+        }
+        let offsets = grown.param_offsets(prog, pi);
+        for &(m, kind, state) in &drawing.drawn.queries {
+            let q = &QUERIES[kind as usize];
+            let at = offsets[m];
+            let arity = prog.symbols.arity(piece.string.syms[m]);
+            let own = &piece.string.params[at..at + arity];
+            let ans = match q.kind {
+                QueryKind::Collision => {
+                    let delta = own.get(q.outputs.len()).copied().unwrap_or(0.0);
+                    let (ans, edge) = collide(scene, grid, gi, &state, delta);
+                    if let Some(edge) = edge {
+                        crossings.push(Crossing {
+                            module: origin + m,
+                            edge,
+                            from: state.pos.truncate(),
+                            dir: state.h.truncate().normalize_or_zero(),
+                            pass: own
+                                .get(q.outputs.len()..)
+                                .map_or(Vec::new(), <[f64]>::to_vec),
+                        });
+                    }
+                    ans
+                }
+                kind => query(scene, grid, gi, kind, &state),
+            };
+            answers.push((pi, at, arity, ans));
+        }
     }
     (answers, crossings)
 }
@@ -959,13 +989,13 @@ fn write_answers(
     scene: &Scene,
     l: &mut Live,
     k: usize,
-    answers: Vec<(usize, usize, Answer)>,
+    answers: Vec<(usize, usize, usize, Answer)>,
 ) -> bool {
     let prog = &scene.programs[scene.guides[l.guide].program];
-    let inst = &mut l.run.instances[k];
     l.run.queries += answers.len() as u64;
-    for (at, arity, ans) in answers {
-        for (slot, v) in inst.string.params[at..at + arity]
+    let grown = &mut l.grown[k];
+    for (piece, at, arity, ans) in answers {
+        for (slot, v) in grown.params_mut(piece)[at..at + arity]
             .iter_mut()
             .zip(ans.values())
         {
@@ -974,9 +1004,9 @@ fn write_answers(
     }
     if queries_interpreted(prog) {
         // Its drawing may read the answers: draw it again when needed.
-        l.probes[k] = None;
+        grown.forget();
     }
-    inst.steps < prog.derive
+    l.run.instances[k].steps < prog.derive
 }
 
 /// Reserves, for each crossing of system `k`, a free token of every link
@@ -1042,16 +1072,6 @@ fn queries_interpreted(prog: &crate::compile::Program) -> bool {
         matches!(info.action, crate::compile::Action::Query(_))
             && prog.interpret.get(i).is_some_and(|r| !r.is_empty())
     })
-}
-
-fn param_offsets(prog: &crate::compile::Program, s: &ModString) -> Vec<u32> {
-    let mut off = Vec::with_capacity(s.len());
-    let mut p = 0u32;
-    for &x in &s.syms {
-        off.push(p);
-        p += prog.symbols.arity(x) as u32;
-    }
-    off
 }
 
 /// A scene with its cache: `run` recomputes only what changed since the last

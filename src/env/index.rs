@@ -1,11 +1,12 @@
 //! The spatial index of the segments drawn in a guide, as the environment
 //! asks it: a `Grid` (the crate's `geometry::index::GrowingGrid`, kept from
 //! step to step while the systems grow; the engine keeps one per guide, over
-//! the segments of all its systems in order), and `Layers`, grids whose ids
-//! run on from one to the next, searched as one.
+//! the segments of all its systems), and `Layers`, which turns the grid's
+//! keys into ids: the segments of all systems of the guide numbered in order,
+//! as if all were one list.
 //!
-//! Owns: numbering segments across systems and merging the per-grid answers
-//! (the lowest id wins ties). Must not index or search segments itself.
+//! Owns: the keys (a piece of a system's drawing and a segment's place in it)
+//! and turning them into ids. Must not index or search segments itself.
 
 pub use crate::geometry::index::GrowingGrid as Grid;
 pub use crate::geometry::index::segments::{
@@ -13,55 +14,42 @@ pub use crate::geometry::index::segments::{
 };
 use glam::DVec2;
 
-/// The grids of all systems of a guide, in order: segment ids run on from one
-/// system to the next, as if all were one list.
+/// The key of segment `place` of the piece `piece` of a drawing (pieces are
+/// numbered in a guide as they are made).
+pub fn key(piece: usize, place: usize) -> u64 {
+    ((piece as u64) << 32) | place as u64
+}
+
+/// A guide's grid with the id of each piece's first segment.
 pub struct Layers<'a> {
-    pub parts: Vec<(usize, &'a Grid)>,
+    pub grid: Option<&'a Grid>,
+    /// Per piece: the id of its first segment (how many segments the guide's
+    /// drawings hold before it).
+    pub offsets: &'a [usize],
 }
 
 impl Layers<'_> {
-    /// `Grid::first_crossing` over all parts: the nearest along `p`–`q`,
-    /// then the lowest id.
+    /// The id of the segment with key `key`.
+    pub fn id(&self, key: u64) -> u64 {
+        (self.offsets[(key >> 32) as usize] + (key & u64::from(u32::MAX)) as usize) as u64
+    }
+
+    /// `Grid::first_crossing`: the nearest along `p`–`q`, then the lowest id.
     pub fn first_crossing(&self, p: DVec2, q: DVec2) -> Option<(f64, usize)> {
-        let mut best: Option<(f64, usize)> = None;
-        for (off, g) in &self.parts {
-            if let Some((t, i)) = g.first_crossing(p, q)
-                && best.is_none_or(|b| t.total_cmp(&b.0).then((off + i).cmp(&b.1)).is_lt())
-            {
-                best = Some((t, off + i));
-            }
-        }
-        best
+        let (t, i) = self.grid?.first_crossing(p, q, &|k| self.id(k))?;
+        Some((t, i as usize))
     }
 
-    /// `Grid::nearest` over all parts: the closest, then the lowest id.
+    /// `Grid::nearest`: the closest, then the lowest id.
     pub fn nearest(&self, p: DVec2) -> Option<(f64, DVec2, usize)> {
-        let mut best: Option<(f64, DVec2, usize)> = None;
-        for (off, g) in &self.parts {
-            if best.is_some_and(|b| g.box_distance(p) > b.0) {
-                continue;
-            }
-            if let Some((d, c, i)) = g.nearest(p)
-                && best.is_none_or(|b| d.total_cmp(&b.0).then((off + i).cmp(&b.2)).is_lt())
-            {
-                best = Some((d, c, off + i));
-            }
-        }
-        best
+        let (d, c, i) = self.grid?.nearest(p, &|k| self.id(k))?;
+        Some((d, c, i as usize))
     }
 
-    /// `Grid::ray` over all parts: the nearest hit, then the lowest id.
+    /// `Grid::ray`: the nearest hit, then the lowest id.
     pub fn ray(&self, p: DVec2, dir: DVec2, limit: f64) -> Option<(f64, usize)> {
-        let mut best: Option<(f64, usize)> = None;
-        for (off, g) in &self.parts {
-            let lim = best.map_or(limit, |b| b.0);
-            if let Some((t, i)) = g.ray(p, dir, lim)
-                && best.is_none_or(|b| t.total_cmp(&b.0).then((off + i).cmp(&b.1)).is_lt())
-            {
-                best = Some((t, off + i));
-            }
-        }
-        best
+        let (t, i) = self.grid?.ray(p, dir, limit, &|k| self.id(k))?;
+        Some((t, i as usize))
     }
 }
 
@@ -103,23 +91,43 @@ mod tests {
     /// (crossing, nearest, ray).
     fn check(segs: &[(DVec2, DVec2)], asks: &[(DVec2, DVec2)]) -> [usize; 3] {
         let grid = Grid::new(segs.to_vec());
+        let id = |k: u64| k;
         let mut found = [0; 3];
         for &(p, dir) in asks {
             let q = p + dir * 3.0;
-            let x = grid.first_crossing(p, q);
+            let x = grid.first_crossing(p, q, &id).map(|(t, k)| (t, k as usize));
             found[0] += usize::from(x.is_some());
-            found[1] += usize::from(grid.nearest(p).is_some());
-            found[2] += usize::from(grid.ray(p, dir, f64::INFINITY).is_some());
+            found[1] += usize::from(grid.nearest(p, &id).is_some());
+            found[2] += usize::from(grid.ray(p, dir, f64::INFINITY, &id).is_some());
             assert_eq!(x, scan_crossing(segs, p, q), "{p} {q}");
-            // The same segments in three grids, ids running on.
+            // The same segments as three systems' drawings, in a kept part
+            // and the live one, ids running on.
             let (a, b) = (segs.len() / 3, 2 * segs.len() / 3);
-            let grids = [
-                Grid::new(segs[..a].to_vec()),
-                Grid::new(segs[a..b].to_vec()),
-                Grid::new(segs[b..].to_vec()),
-            ];
+            let mut split = Grid::default();
+            let keyed = |range: std::ops::Range<usize>| -> Vec<u64> {
+                range
+                    .map(|i| {
+                        let k = usize::from(i >= a) + usize::from(i >= b);
+                        key(k, i - [0, a, b][k])
+                    })
+                    .collect()
+            };
+            let kept: Vec<usize> = (0..segs.len()).filter(|i| i % 3 != 1).collect();
+            let offsets = [0, a, b];
+            let number = |k: u64| (offsets[(k >> 32) as usize] + (k & 0xffff_ffff) as usize) as u64;
+            split.push(
+                kept.iter().map(|&i| segs[i]).collect(),
+                kept.iter().flat_map(|&i| keyed(i..i + 1)).collect(),
+                &number,
+            );
+            let live: Vec<usize> = (0..segs.len()).filter(|i| i % 3 == 1).collect();
+            split.set_live(
+                live.iter().map(|&i| segs[i]).collect(),
+                live.iter().flat_map(|&i| keyed(i..i + 1)).collect(),
+            );
             let layers = Layers {
-                parts: vec![(0, &grids[0]), (a, &grids[1]), (b, &grids[2])],
+                grid: Some(&split),
+                offsets: &offsets,
             };
             assert_eq!(layers.first_crossing(p, q), x);
             assert_eq!(
@@ -128,12 +136,13 @@ mod tests {
             );
             assert_eq!(layers.ray(p, dir, f64::INFINITY), scan_ray(segs, p, dir));
             assert_eq!(
-                grid.nearest(p).map(|(d, _, i)| (d, i)),
+                grid.nearest(p, &id).map(|(d, _, i)| (d, i as usize)),
                 scan_nearest(segs, p),
                 "{p}"
             );
             assert_eq!(
-                grid.ray(p, dir, f64::INFINITY),
+                grid.ray(p, dir, f64::INFINITY, &id)
+                    .map(|(t, k)| (t, k as usize)),
                 scan_ray(segs, p, dir),
                 "{p} {dir}"
             );
@@ -188,6 +197,7 @@ mod tests {
 
     #[test]
     fn ties_go_to_the_lowest_index_and_degenerate_sets_work() {
+        let id = |k: u64| k;
         // Two copies of one segment after 40 far-away ones: the lower index wins
         // every query, through the cells and through the one-cell scan.
         let s = (DVec2::new(0.0, 5.0), DVec2::new(10.0, 5.0));
@@ -200,14 +210,17 @@ mod tests {
             let grid = Grid::new(segs[40 - (n - 2)..].to_vec());
             let segs = &segs[40 - (n - 2)..];
             assert_eq!(grid.cells() > 1, n == 42);
-            let first = segs.len() - 2;
+            let first = segs.len() as u64 - 2;
             assert_eq!(
-                grid.first_crossing(p, DVec2::new(5.0, 10.0)),
+                grid.first_crossing(p, DVec2::new(5.0, 10.0), &id),
                 Some((0.5, first))
             );
-            assert_eq!(grid.nearest(p).map(|x| x.2), Some(first));
-            assert_eq!(grid.ray(p, DVec2::Y, f64::INFINITY), Some((5.0, first)));
-            assert_eq!(grid.ray(p, DVec2::Y, 4.0), None, "beyond the limit");
+            assert_eq!(grid.nearest(p, &id).map(|x| x.2), Some(first));
+            assert_eq!(
+                grid.ray(p, DVec2::Y, f64::INFINITY, &id),
+                Some((5.0, first))
+            );
+            assert_eq!(grid.ray(p, DVec2::Y, 4.0, &id), None, "beyond the limit");
         }
         // All on one horizontal line, all at one point, empty, not finite.
         let line: Vec<_> = (0..100)
@@ -229,7 +242,7 @@ mod tests {
         ];
         let g = Grid::new(wild);
         assert_eq!(
-            g.first_crossing(DVec2::new(0.0, -1.0), DVec2::new(0.0, 2.0))
+            g.first_crossing(DVec2::new(0.0, -1.0), DVec2::new(0.0, 2.0), &id)
                 .map(|x| x.1),
             Some(1)
         );

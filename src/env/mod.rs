@@ -27,6 +27,7 @@
 pub mod clip;
 pub mod engine;
 pub mod explain;
+pub mod grown;
 pub mod index;
 pub mod query;
 pub mod redraw;

@@ -17,19 +17,87 @@
 //! means that less is copied. Programs with interpretation rules or `cut` are
 //! drawn whole.
 //!
-//! Owns: `Sketch` (a drawing and its marks), `draw` and `redraw`. Must not
-//! answer queries or index segments.
+//! A string can be drawn from a place on (`Span`, from the turtle that place
+//! was reached with: `Resume`): the engine keeps the start of a system's
+//! string that holds no active module, and its segments, for good
+//! (`Sketch::split_front`), and draws only what follows.
+//!
+//! Owns: `Sketch` (a drawing and its marks), `draw`, `redraw` and splitting
+//! off a drawing's front. Must not answer queries or index segments.
 
 use super::query::Probe;
 use crate::compile::{Program, Sym};
 use crate::derive::ModString;
 use crate::turtle::{State, Stepper};
+use glam::DVec2;
+use std::sync::Arc;
+
+/// Modules of a string from some place on, with their parameters.
+#[derive(Clone, Copy)]
+pub(crate) struct Span<'a> {
+    pub(crate) syms: &'a [Sym],
+    pub(crate) params: &'a [f64],
+    /// The place of `syms[0]` in the whole string.
+    pub(crate) base: usize,
+}
+
+impl<'a> Span<'a> {
+    /// Modules `from..` of `s` (their parameters from `pfrom`).
+    pub(crate) fn tail(s: &'a ModString, from: usize, pfrom: usize) -> Span<'a> {
+        Span {
+            syms: &s.syms[from..],
+            params: &s.params[pfrom..],
+            base: from,
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.syms.len()
+    }
+}
+
+/// The turtle where a span starts: `None` at the start of the string (the
+/// system's start state), or the state and stack it was reached with.
+pub(crate) type Resume<'a> = Option<(&'a State, &'a [State])>;
+
+fn stepper<'p>(prog: &'p Program, start: State, at: Resume) -> Stepper<'p> {
+    let mut st = Stepper::new(prog, start);
+    if let Some((state, stack)) = at {
+        st.state = *state;
+        st.stack = stack.to_vec();
+    }
+    st
+}
+
+/// A piece of a drawn span (`cut`): modules, parameters and segments.
+pub(crate) enum Cut {
+    /// Modules that no step changes and that are drawn from a turtle
+    /// nothing before them can change: their segments are final.
+    Kept {
+        modules: std::ops::Range<usize>,
+        params: std::ops::Range<usize>,
+        segments: Vec<(DVec2, DVec2)>,
+    },
+    /// The rest, with its drawing, from the turtle it starts with (`None`:
+    /// the span's own start).
+    Live {
+        modules: std::ops::Range<usize>,
+        params: std::ops::Range<usize>,
+        entry: Option<(State, Vec<State>)>,
+        sketch: Box<Sketch>,
+    },
+}
+
+/// The fewest modules a kept piece holds, unless it ends the span (pieces
+/// kept are never merged: a few large ones are cheaper than many small).
+const MIN_KEPT: usize = 16;
 
 /// The turtle at one place of the string, and what was drawn before it.
 #[derive(Clone)]
 struct Snap {
     state: State,
-    stack: Vec<State>,
+    /// Shared by the snaps of one drawing that have equal stacks.
+    stack: Arc<[State]>,
     /// A polygon was open (the turtle cannot be set to this place).
     polygon: bool,
     segs: usize,
@@ -52,6 +120,8 @@ struct Mark {
 pub(crate) struct Sketch {
     pub(crate) drawn: Probe,
     marks: Option<Vec<Mark>>,
+    /// The turtle after the last module (with marks only).
+    end: Option<Snap>,
     /// The segment list of the drawing before, emptied: the next redraw
     /// fills it instead of allocating a list as large.
     spare: Vec<(glam::DVec2, glam::DVec2)>,
@@ -63,6 +133,7 @@ impl Sketch {
         Sketch {
             drawn,
             marks: None,
+            end: None,
             spare: Vec::new(),
         }
     }
@@ -118,16 +189,281 @@ fn shared(a: &[State], b: &[State]) -> usize {
         .count()
 }
 
-/// Draws a string whole, from the turtle `start`, as `turtle::interpret_from`
-/// does (segments, elements' axes, queries), with marks when the program has
-/// no interpretation rules.
-pub(crate) fn draw(prog: &Program, s: &ModString, start: State) -> Sketch {
-    let mut st = Stepper::new(prog, start);
+/// Cuts the drawing in `slot` of span `s` (drawn from `start`, or from `at`)
+/// into pieces kept for good and live pieces, taking it; `None` (and the
+/// drawing left in `slot`) when nothing is to be kept. A module's turtle is *fixed* when no active module comes
+/// before it outside a branch closed before it (an active module before may
+/// move the turtle once rewritten; a `]` restores what its `[` saved). A run
+/// of inactive modules that starts with a fixed turtle, outside a polygon,
+/// and ends outside a polygon is kept when it holds `MIN_KEPT` modules or
+/// ends the span. What remains between kept runs is live, each live piece
+/// starting from a fixed turtle.
+pub(crate) fn cut(
+    prog: &Program,
+    s: Span,
+    slot: &mut Option<Sketch>,
+    start: State,
+    at: Resume,
+) -> Option<Vec<Cut>> {
+    let d = slot.as_ref()?;
+    let marks = d.marks.as_deref()?;
+    let end = d.end.as_ref()?;
+    // Where the turtle is fixed again after each run of active modules
+    // (`None`: not before the next run), by the branches' nesting.
+    let mut fixed_from: Vec<Option<usize>> = Vec::with_capacity(marks.len());
+    let mut cur = true;
+    let mut saved: Vec<bool> = Vec::new();
+    let mut poisoned = false;
+    let mut mi = 0;
+    let mut i = 0;
+    while i < s.len() {
+        if let Some(m) = marks.get(mi)
+            && m.start == i
+        {
+            for &x in &s.syms[m.start..m.end] {
+                let action = prog.symbols.info[x as usize].action;
+                poisoned |= matches!(
+                    action,
+                    crate::compile::Action::Push | crate::compile::Action::Pop
+                );
+            }
+            cur = false;
+            i = m.end;
+            mi += 1;
+            fixed_from.push(None);
+            continue;
+        }
+        match prog.symbols.info[s.syms[i] as usize].action {
+            crate::compile::Action::Push => saved.push(cur),
+            crate::compile::Action::Pop => cur = saved.pop().unwrap_or(true),
+            _ => {}
+        }
+        i += 1;
+        if cur
+            && !poisoned
+            && let Some(f @ None) = fixed_from.last_mut()
+        {
+            *f = Some(i);
+        }
+    }
+    // A run to keep: modules `a..b`; at `a` its parameters, segments and
+    // queries drawn before it.
+    struct Run<'a> {
+        a: usize,
+        pa: usize,
+        sa: usize,
+        qa: usize,
+        /// The turtle at `a` when it is not a mark's (for a live piece
+        /// ending there).
+        snap_a: Option<Snap>,
+        b: usize,
+        at_b: &'a Snap,
+    }
+    // A run to keep, with everything of `d` it needs.
+    struct Kept {
+        a: usize,
+        pa: usize,
+        sa: usize,
+        qa: usize,
+        snap_a: Option<Snap>,
+        b: usize,
+        pb: usize,
+        sb: usize,
+        qb: usize,
+        exit: (State, Vec<State>),
+    }
+    let mut runs: Vec<Run> = Vec::new();
+    for k in 0..=marks.len() {
+        let (b, at_b) = match marks.get(k) {
+            Some(m) => (m.start, &m.before),
+            None => (s.len(), end),
+        };
+        // Where the run to keep would start: only a run worth keeping is
+        // looked at further.
+        let a = if k == 0 {
+            0
+        } else {
+            match fixed_from[k - 1] {
+                Some(a) => a,
+                None => continue,
+            }
+        };
+        let enough = b - a >= MIN_KEPT || (b == s.len() && b > a);
+        if a >= b || !enough || at_b.polygon {
+            continue;
+        }
+        let (a, pa, sa, qa, snap_a) = if k == 0 {
+            (0, 0, 0, 0, None)
+        } else {
+            let prev = &marks[k - 1];
+            if a == prev.end {
+                (a, prev.pend, prev.after.segs, prev.after.queries, None)
+            } else {
+                // Draw up to `a` again for its turtle and segment count.
+                if prev.after.polygon {
+                    continue;
+                }
+                let mut st = stepper(
+                    prog,
+                    start,
+                    Some((&prev.after.state, &prev.after.stack[..])),
+                );
+                let pa = prev.pend
+                    + s.syms[prev.end..a]
+                        .iter()
+                        .map(|&x| prog.symbols.arity(x))
+                        .sum::<usize>();
+                let mut scratch = Probe::default();
+                st.run(
+                    &mut scratch,
+                    &s.syms[prev.end..a],
+                    &s.params[prev.pend..pa],
+                    s.base + prev.end,
+                    None,
+                );
+                let mut snap_a = snap(&st, &scratch, &mut None);
+                snap_a.segs += prev.after.segs;
+                snap_a.queries += prev.after.queries;
+                (a, pa, snap_a.segs, snap_a.queries, Some(snap_a))
+            }
+        };
+        let open = snap_a.as_ref().is_some_and(|x| x.polygon);
+        if !open && at_b.queries == qa {
+            runs.push(Run {
+                a,
+                pa,
+                sa,
+                qa,
+                snap_a,
+                b,
+                at_b,
+            });
+        }
+    }
+    if runs.is_empty() {
+        return None;
+    }
+    // What the kept runs need of `d`, taken before `d` is taken apart.
+    let runs: Vec<Kept> = runs
+        .into_iter()
+        .map(|r| Kept {
+            a: r.a,
+            pa: r.pa,
+            sa: r.sa,
+            qa: r.qa,
+            snap_a: r.snap_a,
+            b: r.b,
+            pb: r.pa
+                + s.syms[r.a..r.b]
+                    .iter()
+                    .map(|&x| prog.symbols.arity(x))
+                    .sum::<usize>(),
+            sb: r.at_b.segs,
+            qb: r.at_b.queries,
+            exit: (r.at_b.state, r.at_b.stack.to_vec()),
+        })
+        .collect();
+    let Some(Sketch {
+        drawn, marks, end, ..
+    }) = slot.take()
+    else {
+        unreachable!("looked at above")
+    };
+    let (Some(marks), Some(end)) = (marks, end) else {
+        unreachable!("checked above")
+    };
+    let mut marks = marks.into_iter().peekable();
+    let mut out = Vec::with_capacity(2 * runs.len() + 1);
+    let mut from = (0, 0, 0, 0);
+    let mut entry: Option<(State, Vec<State>)> = at.map(|(a, b)| (*a, b.to_vec()));
+    let mut live = |from: (usize, usize, usize, usize),
+                    to: (usize, usize, usize, usize),
+                    snap_a: Option<Snap>,
+                    entry: Option<(State, Vec<State>)>|
+     -> Cut {
+        let (c, pc, sc, qc) = from;
+        let (a, pa, sa, qa) = to;
+        let rebase = |mut x: Snap| {
+            x.segs -= sc;
+            x.queries -= qc;
+            x
+        };
+        let mut inside = Vec::new();
+        while let Some(m) = marks.next_if(|m| m.start < a) {
+            inside.push(Mark {
+                start: m.start - c,
+                end: m.end - c,
+                pstart: m.pstart - pc,
+                pend: m.pend - pc,
+                before: rebase(m.before),
+                after: rebase(m.after),
+            });
+        }
+        let end_at = match snap_a {
+            Some(x) => x,
+            None if a == s.len() => end.clone(),
+            None => {
+                let last = inside.last().expect("a live piece ends after a mark");
+                let mut x = last.after.clone();
+                x.segs += sc;
+                x.queries += qc;
+                x
+            }
+        };
+        let queries = drawn.queries[qc..qa]
+            .iter()
+            .map(|&(m, kind, state)| (m - c, kind, state))
+            .collect();
+        Cut::Live {
+            modules: c..a,
+            params: pc..pa,
+            entry,
+            sketch: Box::new(Sketch {
+                drawn: Probe {
+                    segments: drawn.segments[sc..sa].to_vec(),
+                    queries,
+                },
+                marks: Some(inside),
+                end: Some(rebase(end_at)),
+                spare: Vec::new(),
+            }),
+        }
+    };
+    for r in runs {
+        if r.a > from.0 {
+            out.push(live(from, (r.a, r.pa, r.sa, r.qa), r.snap_a, entry.take()));
+        }
+        out.push(Cut::Kept {
+            modules: r.a..r.b,
+            params: r.pa..r.pb,
+            segments: drawn.segments[r.sa..r.sb].to_vec(),
+        });
+        from = (r.b, r.pb, r.sb, r.qb);
+        entry = Some(r.exit);
+    }
+    if from.0 < s.len() {
+        let to = (
+            s.len(),
+            s.params.len(),
+            drawn.segments.len(),
+            drawn.queries.len(),
+        );
+        out.push(live(from, to, None, entry));
+    }
+    Some(out)
+}
+
+/// Draws a span whole, from the turtle `start` (or where it was reached:
+/// `at`), as `turtle::interpret_from` does (segments, elements' axes,
+/// queries), with marks when the program has no interpretation rules.
+pub(crate) fn draw(prog: &Program, s: Span, start: State, at: Resume) -> Sketch {
+    let mut st = stepper(prog, start, at);
     let mut out = Probe::default();
     let mut marks = Vec::new();
     fresh(prog, &mut st, &mut out, &mut marks, s, 0, s.len(), 0);
     let marks = keep(marks, s.len());
     Sketch {
+        end: marks.as_ref().map(|_| snap(&st, &out, &mut None)),
         drawn: out,
         marks,
         spare: Vec::new(),
@@ -143,10 +479,18 @@ fn keep(marks: Vec<Mark>, len: usize) -> Option<Vec<Mark>> {
     (held <= len / 2 + 4096).then_some(marks)
 }
 
-fn snap(st: &Stepper, out: &Probe) -> Snap {
+fn snap(st: &Stepper, out: &Probe, share: &mut Option<Arc<[State]>>) -> Snap {
+    let stack = match share {
+        Some(x) if x.len() == st.stack.len() && shared(x, &st.stack) == x.len() => x.clone(),
+        _ => {
+            let x: Arc<[State]> = Arc::from(&st.stack[..]);
+            *share = Some(x.clone());
+            x
+        }
+    };
     Snap {
         state: st.state,
-        stack: st.stack.clone(),
+        stack,
         polygon: st.in_polygon(),
         segs: out.segments.len(),
         queries: out.queries.len(),
@@ -161,7 +505,7 @@ fn fresh(
     st: &mut Stepper,
     out: &mut Probe,
     marks: &mut Vec<Mark>,
-    s: &ModString,
+    s: Span,
     from: usize,
     to: usize,
     mut p: usize,
@@ -172,6 +516,7 @@ fn fresh(
             .map(|&x| prog.symbols.arity(x))
             .sum::<usize>()
     };
+    let mut share = None;
     let mut i = from;
     while i < to {
         let is_active = active(prog, s.syms[i]);
@@ -181,18 +526,18 @@ fn fresh(
         }
         let q = params(i, j, p);
         if is_active {
-            let before = snap(st, out);
-            st.run(out, &s.syms[i..j], &s.params[p..q], i, None);
+            let before = snap(st, out, &mut share);
+            st.run(out, &s.syms[i..j], &s.params[p..q], s.base + i, None);
             marks.push(Mark {
                 start: i,
                 end: j,
                 pstart: p,
                 pend: q,
                 before,
-                after: snap(st, out),
+                after: snap(st, out, &mut share),
             });
         } else {
-            st.run(out, &s.syms[i..j], &s.params[p..q], i, None);
+            st.run(out, &s.syms[i..j], &s.params[p..q], s.base + i, None);
         }
         i = j;
         p = q;
@@ -212,15 +557,7 @@ struct Run {
     pnew: usize,
 }
 
-fn equal_at(
-    a: &ModString,
-    ai: usize,
-    pa: usize,
-    b: &ModString,
-    bi: usize,
-    pb: usize,
-    r: Run,
-) -> bool {
+fn equal_at(a: Span, ai: usize, pa: usize, b: Span, bi: usize, pb: usize, r: Run) -> bool {
     a.syms[ai..ai + r.len] == b.syms[bi..bi + r.len]
         && a.params[pa..pa + r.plen]
             .iter()
@@ -231,7 +568,7 @@ fn equal_at(
 /// Places the inactive runs of `old` (between its marks) in `new`: the first
 /// at the start, the last at the end, the others each at its first place
 /// after the one before. `None` when they do not all fit.
-fn align(prog: &Program, old: &ModString, marks: &[Mark], new: &ModString) -> Option<Vec<Run>> {
+fn align(prog: &Program, old: Span, marks: &[Mark], new: Span) -> Option<Vec<Run>> {
     let mut runs = Vec::with_capacity(marks.len() + 1);
     let (mut o, mut po) = (0, 0);
     for m in marks {
@@ -296,29 +633,30 @@ fn align(prog: &Program, old: &ModString, marks: &[Mark], new: &ModString) -> Op
     Some(runs)
 }
 
-/// Draws `new`, the string derived from `old` (drawn as `last`), from the
-/// turtle `start`; see the module note.
+/// Draws `new`, the span derived from `old` (drawn as `last`), from the
+/// turtle `start` (or where the spans start: `at`); see the module note.
 pub(crate) fn redraw(
     prog: &Program,
-    old: &ModString,
+    old: Span,
     mut last: Sketch,
-    new: &ModString,
+    new: Span,
     start: State,
+    at: Resume,
 ) -> Sketch {
     if !redrawable(prog) {
-        return draw(prog, new, start);
+        return draw(prog, new, start, at);
     }
     let Some(marks) = last.marks.as_deref() else {
-        return draw(prog, new, start);
+        return draw(prog, new, start, at);
     };
     let Some(runs) = align(prog, old, marks, new) else {
-        return draw(prog, new, start);
+        return draw(prog, new, start, at);
     };
     let drawn = &last.drawn;
-    let mut st = Stepper::new(prog, start);
+    let mut st = stepper(prog, start, at);
     let begin = Snap {
         state: st.state,
-        stack: Vec::new(),
+        stack: Arc::from(&st.stack[..]),
         polygon: false,
         segs: 0,
         queries: 0,
@@ -365,7 +703,7 @@ pub(crate) fn redraw(
                 &mut out,
                 &new.syms[r.new..r.new + r.len],
                 &new.params[r.pnew..end],
-                r.new,
+                new.base + r.new,
                 below,
             );
             (done < r.len).then(|| (done, out.segments.len() - s0, out.queries.len() - q0))
@@ -378,7 +716,7 @@ pub(crate) fn redraw(
                     });
                 out.segments
                     .extend_from_slice(&drawn.segments[entry.segs + segs..s_end]);
-                let shift = r.new as isize - r.old as isize;
+                let shift = (new.base + r.new) as isize - (old.base + r.old) as isize;
                 out.queries.extend(
                     drawn.queries[entry.queries + queries..q_end]
                         .iter()
@@ -386,7 +724,8 @@ pub(crate) fn redraw(
                 );
                 if let Some(m) = exit {
                     st.state = m.before.state;
-                    st.stack.clone_from(&m.before.stack);
+                    st.stack.clear();
+                    st.stack.extend_from_slice(&m.before.stack);
                 }
             }
             (Some((skip, _, _)), _) => {
@@ -401,7 +740,7 @@ pub(crate) fn redraw(
                     &mut out,
                     &new.syms[from..r.new + r.len],
                     &new.params[pfrom..r.pnew + r.plen],
-                    from,
+                    new.base + from,
                     None,
                 );
             }
@@ -414,6 +753,7 @@ pub(crate) fn redraw(
     let mut spare = std::mem::take(&mut last.drawn.segments);
     spare.clear();
     Sketch {
+        end: marks.as_ref().map(|_| snap(&st, &out, &mut None)),
         drawn: out,
         marks,
         spare,
@@ -421,12 +761,12 @@ pub(crate) fn redraw(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::derive::{self, Limits};
     use crate::turtle::State;
 
-    fn program(text: &str) -> Program {
+    pub(crate) fn program(text: &str) -> Program {
         let fe = crate::frontend::run(text, vec![], &[]);
         assert!(!fe.has_errors(), "{:?}", fe.diagnostics);
         let checked = fe.checked.as_ref().expect("checked");
@@ -434,9 +774,9 @@ mod tests {
     }
 
     /// Segments and queries (module, kind, position), bit for bit.
-    type Bits = (Vec<[u64; 4]>, Vec<(usize, u8, [u64; 3])>);
+    pub(crate) type Bits = (Vec<[u64; 4]>, Vec<(usize, u8, [u64; 3])>);
 
-    fn bits(p: &Probe) -> Bits {
+    pub(crate) fn bits(p: &Probe) -> Bits {
         (
             p.segments
                 .iter()
@@ -449,37 +789,46 @@ mod tests {
         )
     }
 
+    /// Test programs: tips that grow and stop inside branches, polygons,
+    /// stochastic rules and a query, branches that end with turns and widths
+    /// kept on the stack.
+    pub(crate) const PROGRAMS: [&str; 4] = [
+        // Tips that grow inside branches, turn by their parameter, and stop
+        // at random: most of the string stays.
+        "lsystem A { derive 40; axiom [X(0)][+(90) X(1)] F X(2); \
+         X(k) : k < 30 -> F(1) +(k * 3) [-(45) Y(k)] F(2) X(k + 1); \
+         X(k) -> ; Y(k) : k % 3 == 0 -> F(1) Y(k + 1); Y(k) -> F(0.5); }",
+        // Polygons opened before a tip and closed after it; a tip inside a
+        // polygon; branches inside the polygon.
+        "lsystem B { derive 9; axiom A {. f(1) . [B] . B . } C; \
+         A -> F(1) [+(30) A] A; B -> f(1) . +(10) B; C -> F(1) [-(5) C] C; }",
+        // Stochastic rules and a queried tip (?P).
+        "lsystem C { derive 30; axiom ?P X; \
+         ?P(x, y, _) -> F(1) ?P; \
+         X -> (1) F(1) [+(20) X] X; X -> (1) F(1) [-(20) X]; X -> (2) F(1) X; }",
+        // Branches that end, turns and widths kept on the stack.
+        "lsystem D { derive 30; axiom X(0); \
+         X(k) : k < 25 -> F(1) [+(40) !(2) Y(3)] -(3) X(k + 1); X(k) -> F(2); \
+         Y(n) : n > 0 -> F(1) -(10) Y(n - 1); Y(n) -> ; }",
+    ];
+
     /// Derives each program step by step; every step's redraw must equal a
     /// whole drawing of the string (segments bit for bit, queries with their
     /// modules), and the redraws must have copied most of the drawing.
     #[test]
     fn a_redraw_is_the_whole_drawing() {
-        let programs = [
-            // Tips that grow inside branches, turn by their parameter, and
-            // stop at random: most of the string stays.
-            "lsystem A { derive 40; axiom [X(0)][+(90) X(1)] F X(2); \
-             X(k) : k < 30 -> F(1) +(k * 3) [-(45) Y(k)] F(2) X(k + 1); \
-             X(k) -> ; Y(k) : k % 3 == 0 -> F(1) Y(k + 1); Y(k) -> F(0.5); }",
-            // Polygons opened before a tip and closed after it; a tip inside a
-            // polygon; branches inside the polygon.
-            "lsystem B { derive 9; axiom A {. f(1) . [B] . B . } C; \
-             A -> F(1) [+(30) A] A; B -> f(1) . +(10) B; C -> F(1) [-(5) C] C; }",
-            // Stochastic rules and a queried tip (?P).
-            "lsystem C { derive 30; axiom ?P X; \
-             ?P(x, y, _) -> F(1) ?P; \
-             X -> (1) F(1) [+(20) X] X; X -> (1) F(1) [-(20) X]; X -> (2) F(1) X; }",
-        ];
         let mut copied = 0;
-        for text in programs {
+        for text in PROGRAMS {
             let prog = program(text);
             let start = State::default();
             let mut s = derive::axiom(&prog, &[], 7).expect("axiom");
-            let mut sketch = draw(&prog, &s, start);
+            let mut sketch = draw(&prog, Span::tail(&s, 0, 0), start, None);
             for step in 1..=prog.derive {
                 let next = derive::step(&prog, &s, step, 7, Limits::default()).expect("step");
-                let whole = draw(&prog, &next, start);
+                let whole = draw(&prog, Span::tail(&next, 0, 0), start, None);
                 let before = sketch.drawn.segments.len();
-                sketch = redraw(&prog, &s, sketch, &next, start);
+                let (old, new) = (Span::tail(&s, 0, 0), Span::tail(&next, 0, 0));
+                sketch = redraw(&prog, old, sketch, new, start, None);
                 assert_eq!(
                     bits(&sketch.drawn),
                     bits(&whole.drawn),

@@ -63,9 +63,12 @@ fn segment_index_is_the_environments() {
     let segs: Vec<(DVec2, DVec2)> = pts.chunks(2).map(|c| (c[0], c[1])).collect();
     let grid = SegmentGrid::new(segs.clone());
     let env = lsyc::env::index::Grid::new(segs);
+    let id = |k: u64| k;
     for q in points(20, 6) {
-        assert_eq!(grid.nearest(q), env.nearest(q));
-        assert_eq!(grid.ray(q, DVec2::X, 1e9), env.ray(q, DVec2::X, 1e9));
+        let near = env.nearest(q, &id).map(|(d, c, i)| (d, c, i as usize));
+        assert_eq!(grid.nearest(q), near);
+        let ray = env.ray(q, DVec2::X, 1e9, &id).map(|(t, i)| (t, i as usize));
+        assert_eq!(grid.ray(q, DVec2::X, 1e9), ray);
     }
 }
 
