@@ -12,6 +12,13 @@
 
 use crate::geometry::{closest_on_segment, crossing, ray_hit};
 use glam::DVec2;
+use std::cell::RefCell;
+
+thread_local! {
+    /// Cells and candidates of a search, reused from search to search (a
+    /// query asks several grids many times a step).
+    static SCRATCH: RefCell<(Vec<u32>, Vec<u32>)> = const { RefCell::new((Vec::new(), Vec::new())) };
+}
 
 /// The grid never has more than this many cells along an axis.
 pub const MAX_CELLS_PER_AXIS: usize = 2048;
@@ -311,18 +318,20 @@ impl SegmentGrid {
                 .filter_map(|&i| hit(i as usize))
                 .fold(None, nearer);
         }
-        let mut cells = Vec::new();
-        self.walk(p, q, &mut cells);
-        let mut cands: Vec<u32> = cells
-            .iter()
-            .flat_map(|&c| self.cell_items(c).iter().copied())
-            .collect();
-        cands.sort_unstable();
-        cands.dedup();
-        cands
-            .into_iter()
-            .filter_map(|i| hit(i as usize))
-            .fold(None, nearer)
+        SCRATCH.with_borrow_mut(|(cells, cands)| {
+            cells.clear();
+            self.walk(p, q, cells);
+            cands.clear();
+            for &c in cells.iter() {
+                cands.extend_from_slice(self.cell_items(c));
+            }
+            cands.sort_unstable();
+            cands.dedup();
+            cands
+                .iter()
+                .filter_map(|&i| hit(i as usize))
+                .fold(None, nearer)
+        })
     }
 
     /// The closest segment to `p` not touching it: (distance, closest point,
@@ -443,9 +452,24 @@ impl SegmentGrid {
         } else {
             (f64::INFINITY, 1)
         };
+        SCRATCH.with_borrow_mut(|(cells, cands)| {
+            self.ray_pieces(p, dir, limit, (enter, exit), (stride, pieces), cells, cands)
+        })
+    }
+
+    /// The ray's search, piece by piece along it (see `ray`).
+    #[allow(clippy::too_many_arguments)]
+    fn ray_pieces(
+        &self,
+        p: DVec2,
+        dir: DVec2,
+        limit: f64,
+        (enter, exit): (f64, f64),
+        (stride, pieces): (f64, usize),
+        cells: &mut Vec<u32>,
+        cands: &mut Vec<u32>,
+    ) -> Option<(f64, usize)> {
         let mut best: Option<(f64, usize)> = None;
-        let mut cells = Vec::new();
-        let mut cands: Vec<u32> = Vec::new();
         for k in 0..pieces {
             let t0 = enter + k as f64 * stride;
             if t0 > limit || t0 > exit {
@@ -455,16 +479,16 @@ impl SegmentGrid {
             cells.clear();
             if pieces == 1 {
                 cells.extend(0..(self.nx * self.ny) as u32);
-            } else if !self.boxed(p + dir * t0, p + dir * t1, &mut cells) {
+            } else if !self.boxed(p + dir * t0, p + dir * t1, cells) {
                 break;
             }
             cands.clear();
-            for &c in &cells {
+            for &c in cells.iter() {
                 cands.extend_from_slice(self.cell_items(c));
             }
             cands.sort_unstable();
             cands.dedup();
-            for &i in &cands {
+            for &i in cands.iter() {
                 let i = i as usize;
                 let s = &self.segs[i];
                 if touches(s, p) {
