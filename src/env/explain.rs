@@ -17,6 +17,7 @@ use crate::diagnostic::{Code, Diagnostic};
 use crate::geometry::{closest_on_segment, inside};
 use crate::turtle::{self, Discard, Sink};
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::fmt::Write;
 
@@ -409,39 +410,46 @@ fn comes_back(scene: &Scene, out: &Outcome, cfg: Config, diags: &mut Vec<Diagnos
         Outside,
         Left,
     }
+    // Where each system's growth comes back in, and how many of its segments
+    // lie outside (systems in parallel; the first system of a guide that
+    // comes back is told).
+    let found: Vec<Option<(DVec2, usize)>> = out
+        .instances
+        .par_iter()
+        .map(|inst| {
+            let poly = &scene.guides[inst.guide].polygon;
+            let mut t = Trace::default();
+            let prog = program(scene, inst);
+            turtle::interpret_limited(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut t)
+                .ok()?;
+            let key = |p: DVec2| (p.x.to_bits(), p.y.to_bits());
+            let mut at: HashMap<(u64, u64), Path> = HashMap::new();
+            let mut back: Option<DVec2> = None;
+            let mut outside = 0;
+            for (p, q) in &t.segs {
+                let ins = inside((*p + *q) * 0.5, poly);
+                outside += usize::from(!ins);
+                let before = at.get(&key(*p)).copied();
+                let now = match (ins, before) {
+                    (true, Some(Path::Left)) => {
+                        back.get_or_insert(*p);
+                        Path::Inside
+                    }
+                    (true, _) => Path::Inside,
+                    (false, Some(Path::Inside | Path::Left)) => Path::Left,
+                    (false, _) => Path::Outside,
+                };
+                at.insert(key(*q), now);
+            }
+            back.map(|p| (p, outside))
+        })
+        .collect();
     let mut told = vec![false; scene.guides.len()];
-    for inst in &out.instances {
+    for (inst, found) in out.instances.iter().zip(found) {
         if told[inst.guide] {
             continue;
         }
-        let poly = &scene.guides[inst.guide].polygon;
-        let mut t = Trace::default();
-        let prog = program(scene, inst);
-        if turtle::interpret_limited(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut t)
-            .is_err()
-        {
-            continue;
-        }
-        let key = |p: DVec2| (p.x.to_bits(), p.y.to_bits());
-        let mut at: HashMap<(u64, u64), Path> = HashMap::new();
-        let mut back: Option<DVec2> = None;
-        let mut outside = 0;
-        for (p, q) in &t.segs {
-            let ins = inside((*p + *q) * 0.5, poly);
-            outside += usize::from(!ins);
-            let before = at.get(&key(*p)).copied();
-            let now = match (ins, before) {
-                (true, Some(Path::Left)) => {
-                    back.get_or_insert(*p);
-                    Path::Inside
-                }
-                (true, _) => Path::Inside,
-                (false, Some(Path::Inside | Path::Left)) => Path::Left,
-                (false, _) => Path::Outside,
-            };
-            at.insert(key(*q), now);
-        }
-        if let Some(p) = back {
+        if let Some((p, outside)) = found {
             told[inst.guide] = true;
             let guide = &scene.guides[inst.guide];
             diags.push(

@@ -6,11 +6,15 @@
 //! - `scene` — the scene model (`Scene`, `Guide`, `Seed`, `Link`), building it
 //!   from a checked file (`build`, `SceneError`) and a seed's turtle
 //!   (`seed_state`);
-//! - `index` — the layers of segments drawn in a guide (`Grid`, `Layers`);
+//! - `index` — the segments drawn in a guide and their ids (`Grid`, `Layers`,
+//!   `key`);
 //! - `query` — the answers to query modules (`Probe`, `Answer`, `query`,
 //!   `collide`);
 //! - `redraw` — a system's drawing for its queries and index, drawn again
-//!   after a step by reusing what did not change (`Sketch`, `draw`, `redraw`);
+//!   after a step by reusing what did not change, and cut where what comes
+//!   before can no longer change it (`Sketch`, `draw`, `redraw`, `cut`);
+//! - `grown` — a running system's string and drawing in pieces kept for good
+//!   and live pieces, so that a step works on the live pieces only (`Grown`);
 //! - `clip` — the centre rule (`Clip`, `element_centres`, `outline_centre`);
 //! - `explain` — what each guide did in a run and the warnings a run
 //!   deserves (`explain`, `warnings`);
@@ -19,8 +23,9 @@
 //!   incremental reruns (`execute`, `Runner`), and the entry `run`.
 //!
 //! Who may call whom (a DAG; an arrow reads "imports"): `explain` → `engine`,
-//! `scene`, `clip`; `engine` → `query`, `redraw`, `scene`, `index`; `redraw` → `query`; `query` → `scene`, `index`. `scene`, `index` and `clip`
-//! import nothing from `env`. Plane geometry comes from `crate::geometry`.
+//! `scene`, `clip`; `engine` → `grown`, `query`, `redraw`, `scene`, `index`;
+//! `grown` → `redraw`; `redraw` → `query`; `query` → `scene`, `index`.
+//! `scene`, `index` and `clip` import nothing from `env`. Plane geometry comes from `crate::geometry`.
 //!
 //! Must not parse or print programs.
 
