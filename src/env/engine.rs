@@ -735,9 +735,9 @@ fn reindex(scene: &Scene, live: &mut [Live]) {
         for p in l.grown.iter().flat_map(|g| &g.pieces) {
             match p {
                 Piece::Kept(k) => {
-                    for x in &k.parts {
-                        l.offsets[x.id] = off;
-                        off += x.segments.len();
+                    for &(id, n) in &k.ids {
+                        l.offsets[id as usize] = off;
+                        off += n as usize;
                     }
                 }
                 Piece::Live(x) => {
@@ -749,6 +749,9 @@ fn reindex(scene: &Scene, live: &mut [Live]) {
         let (mut segs, mut keys) = (Vec::new(), Vec::new());
         for p in l.grown.iter_mut().flat_map(|g| &mut g.pieces) {
             let Piece::Kept(k) = p else { continue };
+            if !std::mem::replace(&mut k.pending, false) {
+                continue;
+            }
             for x in k.parts.iter_mut().filter(|x| !x.indexed) {
                 keys.extend((0..x.segments.len()).map(|i| key(x.id, i)));
                 segs.extend_from_slice(&x.segments);

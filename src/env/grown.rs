@@ -31,6 +31,11 @@ pub(crate) enum Piece {
 /// the pieces of a string stay about twice its live pieces).
 pub(crate) struct Kept {
     pub(crate) parts: Vec<KeptPart>,
+    /// Each part's number and segment count, in order (what numbering the
+    /// segments at each step reads).
+    pub(crate) ids: Vec<(u32, u32)>,
+    /// Some part is not in the guide's index yet.
+    pub(crate) pending: bool,
     modules: usize,
     params: usize,
 }
@@ -302,6 +307,8 @@ impl Grown {
                         } => Piece::Kept(Kept {
                             modules: modules.len(),
                             params: params.len(),
+                            ids: vec![(id as u32, segments.len() as u32)],
+                            pending: true,
                             parts: vec![KeptPart {
                                 id,
                                 string: slice(&string, modules, params),
@@ -361,6 +368,8 @@ fn push(out: &mut Vec<Piece>, p: Piece) {
             a.modules += b.modules;
             a.params += b.params;
             a.parts.extend(b.parts);
+            a.ids.extend(b.ids);
+            a.pending |= b.pending;
         }
         (_, p) => out.push(p),
     }
