@@ -246,20 +246,9 @@ pub(crate) fn cut(
             *f = Some(i);
         }
     }
-    // A run to keep: modules `a..b`; at `a` its parameters, segments and
-    // queries drawn before it.
-    struct Run<'a> {
-        a: usize,
-        pa: usize,
-        sa: usize,
-        qa: usize,
-        /// The turtle at `a` when it is not a mark's (for a live piece
-        /// ending there).
-        snap_a: Option<Snap>,
-        b: usize,
-        at_b: &'a Snap,
-    }
-    // A run to keep, with everything of `d` it needs.
+    // A run to keep: modules `a..b`; at `a` and `b` its parameters and the
+    // segments and queries drawn before, the turtle at `a` when it is not a
+    // mark's (for a live piece ending there) and the turtle after it.
     struct Kept {
         a: usize,
         pa: usize,
@@ -272,7 +261,7 @@ pub(crate) fn cut(
         qb: usize,
         exit: (State, Vec<State>),
     }
-    let mut runs: Vec<Run> = Vec::new();
+    let mut runs: Vec<Kept> = Vec::new();
     for k in 0..=marks.len() {
         let (b, at_b) = match marks.get(k) {
             Some(m) => (m.start, &m.before),
@@ -329,40 +318,27 @@ pub(crate) fn cut(
         };
         let open = snap_a.as_ref().is_some_and(|x| x.polygon);
         if !open && at_b.queries == qa {
-            runs.push(Run {
+            runs.push(Kept {
                 a,
                 pa,
                 sa,
                 qa,
                 snap_a,
                 b,
-                at_b,
+                pb: pa
+                    + s.syms[a..b]
+                        .iter()
+                        .map(|&x| prog.symbols.arity(x))
+                        .sum::<usize>(),
+                sb: at_b.segs,
+                qb: at_b.queries,
+                exit: (at_b.state, at_b.stack.to_vec()),
             });
         }
     }
     if runs.is_empty() {
         return None;
     }
-    // What the kept runs need of `d`, taken before `d` is taken apart.
-    let runs: Vec<Kept> = runs
-        .into_iter()
-        .map(|r| Kept {
-            a: r.a,
-            pa: r.pa,
-            sa: r.sa,
-            qa: r.qa,
-            snap_a: r.snap_a,
-            b: r.b,
-            pb: r.pa
-                + s.syms[r.a..r.b]
-                    .iter()
-                    .map(|&x| prog.symbols.arity(x))
-                    .sum::<usize>(),
-            sb: r.at_b.segs,
-            qb: r.at_b.queries,
-            exit: (r.at_b.state, r.at_b.stack.to_vec()),
-        })
-        .collect();
     let Some(Sketch {
         drawn, marks, end, ..
     }) = slot.take()
