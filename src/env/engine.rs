@@ -31,7 +31,7 @@
 //! when none of its systems derives and no message is still to come.
 
 use super::grown::{Grown, Piece};
-use super::index::{Grid, Layers, key};
+use super::index::{Grid, Layers, id, key};
 use super::query::{Answer, Probe, collide, edge_meet, inward, query};
 use super::redraw::Sketch;
 use super::scene::{Link, Scene, seed_state};
@@ -692,7 +692,7 @@ fn interpret(scene: &Scene, cfg: Config, live: &mut [Live]) -> Result<(), Diagno
             // asks none of them needs only the turtle at its query modules,
             // and its guide's index stays empty.
             let reads = reads_drawing(prog);
-            if Grown::splits(prog, reads) || (reads && super::redraw::redrawable(prog)) {
+            if reads && super::redraw::redrawable(prog) {
                 grown.draw(prog, inst.start);
                 return Ok(());
             }
@@ -759,10 +759,10 @@ fn reindex(scene: &Scene, live: &mut [Live]) {
             }
         }
         let offsets = &l.offsets;
-        let rank =
-            |k: u64| (offsets[(k >> 32) as usize] + (k & u64::from(u32::MAX)) as usize) as u64;
         l.index
-            .push(std::mem::take(&mut segs), std::mem::take(&mut keys), &rank);
+            .push(std::mem::take(&mut segs), std::mem::take(&mut keys), &|k| {
+                id(offsets, k)
+            });
 
         for p in l.grown.iter().flat_map(|g| &g.pieces) {
             if let Piece::Live(x) = p

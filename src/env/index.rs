@@ -28,10 +28,15 @@ pub struct Layers<'a> {
     pub offsets: &'a [usize],
 }
 
+/// The id of the segment with key `key`, given each piece's first id.
+pub fn id(offsets: &[usize], key: u64) -> u64 {
+    (offsets[(key >> 32) as usize] + (key & u64::from(u32::MAX)) as usize) as u64
+}
+
 impl Layers<'_> {
     /// The id of the segment with key `key`.
     pub fn id(&self, key: u64) -> u64 {
-        (self.offsets[(key >> 32) as usize] + (key & u64::from(u32::MAX)) as usize) as u64
+        id(self.offsets, key)
     }
 
     /// `Grid::first_crossing`: the nearest along `p`–`q`, then the lowest id.
@@ -114,7 +119,7 @@ mod tests {
             };
             let kept: Vec<usize> = (0..segs.len()).filter(|i| i % 3 != 1).collect();
             let offsets = [0, a, b];
-            let number = |k: u64| (offsets[(k >> 32) as usize] + (k & 0xffff_ffff) as usize) as u64;
+            let number = |k: u64| super::id(&offsets, k);
             split.push(
                 kept.iter().map(|&i| segs[i]).collect(),
                 kept.iter().flat_map(|&i| keyed(i..i + 1)).collect(),
