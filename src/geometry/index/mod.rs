@@ -1,8 +1,9 @@
 //! The spatial indexes, one module: uniform grids over points (`PointGrid`:
 //! the k nearest, those within a distance) and over segments (`SegmentGrid`:
 //! first crossing, nearest segment, first ray hit) and over the segments of a
-//! drawing that grows step by step (`GrowingGrid`: the same searches, only
-//! what was inserted since the last step indexed anew).
+//! drawing that grows step by step (`GrowingGrid`: the same searches over
+//! segments added in batches and kept, plus a live batch replaced at will,
+//! numbered by the caller).
 //!
 //! Owns: every spatial search of the crate. Each search returns exactly what a
 //! scan of all items would, ties broken by the lower index, so an index changes
