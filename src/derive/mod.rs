@@ -430,7 +430,6 @@ pub struct Place {
 /// program `piecewise` serves: the pieces' results, in order, are `step`'s
 /// result. An error here may name the piece's places, not the string's: step
 /// the whole string for the message.
-#[allow(clippy::too_many_arguments)]
 pub fn step_piece(
     prog: &Program,
     plan: &Plan,
@@ -443,48 +442,7 @@ pub fn step_piece(
     if limits.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
         return Err(DeriveError::Cancelled { step: step_no });
     }
-    if s.len() > CHUNK {
-        return parametric_step(prog, plan, s, at, step_no, seed, limits);
-    }
-    // One chunk, on this thread.
-    let mut n = count(&plan.table, &s.syms);
-    let view = View {
-        prog,
-        s,
-        offsets: Vec::new(),
-        growth: Vec::new(),
-    };
-    let choices = if n.choose {
-        choose_chunk(&view, plan, at.origin, &s.syms, 0, step_no, seed, &mut n)
-            .map_err(|_| first_error(&view, step_no, seed))?
-    } else {
-        Vec::new()
-    };
-    check_limits(
-        step_no,
-        n.mods.saturating_add(at.other_modules),
-        n.params.saturating_add(at.other_params),
-        limits,
-        false,
-    )?;
-    let mut syms = vec![0 as Sym; n.mods];
-    let mut params = vec![0.0; n.params];
-    let ok = fill_chunk(
-        &view,
-        plan,
-        at.origin,
-        &s.syms,
-        0,
-        &choices,
-        step_no,
-        seed,
-        &mut syms,
-        &mut params,
-    );
-    if !ok {
-        return Err(first_error(&view, step_no, seed));
-    }
-    Ok(ModString { syms, params })
+    parametric_step(prog, plan, s, at, step_no, seed, limits)
 }
 
 /// What a chunk of modules holds and makes, by the plan's table.
@@ -789,9 +747,8 @@ struct Counts {
 /// decide, and recording the choice); the limits are checked on the exact
 /// totals; then every chunk writes its share of the output directly. On an
 /// expression error the step is rewritten again in module order, so the error
-/// reported is the first in the string on any thread count.
-/// Rewrites the modules of `s`, a piece of a string at `at` (the whole
-/// string: `Place::default()`).
+/// reported is the first in the string on any thread count. `s` may be a
+/// piece of a string at `at` (the whole string: `Place::default()`).
 fn parametric_step(
     prog: &Program,
     plan: &Plan,
