@@ -15,7 +15,7 @@
 //! Owns: the pieces, their places, deriving and drawing them, and cutting
 //! them. Must not answer queries or index segments (that is `engine`).
 
-use super::redraw::{self, Cut, Sketch, Span};
+use super::redraw::{self, Cut, Sketch};
 use crate::compile::Program;
 use crate::derive::{self, DeriveError, Limits, ModString, Place, Plan};
 use crate::turtle::State;
@@ -254,9 +254,9 @@ impl Grown {
                 continue;
             }
             let at = l.entry.as_ref().map(|(a, b)| (a, &b[..]));
-            let new = Span::tail(&l.string, 0, 0);
+            let new = &l.string;
             l.drawing = Some(match l.prev.take() {
-                Some((old, d)) => redraw::redraw(prog, Span::tail(&old, 0, 0), d, new, start, at),
+                Some((old, d)) => redraw::redraw(prog, &old, d, new, start, at),
                 None => redraw::draw(prog, new, start, at),
             });
             l.uncut = true;
@@ -275,7 +275,7 @@ impl Grown {
             }
             l.uncut = false;
             let at = l.entry.as_ref().map(|(a, b)| (a, &b[..]));
-            let span = Span::tail(&l.string, 0, 0);
+            let span = &l.string;
             if let Some(c) = redraw::cut(prog, span, &mut l.drawing, start, at) {
                 cuts.push((i, c, std::mem::take(&mut l.string)));
             }
@@ -432,7 +432,7 @@ mod tests {
                     .expect("pieces");
                 assert_eq!(grown.string(), s, "{text} step {step}");
                 grown.draw(&prog, start);
-                let whole = redraw::draw(&prog, Span::tail(&s, 0, 0), start, None);
+                let whole = redraw::draw(&prog, &s, start, None);
                 let mut queries = Vec::new();
                 for (i, origin, _) in grown.live() {
                     let d = grown.drawing(i).expect("drawn");

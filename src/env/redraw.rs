@@ -17,8 +17,8 @@
 //! means that less is copied. Programs with interpretation rules or `cut` are
 //! drawn whole.
 //!
-//! A string can be drawn from a place on (`Span`, from the turtle that place
-//! was reached with: `Resume`): the engine keeps the start of a system's
+//! A string can be drawn from a turtle other than the system's start (the
+//! state and stack a piece of a longer string starts with: `Resume`): the engine keeps the start of a system's
 //! string that holds no active module, and its segments, for good
 //! (`Sketch::split_front`), and draws only what follows.
 //!
@@ -32,32 +32,8 @@ use crate::turtle::{State, Stepper};
 use glam::DVec2;
 use std::sync::Arc;
 
-/// Modules of a string from some place on, with their parameters.
-#[derive(Clone, Copy)]
-pub(crate) struct Span<'a> {
-    pub(crate) syms: &'a [Sym],
-    pub(crate) params: &'a [f64],
-    /// The place of `syms[0]` in the whole string.
-    pub(crate) base: usize,
-}
-
-impl<'a> Span<'a> {
-    /// Modules `from..` of `s` (their parameters from `pfrom`).
-    pub(crate) fn tail(s: &'a ModString, from: usize, pfrom: usize) -> Span<'a> {
-        Span {
-            syms: &s.syms[from..],
-            params: &s.params[pfrom..],
-            base: from,
-        }
-    }
-
-    fn len(&self) -> usize {
-        self.syms.len()
-    }
-}
-
-/// The turtle where a span starts: `None` at the start of the string (the
-/// system's start state), or the state and stack it was reached with.
+/// The turtle where a string starts: `None` for the system's start state, or
+/// the state and stack a piece of a longer string starts with.
 pub(crate) type Resume<'a> = Option<(&'a State, &'a [State])>;
 
 fn stepper<'p>(prog: &'p Program, start: State, at: Resume) -> Stepper<'p> {
@@ -200,7 +176,7 @@ fn shared(a: &[State], b: &[State]) -> usize {
 /// starting from a fixed turtle.
 pub(crate) fn cut(
     prog: &Program,
-    s: Span,
+    s: &ModString,
     slot: &mut Option<Sketch>,
     start: State,
     at: Resume,
@@ -307,7 +283,7 @@ pub(crate) fn cut(
                     &mut scratch,
                     &s.syms[prev.end..a],
                     &s.params[prev.pend..pa],
-                    s.base + prev.end,
+                    prev.end,
                     None,
                 );
                 let mut snap_a = snap(&st, &scratch, &mut None);
@@ -432,7 +408,7 @@ pub(crate) fn cut(
 /// Draws a span whole, from the turtle `start` (or where it was reached:
 /// `at`), as `turtle::interpret_from` does (segments, elements' axes,
 /// queries), with marks when the program has no interpretation rules.
-pub(crate) fn draw(prog: &Program, s: Span, start: State, at: Resume) -> Sketch {
+pub(crate) fn draw(prog: &Program, s: &ModString, start: State, at: Resume) -> Sketch {
     let mut st = stepper(prog, start, at);
     let mut out = Probe::default();
     let mut marks = Vec::new();
@@ -481,7 +457,7 @@ fn fresh(
     st: &mut Stepper,
     out: &mut Probe,
     marks: &mut Vec<Mark>,
-    s: Span,
+    s: &ModString,
     from: usize,
     to: usize,
     mut p: usize,
@@ -503,7 +479,7 @@ fn fresh(
         let q = params(i, j, p);
         if is_active {
             let before = snap(st, out, &mut share);
-            st.run(out, &s.syms[i..j], &s.params[p..q], s.base + i, None);
+            st.run(out, &s.syms[i..j], &s.params[p..q], i, None);
             marks.push(Mark {
                 start: i,
                 end: j,
@@ -513,7 +489,7 @@ fn fresh(
                 after: snap(st, out, &mut share),
             });
         } else {
-            st.run(out, &s.syms[i..j], &s.params[p..q], s.base + i, None);
+            st.run(out, &s.syms[i..j], &s.params[p..q], i, None);
         }
         i = j;
         p = q;
@@ -533,7 +509,15 @@ struct Run {
     pnew: usize,
 }
 
-fn equal_at(a: Span, ai: usize, pa: usize, b: Span, bi: usize, pb: usize, r: Run) -> bool {
+fn equal_at(
+    a: &ModString,
+    ai: usize,
+    pa: usize,
+    b: &ModString,
+    bi: usize,
+    pb: usize,
+    r: Run,
+) -> bool {
     a.syms[ai..ai + r.len] == b.syms[bi..bi + r.len]
         && a.params[pa..pa + r.plen]
             .iter()
@@ -544,7 +528,7 @@ fn equal_at(a: Span, ai: usize, pa: usize, b: Span, bi: usize, pb: usize, r: Run
 /// Places the inactive runs of `old` (between its marks) in `new`: the first
 /// at the start, the last at the end, the others each at its first place
 /// after the one before. `None` when they do not all fit.
-fn align(prog: &Program, old: Span, marks: &[Mark], new: Span) -> Option<Vec<Run>> {
+fn align(prog: &Program, old: &ModString, marks: &[Mark], new: &ModString) -> Option<Vec<Run>> {
     let mut runs = Vec::with_capacity(marks.len() + 1);
     let (mut o, mut po) = (0, 0);
     for m in marks {
@@ -613,9 +597,9 @@ fn align(prog: &Program, old: Span, marks: &[Mark], new: Span) -> Option<Vec<Run
 /// turtle `start` (or where the spans start: `at`); see the module note.
 pub(crate) fn redraw(
     prog: &Program,
-    old: Span,
+    old: &ModString,
     mut last: Sketch,
-    new: Span,
+    new: &ModString,
     start: State,
     at: Resume,
 ) -> Sketch {
@@ -679,7 +663,7 @@ pub(crate) fn redraw(
                 &mut out,
                 &new.syms[r.new..r.new + r.len],
                 &new.params[r.pnew..end],
-                new.base + r.new,
+                r.new,
                 below,
             );
             (done < r.len).then(|| (done, out.segments.len() - s0, out.queries.len() - q0))
@@ -692,7 +676,7 @@ pub(crate) fn redraw(
                     });
                 out.segments
                     .extend_from_slice(&drawn.segments[entry.segs + segs..s_end]);
-                let shift = (new.base + r.new) as isize - (old.base + r.old) as isize;
+                let shift = r.new as isize - r.old as isize;
                 out.queries.extend(
                     drawn.queries[entry.queries + queries..q_end]
                         .iter()
@@ -716,7 +700,7 @@ pub(crate) fn redraw(
                     &mut out,
                     &new.syms[from..r.new + r.len],
                     &new.params[pfrom..r.pnew + r.plen],
-                    new.base + from,
+                    from,
                     None,
                 );
             }
@@ -798,12 +782,12 @@ pub(crate) mod tests {
             let prog = program(text);
             let start = State::default();
             let mut s = derive::axiom(&prog, &[], 7).expect("axiom");
-            let mut sketch = draw(&prog, Span::tail(&s, 0, 0), start, None);
+            let mut sketch = draw(&prog, &s, start, None);
             for step in 1..=prog.derive {
                 let next = derive::step(&prog, &s, step, 7, Limits::default()).expect("step");
-                let whole = draw(&prog, Span::tail(&next, 0, 0), start, None);
+                let whole = draw(&prog, &next, start, None);
                 let before = sketch.drawn.segments.len();
-                let (old, new) = (Span::tail(&s, 0, 0), Span::tail(&next, 0, 0));
+                let (old, new) = (&s, &next);
                 sketch = redraw(&prog, old, sketch, new, start, None);
                 assert_eq!(
                     bits(&sketch.drawn),
