@@ -587,22 +587,72 @@ fn draw_scene(
             // Counts and bounds of what the centre rule keeps.
             let mut clip = crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut *sink);
             r.interpret(inst, seed, &mut clip)?;
-            let d = clip.kept;
-            total.segments += d.segments;
-            total.elements += d.elements;
-            total.polygons += d.polygons;
-            if let Some(b) = d.bbox {
-                let t = total.bbox.get_or_insert(b);
-                *t = [
-                    t[0].min(b[0]),
-                    t[1].min(b[1]),
-                    t[2].max(b[2]),
-                    t[3].max(b[3]),
-                ];
-            }
+            add_drawn(&mut total, clip.kept);
         }
     }
     Ok(total)
+}
+
+/// Adds the counts and box of `d` to `total`.
+fn add_drawn(total: &mut Drawn, d: Drawn) {
+    total.segments += d.segments;
+    total.elements += d.elements;
+    total.polygons += d.polygons;
+    if let Some(b) = d.bbox {
+        let t = total.bbox.get_or_insert(b);
+        *t = [
+            t[0].min(b[0]),
+            t[1].min(b[1]),
+            t[2].max(b[2]),
+            t[3].max(b[3]),
+        ];
+    }
+}
+
+/// What `draw_scene` into a `BoundsSink` gives (counts, and the bounds of
+/// the view), with the systems drawn in parallel: sums, minima and maxima
+/// do not depend on the order.
+fn scene_bounds(
+    r: &SceneRun,
+    seed: u64,
+    view: View,
+    boxes: &[Option<(glam::DVec3, glam::DVec3)>],
+) -> Result<(Drawn, Bounds), Diagnostic> {
+    use rayon::prelude::*;
+    let centres = program_centres(&r.scene);
+    let each: Vec<Result<(Drawn, Bounds), Diagnostic>> = r
+        .outcome
+        .instances
+        .par_iter()
+        .map(|inst| {
+            let g = &r.scene.guides[inst.guide];
+            let mut sink = BoundsSink {
+                view,
+                bounds: Bounds::default(),
+                element_boxes: boxes,
+            };
+            let mut clip = crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut sink);
+            r.interpret(inst, seed, &mut clip)?;
+            let kept = clip.kept;
+            Ok((kept, sink.bounds))
+        })
+        .collect();
+    let (mut total, mut bounds) = (Drawn::default(), Bounds::default());
+    // In the order `draw_scene` meets them (the first error is its).
+    for gi in 0..r.scene.guides.len() {
+        for (inst, x) in r.outcome.instances.iter().zip(&each) {
+            if inst.guide != gi {
+                continue;
+            }
+            let (d, b) = x.clone()?;
+            add_drawn(&mut total, d);
+            if b.any {
+                bounds.add(b.min);
+                bounds.add(b.max);
+            }
+        }
+    }
+    Ok((total, bounds))
 }
 
 /// The `--stats` of a scene: the contract's fields plus answered queries and messages.
@@ -660,13 +710,8 @@ pub fn write_scene(
     let elements: &[crate::compile::ElementDef] =
         r.scene.programs.first().map_or(&[], |p| &p.elements);
     let boxes: Vec<_> = r.scene.programs.first().map_or(Vec::new(), element_boxes);
-    let mut bounds_sink = BoundsSink {
-        view,
-        bounds: Bounds::default(),
-        element_boxes: &boxes,
-    };
-    let drawn = draw_scene(r, seed, &mut bounds_sink).map_err(OutputError::Diagnostic)?;
-    let mut bounds = bounds_sink.bounds;
+    let (drawn, mut bounds) =
+        scene_bounds(r, seed, view, &boxes).map_err(OutputError::Diagnostic)?;
     for g in &r.scene.guides {
         for p in &g.polygon {
             bounds.add(view.project(p.extend(0.0)));

@@ -422,13 +422,20 @@ fn comes_back(scene: &Scene, out: &Outcome, cfg: Config, diags: &mut Vec<Diagnos
             let prog = program(scene, inst);
             turtle::interpret_limited(prog, &inst.string, cfg.seed, inst.start, cfg.limits, &mut t)
                 .ok()?;
+            let ins: Vec<bool> = t
+                .segs
+                .iter()
+                .map(|(p, q)| inside((*p + *q) * 0.5, poly))
+                .collect();
+            let outside = ins.iter().filter(|&&x| !x).count();
+            if outside == 0 {
+                // Nothing left the guide: nothing came back.
+                return None;
+            }
             let key = |p: DVec2| (p.x.to_bits(), p.y.to_bits());
             let mut at: HashMap<(u64, u64), Path> = HashMap::new();
             let mut back: Option<DVec2> = None;
-            let mut outside = 0;
-            for (p, q) in &t.segs {
-                let ins = inside((*p + *q) * 0.5, poly);
-                outside += usize::from(!ins);
+            for ((p, q), &ins) in t.segs.iter().zip(&ins) {
                 let before = at.get(&key(*p)).copied();
                 let now = match (ins, before) {
                     (true, Some(Path::Left)) => {
