@@ -31,7 +31,7 @@
 //! when none of its systems derives and no message is still to come.
 
 use super::grown::{Grown, Piece};
-use super::index::{Grid, Layers, id, key};
+use super::index::{Grid, Layers, key};
 use super::query::{Answer, Probe, collide, edge_meet, inward, query};
 use super::redraw::Sketch;
 use super::scene::{Link, Scene, seed_state};
@@ -758,11 +758,8 @@ fn reindex(scene: &Scene, live: &mut [Live]) {
                 x.indexed = true;
             }
         }
-        let offsets = &l.offsets;
-        l.index
-            .push(std::mem::take(&mut segs), std::mem::take(&mut keys), &|k| {
-                id(offsets, k)
-            });
+        l.index.push(&segs, std::mem::take(&mut keys));
+        segs.clear();
 
         for p in l.grown.iter().flat_map(|g| &g.pieces) {
             if let Piece::Live(x) = p
@@ -890,10 +887,22 @@ fn answer(
     interpret(scene, cfg, live)?;
     reindex(scene, live);
     let layers = layers(live);
-    let answered: Vec<(usize, usize, Answers)> = fresh_drawings(live)
+    // Piece by piece in parallel, then system by system in order.
+    let mut answered: Vec<(usize, usize, Answers)> = fresh_drawings(live)
         .into_par_iter()
-        .map(|(li, k)| (li, k, answer_system(scene, &live[li], &layers[li], k)))
+        .map(|(li, k, pi, origin)| {
+            let a = answer_piece(scene, &live[li], &layers[li], k, pi, origin);
+            (li, k, a)
+        })
         .collect();
+    answered.dedup_by(|b, a| {
+        let same = (a.0, a.1) == (b.0, b.1);
+        if same {
+            a.2.0.append(&mut b.2.0);
+            a.2.1.append(&mut b.2.1);
+        }
+        same
+    });
     for (li, k, (answers, crossings)) in answered {
         let l = &mut live[li];
         // A system that will not draw again makes no reservation.
@@ -917,17 +926,20 @@ fn layers(live: &[Live]) -> Vec<Layers<'_>> {
         .collect()
 }
 
-/// The drawings of the fresh systems that met query modules: (guide in the
-/// unit, system in the guide, drawing).
-fn fresh_drawings(live: &[Live]) -> Vec<(usize, usize)> {
+/// The live pieces of the fresh systems that met query modules: (guide in
+/// the unit, system in the guide, piece, its first module's place in the
+/// string), in order.
+fn fresh_drawings(live: &[Live]) -> Vec<(usize, usize, usize, usize)> {
     let mut jobs = Vec::new();
     for (li, l) in live.iter().enumerate() {
         for (k, (g, &f)) in l.grown.iter().zip(&l.fresh).enumerate() {
-            let asks = |(i, _, _): (usize, usize, _)| {
-                g.drawing(i).is_some_and(|d| !d.drawn.queries.is_empty())
-            };
-            if f && g.live().any(asks) {
-                jobs.push((li, k));
+            if !f {
+                continue;
+            }
+            for (pi, origin, _) in g.live() {
+                if g.drawing(pi).is_some_and(|d| !d.drawn.queries.is_empty()) {
+                    jobs.push((li, k, pi, origin));
+                }
             }
         }
     }
@@ -939,22 +951,24 @@ fn fresh_drawings(live: &[Live]) -> Vec<(usize, usize)> {
 /// edge.
 type Answers = (Vec<(usize, usize, usize, Answer)>, Vec<Crossing>);
 
-/// Answers every query module that system `k` of guide `l` met in its
-/// drawing, in the order of its string.
-fn answer_system(scene: &Scene, l: &Live, layers: &Layers, k: usize) -> Answers {
+/// Answers every query module that live piece `pi` of system `k` of guide
+/// `l` (its first module at `origin` in the string) met in its drawing, in
+/// the order of its string.
+fn answer_piece(
+    scene: &Scene,
+    l: &Live,
+    layers: &Layers,
+    k: usize,
+    pi: usize,
+    origin: usize,
+) -> Answers {
     let gi = l.guide;
     let grown = &l.grown[k];
     let prog = &scene.programs[scene.guides[gi].program];
     let grid = Some(layers);
     let mut answers = Vec::new();
     let mut crossings = Vec::new();
-    for (pi, origin, piece) in grown.live() {
-        let Some(drawing) = grown.drawing(pi) else {
-            continue;
-        };
-        if drawing.drawn.queries.is_empty() {
-            continue;
-        }
+    if let (Some(drawing), Some(piece)) = (grown.drawing(pi), grown.live_piece(pi)) {
         let offsets = grown.param_offsets(prog, pi);
         for &(m, kind, state) in &drawing.drawn.queries {
             let q = &QUERIES[kind as usize];

@@ -20,6 +20,7 @@ use crate::compile::Program;
 use crate::derive::{self, DeriveError, Limits, ModString, Place, Plan};
 use crate::turtle::State;
 use glam::DVec2;
+use rayon::prelude::*;
 
 /// A piece of a system's string.
 pub(crate) enum Piece {
@@ -163,6 +164,14 @@ impl Grown {
         })
     }
 
+    /// Piece `i`, if live.
+    pub(crate) fn live_piece(&self, i: usize) -> Option<&LivePiece> {
+        match &self.pieces[i] {
+            Piece::Live(l) => Some(l),
+            Piece::Kept(_) => None,
+        }
+    }
+
     /// The drawing of live piece `i`, if drawn.
     pub(crate) fn drawing(&self, i: usize) -> Option<&Sketch> {
         match &self.pieces[i] {
@@ -218,8 +227,7 @@ impl Grown {
         let modules = self.len();
         let params: usize = self.pieces.iter().map(Piece::params).sum();
         let mut origin = 0;
-        let mut changed = false;
-        let mut failed = None;
+        let mut jobs: Vec<(Place, &mut LivePiece)> = Vec::new();
         for p in &mut self.pieces {
             let at = Place {
                 origin,
@@ -227,9 +235,24 @@ impl Grown {
                 other_params: params - p.params(),
             };
             origin += p.modules();
-            let Piece::Live(l) = p else { continue };
-            match derive::step_piece(prog, plan, &l.string, at, step_no, seed, limits) {
-                Ok(next) => changed |= l.replace(next),
+            if let Piece::Live(l) = p {
+                jobs.push((at, l));
+            }
+        }
+        // The pieces in parallel (a system alone in its guide is most of
+        // its guide's work); the first error in order is reported.
+        let done: Vec<Result<bool, DeriveError>> = jobs
+            .into_par_iter()
+            .map(|(at, l)| {
+                derive::step_piece(prog, plan, &l.string, at, step_no, seed, limits)
+                    .map(|next| l.replace(next))
+            })
+            .collect();
+        let mut changed = false;
+        let mut failed = None;
+        for r in done {
+            match r {
+                Ok(c) => changed |= c,
                 Err(e) => {
                     failed = Some(e);
                     break;
@@ -249,10 +272,8 @@ impl Grown {
     /// Draws every live piece not drawn, from the system's start `start`,
     /// reusing its last drawing where it can.
     pub(crate) fn draw(&mut self, prog: &Program, start: State) {
-        for l in self.live_mut() {
-            if l.drawing.is_some() {
-                continue;
-            }
+        let jobs: Vec<&mut LivePiece> = self.live_mut().filter(|l| l.drawing.is_none()).collect();
+        jobs.into_par_iter().for_each(|l| {
             let at = l.entry.as_ref().map(|(a, b)| (a, &b[..]));
             let new = &l.string;
             l.drawing = Some(match l.prev.take() {
@@ -260,26 +281,31 @@ impl Grown {
                 None => redraw::draw(prog, new, start, at),
             });
             l.uncut = true;
-        }
+        });
     }
 
     /// Cuts the live pieces drawn since they were last cut (see
     /// `redraw::cut`), numbering new pieces from `next_id` on, and merges
     /// neighbouring kept pieces.
     pub(crate) fn cut(&mut self, prog: &Program, start: State, next_id: &mut usize) {
-        let mut cuts: Vec<(usize, Vec<Cut>, ModString)> = Vec::new();
-        for (i, p) in self.pieces.iter_mut().enumerate() {
-            let Piece::Live(l) = p else { continue };
-            if !l.uncut || l.prev.is_some() {
-                continue;
-            }
-            l.uncut = false;
-            let at = l.entry.as_ref().map(|(a, b)| (a, &b[..]));
-            let span = &l.string;
-            if let Some(c) = redraw::cut(prog, span, &mut l.drawing, start, at) {
-                cuts.push((i, c, std::mem::take(&mut l.string)));
-            }
-        }
+        let jobs: Vec<(usize, &mut LivePiece)> = self
+            .pieces
+            .iter_mut()
+            .enumerate()
+            .filter_map(|(i, p)| match p {
+                Piece::Live(l) if l.uncut && l.prev.is_none() => Some((i, &mut **l)),
+                _ => None,
+            })
+            .collect();
+        let cuts: Vec<(usize, Vec<Cut>, ModString)> = jobs
+            .into_par_iter()
+            .filter_map(|(i, l)| {
+                l.uncut = false;
+                let at = l.entry.as_ref().map(|(a, b)| (a, &b[..]));
+                let c = redraw::cut(prog, &l.string, &mut l.drawing, start, at)?;
+                Some((i, c, std::mem::take(&mut l.string)))
+            })
+            .collect();
         if cuts.is_empty() {
             return;
         }

@@ -119,11 +119,10 @@ mod tests {
             };
             let kept: Vec<usize> = (0..segs.len()).filter(|i| i % 3 != 1).collect();
             let offsets = [0, a, b];
-            let number = |k: u64| super::id(&offsets, k);
+            let kept_segs: Vec<_> = kept.iter().map(|&i| segs[i]).collect();
             split.push(
-                kept.iter().map(|&i| segs[i]).collect(),
+                &kept_segs,
                 kept.iter().flat_map(|&i| keyed(i..i + 1)).collect(),
-                &number,
             );
             let live: Vec<usize> = (0..segs.len()).filter(|i| i % 3 == 1).collect();
             split.set_live(

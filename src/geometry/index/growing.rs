@@ -1,122 +1,85 @@
-//! A segment index that follows a drawing as it grows: segments are added in
-//! batches (parts) and never moved, each with a key; one more part (`live`)
+//! A segment index that follows a drawing as it grows: segments are added
+//! for good (kept) and never moved, each with a key; one more batch (`live`)
 //! is replaced whenever the caller likes (the segments still changing). The
 //! caller numbers the segments: every search takes `rank`, which turns a key
 //! into the segment's current number. Numbers may change from search to
-//! search, but not the order of two segments a part holds (a drawing that
-//! grows inserts segments, it does not move them).
+//! search (a drawing that grows inserts segments between others).
 //!
-//! Owns: the parts (a grid over each batch, in number order, with each
-//! segment's key) and when they are merged: at most [`MAX_PARTS`] kept parts
-//! (every search asks each part), and a part at least a quarter of the size
-//! of the one before it is merged into it, so that a part indexed anew stays
-//! small. Every search returns what one `SegmentGrid` over all segments in
-//! number order returns (ties to the lowest number), as a number; the parts
-//! change speed, never answers. Must not know guides or systems.
+//! Owns: the kept segments in one `AppendGrid` (adding a batch costs the
+//! batch) with their keys, and the live batch in a `SegmentGrid`. Every
+//! search returns what one `SegmentGrid` over all segments in number order
+//! returns (ties to the lowest number), as a number; the two grids change
+//! speed, never answers. Must not know guides or systems.
 
-use super::segments::SegmentGrid;
+use super::append::AppendGrid;
+use super::segments::{self, Cells, SegmentGrid};
 use glam::DVec2;
 
-/// The most grids the kept segments are in (the live part comes on top).
-pub const MAX_PARTS: usize = 6;
-
-/// A grid over some of the segments; `keys[i]` is the key of the grid's
-/// segment `i` (in number order).
-struct Part {
+/// The live batch: a grid over it, and each segment's key.
+struct Live {
     grid: SegmentGrid,
     keys: Vec<u64>,
 }
 
-impl Part {
-    fn new(segs: Vec<(DVec2, DVec2)>, keys: Vec<u64>) -> Part {
-        debug_assert_eq!(segs.len(), keys.len());
-        Part {
-            grid: SegmentGrid::new(segs),
-            keys,
-        }
-    }
-
-    /// The two parts as one, in number order.
-    fn merge(a: &Part, b: &Part, rank: &impl Fn(u64) -> u64) -> Part {
-        let n = a.keys.len() + b.keys.len();
-        let (mut segs, mut keys) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        let (sa, sb) = (a.grid.segs(), b.grid.segs());
-        let (mut i, mut j) = (0, 0);
-        while i < sa.len() || j < sb.len() {
-            if j == sb.len() || (i < sa.len() && rank(a.keys[i]) < rank(b.keys[j])) {
-                segs.push(sa[i]);
-                keys.push(a.keys[i]);
-                i += 1;
-            } else {
-                segs.push(sb[j]);
-                keys.push(b.keys[j]);
-                j += 1;
-            }
-        }
-        Part::new(segs, keys)
-    }
-}
-
-/// Segments in parts, each with a key; see the module note.
+/// Segments kept and live, each with a key; see the module note.
 #[derive(Default)]
 pub struct GrowingGrid {
-    parts: Vec<Part>,
-    live: Option<Part>,
+    kept: AppendGrid,
+    /// The key of each kept segment, in the order added.
+    keys: Vec<u64>,
+    live: Option<Live>,
+}
+
+/// The better of two answers: the smaller first value, then the lower number.
+fn better<T>(a: Option<(f64, T, u64)>, b: Option<(f64, T, u64)>) -> Option<(f64, T, u64)> {
+    match (a, b) {
+        (Some(x), Some(y)) => Some(if y.0.total_cmp(&x.0).then(y.2.cmp(&x.2)).is_lt() {
+            y
+        } else {
+            x
+        }),
+        (x, None) => x,
+        (None, y) => y,
+    }
 }
 
 impl GrowingGrid {
-    /// Indexes `segs` as one kept part, keyed by their indices.
+    /// Indexes `segs` as kept segments, keyed by their indices.
     pub fn new(segs: Vec<(DVec2, DVec2)>) -> GrowingGrid {
         let mut g = GrowingGrid::default();
         let keys = (0..segs.len() as u64).collect();
-        g.push(segs, keys, &|k| k);
+        g.push(&segs, keys);
         g
     }
 
-    /// Adds segments for good, with their keys (none already held), in
-    /// number order.
-    pub fn push(&mut self, segs: Vec<(DVec2, DVec2)>, keys: Vec<u64>, rank: &impl Fn(u64) -> u64) {
+    /// Adds segments for good, with their keys (none already held).
+    pub fn push(&mut self, segs: &[(DVec2, DVec2)], keys: Vec<u64>) {
+        debug_assert_eq!(segs.len(), keys.len());
         if segs.is_empty() {
             return;
         }
-        self.parts.push(Part::new(segs, keys));
-        // Too many parts, or a part at least a quarter of the size of the one
-        // before it: the last two become one.
-        while let [.., a, b] = &self.parts[..]
-            && (self.parts.len() > MAX_PARTS || b.keys.len() * 4 >= a.keys.len())
-        {
-            let m = Part::merge(a, b, rank);
-            self.parts.truncate(self.parts.len() - 2);
-            self.parts.push(m);
-        }
+        self.kept.extend(segs);
+        self.keys.extend(keys);
     }
 
-    /// Replaces the live part (segments that may still change) with `segs`
-    /// and their keys (none held by a kept part), in number order.
+    /// Replaces the live batch (segments that may still change) with `segs`
+    /// and their keys (none held as kept).
     pub fn set_live(&mut self, segs: Vec<(DVec2, DVec2)>, keys: Vec<u64>) {
-        self.live = (!segs.is_empty()).then(|| Part::new(segs, keys));
+        debug_assert_eq!(segs.len(), keys.len());
+        self.live = (!segs.is_empty()).then(|| Live {
+            grid: SegmentGrid::new(segs),
+            keys,
+        });
     }
 
-    /// Every part, kept then live.
-    fn all(&self) -> impl Iterator<Item = &Part> {
-        self.parts.iter().chain(self.live.as_ref())
-    }
-
-    /// How many grids hold the segments.
+    /// How many grids hold segments.
     pub fn parts(&self) -> usize {
-        self.all().count()
+        usize::from(!self.kept.is_empty()) + usize::from(self.live.is_some())
     }
 
     /// How many cells the grids have in all.
     pub fn cells(&self) -> usize {
-        self.all().map(|p| p.grid.cells()).sum()
-    }
-
-    /// The smallest distance from `p` to the box of the segments.
-    pub fn box_distance(&self, p: DVec2) -> f64 {
-        self.all()
-            .map(|x| x.grid.box_distance(p))
-            .fold(f64::INFINITY, f64::min)
+        self.kept.cells() + self.live.as_ref().map_or(0, |l| l.grid.cells())
     }
 
     /// `SegmentGrid::first_crossing` over all segments: (parameter, number).
@@ -126,33 +89,33 @@ impl GrowingGrid {
         q: DVec2,
         rank: &impl Fn(u64) -> u64,
     ) -> Option<(f64, u64)> {
-        let mut best: Option<(f64, u64)> = None;
-        for part in self.all() {
-            if let Some((t, i)) = part.grid.first_crossing(p, q) {
-                let i = rank(part.keys[i]);
-                if best.is_none_or(|b| t.total_cmp(&b.0).then(i.cmp(&b.1)).is_lt()) {
-                    best = Some((t, i));
-                }
-            }
-        }
-        best
+        let order = |i: usize| rank(self.keys[i]);
+        let kept = self
+            .kept
+            .first_crossing(p, q, &order)
+            .map(|(t, i)| (t, (), order(i)));
+        let live = self.live.as_ref().and_then(|l| {
+            let order = |i: usize| rank(l.keys[i]);
+            segments::first_crossing(&l.grid, p, q, &order).map(|(t, i)| (t, (), order(i)))
+        });
+        better(kept, live).map(|(t, (), i)| (t, i))
     }
 
     /// `SegmentGrid::nearest` over all segments: (distance, point, number).
     pub fn nearest(&self, p: DVec2, rank: &impl Fn(u64) -> u64) -> Option<(f64, DVec2, u64)> {
-        let mut best: Option<(f64, DVec2, u64)> = None;
-        for part in self.all() {
-            if best.is_some_and(|b| part.grid.box_distance(p) > b.0) {
-                continue;
+        let order = |i: usize| rank(self.keys[i]);
+        let kept = self
+            .kept
+            .nearest(p, &order)
+            .map(|(d, c, i)| (d, c, order(i)));
+        let live = self.live.as_ref().and_then(|l| {
+            if kept.is_some_and(|k| l.grid.box_distance(p) > k.0) {
+                return None;
             }
-            if let Some((d, c, i)) = part.grid.nearest(p) {
-                let i = rank(part.keys[i]);
-                if best.is_none_or(|b| d.total_cmp(&b.0).then(i.cmp(&b.2)).is_lt()) {
-                    best = Some((d, c, i));
-                }
-            }
-        }
-        best
+            let order = |i: usize| rank(l.keys[i]);
+            segments::nearest(&l.grid, p, &order).map(|(d, c, i)| (d, c, order(i)))
+        });
+        better(kept, live)
     }
 
     /// `SegmentGrid::ray` over all segments: (distance, number).
@@ -163,26 +126,21 @@ impl GrowingGrid {
         limit: f64,
         rank: &impl Fn(u64) -> u64,
     ) -> Option<(f64, u64)> {
-        if self.parts() < 2 {
-            return self.ray_within(p, dir, limit, rank);
-        }
-        // A part with few segments far apart would walk the ray far to its own
-        // first hit: ask every part within a short reach first, and only
-        // when nothing is hit there, twice as far (the nearest hit within a
-        // reach is the nearest of all).
-        let cell = self
-            .all()
-            .map(|x| x.grid.stride())
+        // A grid with few segments far apart would walk the ray far to its
+        // own first hit: ask both within a short reach first, and only when
+        // nothing is hit there, twice as far (the nearest hit within a reach
+        // is the nearest of all).
+        let layouts = [
+            Some(self.kept.layout()),
+            self.live.as_ref().map(|l| l.grid.layout()),
+        ];
+        let layouts = layouts.iter().flatten().filter(|l| l.cells() > 0);
+        let cell = layouts
+            .clone()
+            .map(|l| l.stride())
             .fold(f64::INFINITY, f64::min);
         // Beyond the farthest corner of every box, a longer reach finds nothing more.
-        let far = self
-            .all()
-            .filter(|x| x.grid.cells() > 0)
-            .map(|x| {
-                let (lo, hi) = x.grid.bounds();
-                (p - lo).abs().max((p - hi).abs()).length()
-            })
-            .fold(0.0, f64::max);
+        let far = layouts.map(|l| l.far_corner(p)).fold(0.0, f64::max);
         let mut reach = 4.0 * cell;
         while reach.is_finite() && reach < limit && reach < far {
             if let Some(hit) = self.ray_within(p, dir, reach, rank) {
@@ -193,7 +151,7 @@ impl GrowingGrid {
         self.ray_within(p, dir, limit, rank)
     }
 
-    /// The first hit not farther than `limit`, asking every part.
+    /// The first hit not farther than `limit`, asking both grids.
     fn ray_within(
         &self,
         p: DVec2,
@@ -201,18 +159,18 @@ impl GrowingGrid {
         limit: f64,
         rank: &impl Fn(u64) -> u64,
     ) -> Option<(f64, u64)> {
-        let mut best: Option<(f64, u64)> = None;
-        for part in self.all() {
-            // Hits at the best distance so far still count (a lower index wins).
-            let lim = best.map_or(limit, |b| b.0);
-            if let Some((t, i)) = part.grid.ray(p, dir, lim) {
-                let i = rank(part.keys[i]);
-                if best.is_none_or(|b| t.total_cmp(&b.0).then(i.cmp(&b.1)).is_lt()) {
-                    best = Some((t, i));
-                }
-            }
-        }
-        best
+        let order = |i: usize| rank(self.keys[i]);
+        let kept = self
+            .kept
+            .ray(p, dir, limit, &order)
+            .map(|(t, i)| (t, (), order(i)));
+        // Hits at the kept hit's distance still count (a lower number wins).
+        let lim = kept.map_or(limit, |k| k.0);
+        let live = self.live.as_ref().and_then(|l| {
+            let order = |i: usize| rank(l.keys[i]);
+            segments::ray(&l.grid, p, dir, lim, &order).map(|(t, i)| (t, (), order(i)))
+        });
+        better(kept, live).map(|(t, (), i)| (t, i))
     }
 }
 
@@ -234,6 +192,7 @@ mod tests {
             (0..systems).map(|_| (Vec::new(), 0)).collect();
         let mut grid = GrowingGrid::default();
         let (mut found, mut most_parts) = ([0usize; 3], 0);
+        let mut placed: Vec<usize> = Vec::new();
         for step in 0..60 {
             let mut batch: Vec<(u64, (DVec2, DVec2))> = Vec::new();
             for (k, (segs, kept)) in drawn.iter_mut().enumerate() {
@@ -255,11 +214,8 @@ mod tests {
             batch.sort_by_key(|b| b.0);
             // Keys are not numbers: the numbers are the places in `all`.
             let number = |k: u64| -> u64 { (k >> 32) * 1_000_000 + (k & 0xffff_ffff) };
-            grid.push(
-                batch.iter().map(|b| b.1).collect(),
-                batch.iter().map(|b| !b.0).collect(),
-                &|k| number(!k),
-            );
+            let segs: Vec<_> = batch.iter().map(|b| b.1).collect();
+            grid.push(&segs, batch.iter().map(|b| !b.0).collect());
             let mut live: Vec<(u64, (DVec2, DVec2))> = Vec::new();
             let mut all: Vec<(u64, (DVec2, DVec2))> = Vec::new();
             for (k, (segs, kept)) in drawn.iter().enumerate() {
@@ -277,6 +233,9 @@ mod tests {
             );
             let rank = |k: u64| number(!k);
             most_parts = most_parts.max(grid.parts());
+            if placed.last() != Some(&grid.kept.cells()) {
+                placed.push(grid.kept.cells());
+            }
             let whole = SegmentGrid::new(all.iter().map(|b| b.1).collect());
             let key = |i: usize| number(all[i].0);
             for k in 0..40 {
@@ -303,9 +262,11 @@ mod tests {
                 found[2] += usize::from(y.is_some());
             }
         }
-        // The searches met segments, and the kept parts were merged.
+        // The searches met segments; the kept grid chose its cells again
+        // several times as it grew (asked in between at every step).
         assert!(found.iter().all(|&f| f > 300), "{found:?}");
-        assert!((3..=MAX_PARTS + 1).contains(&most_parts), "{most_parts}");
+        assert_eq!(most_parts, 2);
+        assert!(placed.len() >= 4, "{placed:?}");
     }
 
     #[test]

@@ -10,6 +10,7 @@
 //! speed, never answers (and never depends on thread count or hash order).
 //! Must not know what the points and segments stand for.
 
+pub mod append;
 pub mod growing;
 pub mod points;
 pub mod segments;

@@ -34,9 +34,10 @@ pub fn touches(s: &(DVec2, DVec2), p: DVec2) -> bool {
     (s.0 - p).length() <= TOUCH || (s.1 - p).length() <= TOUCH
 }
 
-/// Segments in a grid of cells; see the module note.
-pub struct SegmentGrid {
-    segs: Vec<(DVec2, DVec2)>,
+/// Where a grid's cells are: the box of its segments cut into `nx` × `ny`
+/// cells (no cells when it holds no finite segment).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Layout {
     min: DVec2,
     max: DVec2,
     /// Cell sizes (0 along an axis with one cell of zero extent).
@@ -47,9 +48,6 @@ pub struct SegmentGrid {
     /// Length of the pieces a segment or ray is walked in: no longer than a
     /// cell along any axis with more than one cell.
     stride: f64,
-    /// Cell `c` holds `items[start[c]..start[c + 1]]`.
-    start: Vec<u32>,
-    items: Vec<u32>,
 }
 
 /// A margin around every walked piece, so that rounding never hides a cell.
@@ -57,45 +55,44 @@ fn margin(p: DVec2) -> f64 {
     1e-9 * (1.0 + p.x.abs().max(p.y.abs()))
 }
 
-impl SegmentGrid {
-    /// Indexes `segs` (the grid keeps them). Segments with a coordinate that
-    /// is not finite are left out (they cross nothing).
-    pub fn new(segs: Vec<(DVec2, DVec2)>) -> SegmentGrid {
-        let finite = |s: &(DVec2, DVec2)| s.0.is_finite() && s.1.is_finite();
-        let mut min = DVec2::splat(f64::INFINITY);
-        let mut max = DVec2::splat(f64::NEG_INFINITY);
-        let mut len = 0.0;
-        let mut n = 0usize;
-        for s in segs.iter().filter(|s| finite(s)) {
-            min = min.min(s.0).min(s.1);
-            max = max.max(s.0).max(s.1);
-            len += (s.1 - s.0).length();
-            n += 1;
-        }
-        let mut grid = SegmentGrid {
-            segs,
-            min,
-            max,
+/// Whether both ends of a segment are finite (others cross nothing).
+pub(crate) fn finite(s: &(DVec2, DVec2)) -> bool {
+    s.0.is_finite() && s.1.is_finite()
+}
+
+impl Layout {
+    /// No cells (nothing to find).
+    pub(crate) fn empty() -> Layout {
+        Layout {
+            min: DVec2::splat(f64::INFINITY),
+            max: DVec2::splat(f64::NEG_INFINITY),
             cell: DVec2::ZERO,
             inv: DVec2::ZERO,
             nx: 0,
             ny: 0,
             stride: f64::INFINITY,
-            start: Vec::new(),
-            items: Vec::new(),
-        };
-        if n == 0 {
-            return grid;
         }
+    }
+
+    /// One cell over the box `min`–`max`.
+    pub(crate) fn single(min: DVec2, max: DVec2) -> Layout {
+        Layout {
+            min,
+            max,
+            nx: 1,
+            ny: 1,
+            ..Layout::empty()
+        }
+    }
+
+    /// About `n` cells over the box `min`–`max`, none shorter than `mean`
+    /// (a mean segment's length), at most `MAX_CELLS_PER_AXIS` a side.
+    pub(crate) fn fit(min: DVec2, max: DVec2, n: f64, mean: f64) -> Layout {
         let size = max - min;
-        // A few segments: a scan of one cell is cheaper than sorting them into cells.
-        if n < SCAN_BELOW_SEGMENTS || !size.is_finite() {
-            return grid.single(min, max);
+        if !size.is_finite() {
+            return Layout::single(min, max);
         }
-        // About one cell per segment, and cells at least as long as a mean segment.
-        let c = (len / n as f64)
-            .max((size.x * size.y / n as f64).sqrt())
-            .max(1e-12);
+        let c = mean.max((size.x * size.y / n).sqrt()).max(1e-12);
         let count = |extent: f64| -> usize {
             if extent <= 0.0 {
                 1
@@ -116,77 +113,51 @@ impl SegmentGrid {
         if ny > 1 {
             stride = stride.min(cell.y);
         }
-        grid.min = min;
-        grid.max = max;
-        grid.cell = cell;
-        grid.inv = inv;
-        grid.nx = nx;
-        grid.ny = ny;
-        grid.stride = stride;
-        grid.fill();
-        grid
-    }
-
-    /// One cell holding every finite segment (also when the span is beyond the
-    /// range of numbers).
-    fn single(mut self, min: DVec2, max: DVec2) -> SegmentGrid {
-        self.min = min;
-        self.max = max;
-        self.nx = 1;
-        self.ny = 1;
-        self.items = (0..self.segs.len() as u32)
-            .filter(|&i| {
-                let s = &self.segs[i as usize];
-                s.0.is_finite() && s.1.is_finite()
-            })
-            .collect();
-        self.start = vec![0, self.items.len() as u32];
-        self
-    }
-
-    /// Registers every finite segment in the cells along it (counting sort:
-    /// one pass counts, one pass places).
-    fn fill(&mut self) {
-        let cells = self.nx * self.ny;
-        let mut start = vec![0u32; cells + 1];
-        let mut scratch = Vec::new();
-        self.each_cell(&mut scratch, |c, _| start[c as usize + 1] += 1);
-        for c in 0..cells {
-            start[c + 1] += start[c];
+        Layout {
+            min,
+            max,
+            cell,
+            inv,
+            nx,
+            ny,
+            stride,
         }
-        let mut at = start.clone();
-        let mut items = vec![0u32; start[cells] as usize];
-        self.each_cell(&mut scratch, |c, i| {
-            items[at[c as usize] as usize] = i;
-            at[c as usize] += 1;
-        });
-        self.start = start;
-        self.items = items;
     }
 
-    /// Calls `f(cell, segment)` for every cell of every finite segment. A
-    /// segment within one cell's stride is registered in the cells of its box
-    /// (no margin: queries widen their own boxes), a longer one piece by piece.
-    fn each_cell(&self, scratch: &mut Vec<u32>, mut f: impl FnMut(u32, u32)) {
-        for (i, s) in self.segs.iter().enumerate() {
-            if !(s.0.is_finite() && s.1.is_finite()) {
-                continue;
+    /// How many cells there are.
+    pub(crate) fn cells(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// Whether the box holds segment `s` (without a margin).
+    pub(crate) fn holds(&self, s: &(DVec2, DVec2)) -> bool {
+        let (lo, hi) = (s.0.min(s.1), s.0.max(s.1));
+        lo.x >= self.min.x && lo.y >= self.min.y && hi.x <= self.max.x && hi.y <= self.max.y
+    }
+
+    /// Calls `f(cell)` for every cell of finite segment `s`. A segment
+    /// within one cell's stride is registered in the cells of its box (no
+    /// margin: queries widen their own boxes), a longer one piece by piece.
+    pub(crate) fn each_cell(
+        &self,
+        s: &(DVec2, DVec2),
+        scratch: &mut Vec<u32>,
+        mut f: impl FnMut(u32),
+    ) {
+        let (lo, hi) = (s.0.min(s.1), s.0.max(s.1));
+        if hi.x - lo.x <= self.stride && hi.y - lo.y <= self.stride {
+            let (c0, c1) = (self.col(lo.x), self.col(hi.x));
+            let (r0, r1) = (self.row(lo.y), self.row(hi.y));
+            for r in r0..=r1 {
+                for c in c0..=c1 {
+                    f((r * self.nx + c) as u32);
+                }
             }
-            let (lo, hi) = (s.0.min(s.1), s.0.max(s.1));
-            if hi.x - lo.x <= self.stride && hi.y - lo.y <= self.stride {
-                let (c0, c1) = (self.col(lo.x), self.col(hi.x));
-                let (r0, r1) = (self.row(lo.y), self.row(hi.y));
-                for r in r0..=r1 {
-                    for c in c0..=c1 {
-                        f((r * self.nx + c) as u32, i as u32);
-                    }
-                }
-            } else {
-                scratch.clear();
-                self.walk(s.0, s.1, scratch);
-                for &c in scratch.iter() {
-                    f(c, i as u32);
-                }
+        } else {
+            scratch.clear();
+            self.walk(s.0, s.1, scratch);
+            for &c in scratch.iter() {
+                f(c);
             }
         }
     }
@@ -250,225 +221,237 @@ impl SegmentGrid {
         out.truncate(w);
     }
 
-    /// How many cells the grid has (0 when it holds no finite segment).
-    pub fn cells(&self) -> usize {
-        self.nx * self.ny
-    }
-
-    /// The side of a cell along its shortest axis of more than one cell
-    /// (infinite for one cell).
-    pub fn stride(&self) -> f64 {
+    /// The length of a cell's side along its shortest axis of more than one
+    /// cell (infinite for one cell).
+    pub(crate) fn stride(&self) -> f64 {
         self.stride
     }
 
-    /// The corners of the box of the segments (`min > max` when there are none).
-    pub fn bounds(&self) -> (DVec2, DVec2) {
-        (self.min, self.max)
+    /// The distance from `p` to the farthest corner of the box.
+    pub(crate) fn far_corner(&self, p: DVec2) -> f64 {
+        (p - self.min).abs().max((p - self.max).abs()).length()
     }
 
-    /// The indexed segments, in their order.
-    pub fn segs(&self) -> &[(DVec2, DVec2)] {
-        &self.segs
-    }
-
-    /// The smallest distance from `p` to the box of the segments.
-    pub fn box_distance(&self, p: DVec2) -> f64 {
+    /// The smallest distance from `p` to the box.
+    pub(crate) fn box_distance(&self, p: DVec2) -> f64 {
         (self.min - p).max(p - self.max).max(DVec2::ZERO).length()
     }
+}
 
-    fn cell_items(&self, c: u32) -> &[u32] {
-        let c = c as usize;
-        &self.items[self.start[c] as usize..self.start[c + 1] as usize]
+/// Segments in cells, as the searches read them. Segment `i` is ordered
+/// among equally good answers by `order(i)`, given to each search.
+pub(crate) trait Cells {
+    fn layout(&self) -> &Layout;
+    fn segs(&self) -> &[(DVec2, DVec2)];
+    /// Calls `f` with every segment in cell `c`, each once.
+    fn for_items(&self, c: u32, f: impl FnMut(u32));
+}
+
+/// The segment that `p`–`q` meets first going from `p` (crossing, touching
+/// or overlapping on one line; [`crossing`]): (parameter along `p`–`q`,
+/// index), the lowest `order` among equally near ones. Segments touching `p`
+/// (the asker's own) and segments that `p` lies on (what the turtle stands
+/// on) are skipped.
+pub(crate) fn first_crossing(
+    g: &impl Cells,
+    p: DVec2,
+    q: DVec2,
+    order: &impl Fn(usize) -> u64,
+) -> Option<(f64, usize)> {
+    let l = g.layout();
+    if l.nx == 0 || !(p.is_finite() && q.is_finite()) {
+        return None;
     }
-
-    /// The segment that `p`–`q` meets first going from `p` (crossing,
-    /// touching or overlapping on one line; [`crossing`]): (parameter along
-    /// `p`–`q`, index), the lowest index among equally near ones. Segments
-    /// touching `p` (the asker's own) and segments that `p` lies on (what the
-    /// turtle stands on) are skipped.
-    pub fn first_crossing(&self, p: DVec2, q: DVec2) -> Option<(f64, usize)> {
-        if self.nx == 0 || !(p.is_finite() && q.is_finite()) {
+    let segs = g.segs();
+    let hit = |i: usize| -> Option<(f64, usize)> {
+        let s = &segs[i];
+        if touches(s, p) {
             return None;
         }
-        let hit = |i: usize| -> Option<(f64, usize)> {
-            let s = &self.segs[i];
+        crossing(p, q, s.0, s.1)
+            .filter(|&t| t > 0.0)
+            .map(|t| (t, i))
+    };
+    let nearer = |best: Option<(f64, usize)>, x: (f64, usize)| match best {
+        Some(b)
+            if b.0
+                .total_cmp(&x.0)
+                .then_with(|| order(b.1).cmp(&order(x.1)))
+                .is_le() =>
+        {
+            Some(b)
+        }
+        _ => Some(x),
+    };
+    if l.cells() == 1 {
+        // Boxes apart: no segment is met (as `crossing` decides it first).
+        if p.x.max(q.x) < l.min.x
+            || l.max.x < p.x.min(q.x)
+            || p.y.max(q.y) < l.min.y
+            || l.max.y < p.y.min(q.y)
+        {
+            return None;
+        }
+        let mut best = None;
+        g.for_items(0, |i| {
+            if let Some(x) = hit(i as usize) {
+                best = nearer(best, x);
+            }
+        });
+        return best;
+    }
+    SCRATCH.with_borrow_mut(|(cells, cands)| {
+        cells.clear();
+        l.walk(p, q, cells);
+        cands.clear();
+        for &c in cells.iter() {
+            g.for_items(c, |i| cands.push(i));
+        }
+        cands.sort_unstable();
+        cands.dedup();
+        cands
+            .iter()
+            .filter_map(|&i| hit(i as usize))
+            .fold(None, nearer)
+    })
+}
+
+/// The closest segment to `p` not touching it: (distance, closest point,
+/// index), the lowest `order` among equally close ones.
+pub(crate) fn nearest(
+    g: &impl Cells,
+    p: DVec2,
+    order: &impl Fn(usize) -> u64,
+) -> Option<(f64, DVec2, usize)> {
+    let l = g.layout();
+    if l.nx == 0 || !p.is_finite() {
+        return None;
+    }
+    let segs = g.segs();
+    let (ci, cj) = (l.col(p.x), l.row(p.y));
+    let mut best: Option<(f64, DVec2, usize)> = None;
+    let better = |d: f64, i: usize, b: &Option<(f64, DVec2, usize)>| match b {
+        None => true,
+        Some((bd, _, bi)) => d
+            .total_cmp(bd)
+            .then_with(|| order(i).cmp(&order(*bi)))
+            .is_lt(),
+    };
+    let visit = |col: usize, row: usize, best: &mut Option<(f64, DVec2, usize)>| {
+        g.for_items((row * l.nx + col) as u32, |i| {
+            let i = i as usize;
+            let s = &segs[i];
             if touches(s, p) {
+                return;
+            }
+            let c = closest_on_segment(p, s.0, s.1);
+            let d = (c - p).length();
+            if better(d, i, best) {
+                *best = Some((d, c, i));
+            }
+        });
+    };
+    for r in 0..l.nx.max(l.ny) {
+        let (c0, c1) = (ci.saturating_sub(r), (ci + r).min(l.nx - 1));
+        let (r0, r1) = (cj.saturating_sub(r), (cj + r).min(l.ny - 1));
+        // Only the ring at distance r: the inside was searched before.
+        let top = cj + r < l.ny;
+        let bottom = r > 0 && cj >= r;
+        for col in c0..=c1 {
+            if bottom {
+                visit(col, cj - r, &mut best);
+            }
+            if top {
+                visit(col, cj + r, &mut best);
+            }
+        }
+        let inner = (
+            cj.saturating_sub(r.saturating_sub(1)),
+            (cj + r).saturating_sub(1).min(l.ny - 1),
+        );
+        if r > 0 {
+            for row in inner.0..=inner.1 {
+                if ci >= r {
+                    visit(ci - r, row, &mut best);
+                }
+                if ci + r < l.nx {
+                    visit(ci + r, row, &mut best);
+                }
+            }
+        }
+        // Whatever lies beyond the searched block is at least this far away.
+        let mut bound = f64::INFINITY;
+        if c0 > 0 {
+            bound = bound.min(p.x - (l.min.x + c0 as f64 * l.cell.x));
+        }
+        if c1 + 1 < l.nx {
+            bound = bound.min(l.min.x + (c1 + 1) as f64 * l.cell.x - p.x);
+        }
+        if r0 > 0 {
+            bound = bound.min(p.y - (l.min.y + r0 as f64 * l.cell.y));
+        }
+        if r1 + 1 < l.ny {
+            bound = bound.min(l.min.y + (r1 + 1) as f64 * l.cell.y - p.y);
+        }
+        if bound == f64::INFINITY {
+            break;
+        }
+        if let Some((d, _, _)) = best
+            && d < bound - margin(p) * 16.0
+        {
+            break;
+        }
+    }
+    best
+}
+
+/// The first segment hit by the ray from `p` along unit `dir`, not farther
+/// than `limit`: (distance, index), the lowest `order` among equal distances.
+/// Segments touching `p` are skipped.
+pub(crate) fn ray(
+    g: &impl Cells,
+    p: DVec2,
+    dir: DVec2,
+    limit: f64,
+    order: &impl Fn(usize) -> u64,
+) -> Option<(f64, usize)> {
+    let l = g.layout();
+    if l.nx == 0 || !(p.is_finite() && dir.is_finite()) {
+        return None;
+    }
+    if dir.length_squared() == 0.0 {
+        return None;
+    }
+    // The part of the ray inside the grid's box (widened by a margin).
+    let m = DVec2::splat(margin(l.min).max(margin(l.max)) * 16.0);
+    let (lo, hi) = (l.min - m, l.max + m);
+    let (mut enter, mut exit) = (0.0f64, f64::INFINITY);
+    for (o, d, a, b) in [(p.x, dir.x, lo.x, hi.x), (p.y, dir.y, lo.y, hi.y)] {
+        if d == 0.0 {
+            if o < a || o > b {
                 return None;
             }
-            crossing(p, q, s.0, s.1)
-                .filter(|&t| t > 0.0)
-                .map(|t| (t, i))
-        };
-        let nearer = |best: Option<(f64, usize)>, x: (f64, usize)| match best {
-            Some(b) if b.0.total_cmp(&x.0).then(b.1.cmp(&x.1)).is_le() => Some(b),
-            _ => Some(x),
-        };
-        if self.nx * self.ny == 1 {
-            // Boxes apart: no segment is met (as `crossing` decides it first).
-            if p.x.max(q.x) < self.min.x
-                || self.max.x < p.x.min(q.x)
-                || p.y.max(q.y) < self.min.y
-                || self.max.y < p.y.min(q.y)
-            {
-                return None;
-            }
-            return self
-                .items
-                .iter()
-                .filter_map(|&i| hit(i as usize))
-                .fold(None, nearer);
-        }
-        SCRATCH.with_borrow_mut(|(cells, cands)| {
-            cells.clear();
-            self.walk(p, q, cells);
-            cands.clear();
-            for &c in cells.iter() {
-                cands.extend_from_slice(self.cell_items(c));
-            }
-            cands.sort_unstable();
-            cands.dedup();
-            cands
-                .iter()
-                .filter_map(|&i| hit(i as usize))
-                .fold(None, nearer)
-        })
-    }
-
-    /// The closest segment to `p` not touching it: (distance, closest point,
-    /// index), the lowest index among equally close ones.
-    pub fn nearest(&self, p: DVec2) -> Option<(f64, DVec2, usize)> {
-        if self.nx == 0 || !p.is_finite() {
-            return None;
-        }
-        let (ci, cj) = (self.col(p.x), self.row(p.y));
-        let mut best: Option<(f64, DVec2, usize)> = None;
-        let better = |d: f64, i: usize, b: &Option<(f64, DVec2, usize)>| match b {
-            None => true,
-            Some((bd, _, bi)) => d.total_cmp(bd).then(i.cmp(bi)).is_lt(),
-        };
-        let visit = |col: usize, row: usize, best: &mut Option<(f64, DVec2, usize)>| {
-            for &i in self.cell_items((row * self.nx + col) as u32) {
-                let i = i as usize;
-                let s = &self.segs[i];
-                if touches(s, p) {
-                    continue;
-                }
-                let c = closest_on_segment(p, s.0, s.1);
-                let d = (c - p).length();
-                if better(d, i, best) {
-                    *best = Some((d, c, i));
-                }
-            }
-        };
-        for r in 0..self.nx.max(self.ny) {
-            let (c0, c1) = (ci.saturating_sub(r), (ci + r).min(self.nx - 1));
-            let (r0, r1) = (cj.saturating_sub(r), (cj + r).min(self.ny - 1));
-            // Only the ring at distance r: the inside was searched before.
-            let top = cj + r < self.ny;
-            let bottom = r > 0 && cj >= r;
-            for col in c0..=c1 {
-                if bottom {
-                    visit(col, cj - r, &mut best);
-                }
-                if top {
-                    visit(col, cj + r, &mut best);
-                }
-            }
-            let inner = (
-                cj.saturating_sub(r.saturating_sub(1)),
-                (cj + r).saturating_sub(1).min(self.ny - 1),
-            );
-            if r > 0 {
-                for row in inner.0..=inner.1 {
-                    if ci >= r {
-                        visit(ci - r, row, &mut best);
-                    }
-                    if ci + r < self.nx {
-                        visit(ci + r, row, &mut best);
-                    }
-                }
-            }
-            // Whatever lies beyond the searched block is at least this far away.
-            let mut bound = f64::INFINITY;
-            if c0 > 0 {
-                bound = bound.min(p.x - (self.min.x + c0 as f64 * self.cell.x));
-            }
-            if c1 + 1 < self.nx {
-                bound = bound.min(self.min.x + (c1 + 1) as f64 * self.cell.x - p.x);
-            }
-            if r0 > 0 {
-                bound = bound.min(p.y - (self.min.y + r0 as f64 * self.cell.y));
-            }
-            if r1 + 1 < self.ny {
-                bound = bound.min(self.min.y + (r1 + 1) as f64 * self.cell.y - p.y);
-            }
-            if bound == f64::INFINITY {
-                break;
-            }
-            if let Some((d, _, _)) = best
-                && d < bound - margin(p) * 16.0
-            {
-                break;
-            }
-        }
-        best
-    }
-
-    /// The first segment hit by the ray from `p` along unit `dir`, not farther
-    /// than `limit`: (distance, index), the lowest index among equal distances.
-    /// Segments touching `p` are skipped.
-    pub fn ray(&self, p: DVec2, dir: DVec2, limit: f64) -> Option<(f64, usize)> {
-        if self.nx == 0 || !(p.is_finite() && dir.is_finite()) {
-            return None;
-        }
-        if dir.length_squared() == 0.0 {
-            return None;
-        }
-        // The part of the ray inside the grid's box (widened by a margin).
-        let m = DVec2::splat(margin(self.min).max(margin(self.max)) * 16.0);
-        let (lo, hi) = (self.min - m, self.max + m);
-        let (mut enter, mut exit) = (0.0f64, f64::INFINITY);
-        for (o, d, a, b) in [(p.x, dir.x, lo.x, hi.x), (p.y, dir.y, lo.y, hi.y)] {
-            if d == 0.0 {
-                if o < a || o > b {
-                    return None;
-                }
-            } else {
-                let (t0, t1) = ((a - o) / d, (b - o) / d);
-                enter = enter.max(t0.min(t1));
-                exit = exit.min(t0.max(t1));
-            }
-        }
-        if enter.is_nan() || exit.is_nan() || enter > exit || enter > limit {
-            return None;
-        }
-        // One piece when there is one cell; else pieces of a cell's length.
-        let (stride, pieces) = if self.stride.is_finite() && self.nx * self.ny > 1 {
-            let across = (exit.min(limit) - enter) / self.stride;
-            (
-                self.stride,
-                (across.ceil().max(0.0) as usize).min(8 * MAX_CELLS_PER_AXIS) + 2,
-            )
         } else {
-            (f64::INFINITY, 1)
-        };
-        SCRATCH.with_borrow_mut(|(cells, cands)| {
-            self.ray_pieces(p, dir, limit, (enter, exit), (stride, pieces), cells, cands)
-        })
+            let (t0, t1) = ((a - o) / d, (b - o) / d);
+            enter = enter.max(t0.min(t1));
+            exit = exit.min(t0.max(t1));
+        }
     }
-
-    /// The ray's search, piece by piece along it (see `ray`).
-    #[allow(clippy::too_many_arguments)]
-    fn ray_pieces(
-        &self,
-        p: DVec2,
-        dir: DVec2,
-        limit: f64,
-        (enter, exit): (f64, f64),
-        (stride, pieces): (f64, usize),
-        cells: &mut Vec<u32>,
-        cands: &mut Vec<u32>,
-    ) -> Option<(f64, usize)> {
+    if enter.is_nan() || exit.is_nan() || enter > exit || enter > limit {
+        return None;
+    }
+    // One piece when there is one cell; else pieces of a cell's length.
+    let (stride, pieces) = if l.stride.is_finite() && l.cells() > 1 {
+        let across = (exit.min(limit) - enter) / l.stride;
+        (
+            l.stride,
+            (across.ceil().max(0.0) as usize).min(8 * MAX_CELLS_PER_AXIS) + 2,
+        )
+    } else {
+        (f64::INFINITY, 1)
+    };
+    let segs = g.segs();
+    SCRATCH.with_borrow_mut(|(cells, cands)| {
         let mut best: Option<(f64, usize)> = None;
         for k in 0..pieces {
             let t0 = enter + k as f64 * stride;
@@ -478,25 +461,29 @@ impl SegmentGrid {
             let t1 = t0 + stride;
             cells.clear();
             if pieces == 1 {
-                cells.extend(0..(self.nx * self.ny) as u32);
-            } else if !self.boxed(p + dir * t0, p + dir * t1, cells) {
+                cells.extend(0..l.cells() as u32);
+            } else if !l.boxed(p + dir * t0, p + dir * t1, cells) {
                 break;
             }
             cands.clear();
             for &c in cells.iter() {
-                cands.extend_from_slice(self.cell_items(c));
+                g.for_items(c, |i| cands.push(i));
             }
             cands.sort_unstable();
             cands.dedup();
             for &i in cands.iter() {
                 let i = i as usize;
-                let s = &self.segs[i];
+                let s = &segs[i];
                 if touches(s, p) {
                     continue;
                 }
                 if let Some(t) = ray_hit(p, dir, s.0, s.1)
                     && t <= limit
-                    && best.is_none_or(|(bt, bi)| t.total_cmp(&bt).then(i.cmp(&bi)).is_lt())
+                    && best.is_none_or(|(bt, bi)| {
+                        t.total_cmp(&bt)
+                            .then_with(|| order(i).cmp(&order(bi)))
+                            .is_lt()
+                    })
                 {
                     best = Some((t, i));
                 }
@@ -507,5 +494,127 @@ impl SegmentGrid {
             }
         }
         best
+    })
+}
+
+/// Segments in a grid of cells, fixed once built; see the module note.
+pub struct SegmentGrid {
+    segs: Vec<(DVec2, DVec2)>,
+    layout: Layout,
+    /// Cell `c` holds `items[start[c]..start[c + 1]]`.
+    start: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Cells for SegmentGrid {
+    fn layout(&self) -> &Layout {
+        &self.layout
+    }
+    fn segs(&self) -> &[(DVec2, DVec2)] {
+        &self.segs
+    }
+    fn for_items(&self, c: u32, f: impl FnMut(u32)) {
+        let c = c as usize;
+        self.items[self.start[c] as usize..self.start[c + 1] as usize]
+            .iter()
+            .copied()
+            .for_each(f);
+    }
+}
+
+/// The box of the finite segments, their count and total length.
+pub(crate) fn extent(segs: &[(DVec2, DVec2)]) -> (DVec2, DVec2, usize, f64) {
+    let mut min = DVec2::splat(f64::INFINITY);
+    let mut max = DVec2::splat(f64::NEG_INFINITY);
+    let mut len = 0.0;
+    let mut n = 0usize;
+    for s in segs.iter().filter(|s| finite(s)) {
+        min = min.min(s.0).min(s.1);
+        max = max.max(s.0).max(s.1);
+        len += (s.1 - s.0).length();
+        n += 1;
+    }
+    (min, max, n, len)
+}
+
+impl SegmentGrid {
+    /// Indexes `segs` (the grid keeps them). Segments with a coordinate that
+    /// is not finite are left out (they cross nothing).
+    pub fn new(segs: Vec<(DVec2, DVec2)>) -> SegmentGrid {
+        let (min, max, n, len) = extent(&segs);
+        let layout = if n == 0 {
+            Layout::empty()
+        } else if n < SCAN_BELOW_SEGMENTS {
+            // A few segments: a scan of one cell is cheaper than sorting them into cells.
+            Layout::single(min, max)
+        } else {
+            // About one cell per segment, and cells at least as long as a mean segment.
+            Layout::fit(min, max, n as f64, len / n as f64)
+        };
+        let mut grid = SegmentGrid {
+            segs,
+            layout,
+            start: Vec::new(),
+            items: Vec::new(),
+        };
+        if n > 0 {
+            grid.fill();
+        }
+        grid
+    }
+
+    /// Registers every finite segment in the cells along it (counting sort:
+    /// one pass counts, one pass places).
+    fn fill(&mut self) {
+        let cells = self.layout.cells();
+        let mut start = vec![0u32; cells + 1];
+        let mut scratch = Vec::new();
+        let l = self.layout;
+        for s in self.segs.iter().filter(|s| finite(s)) {
+            l.each_cell(s, &mut scratch, |c| start[c as usize + 1] += 1);
+        }
+        for c in 0..cells {
+            start[c + 1] += start[c];
+        }
+        let mut at = start.clone();
+        let mut items = vec![0u32; start[cells] as usize];
+        for (i, s) in self.segs.iter().enumerate().filter(|(_, s)| finite(s)) {
+            l.each_cell(s, &mut scratch, |c| {
+                items[at[c as usize] as usize] = i as u32;
+                at[c as usize] += 1;
+            });
+        }
+        self.start = start;
+        self.items = items;
+    }
+
+    /// How many cells the grid has (0 when it holds no finite segment).
+    pub fn cells(&self) -> usize {
+        self.layout.cells()
+    }
+
+    /// The smallest distance from `p` to the box of the segments.
+    pub fn box_distance(&self, p: DVec2) -> f64 {
+        self.layout.box_distance(p)
+    }
+
+    /// The indexed segments, in their order.
+    pub fn segs(&self) -> &[(DVec2, DVec2)] {
+        &self.segs
+    }
+
+    /// [`first_crossing`], ties to the lowest index.
+    pub fn first_crossing(&self, p: DVec2, q: DVec2) -> Option<(f64, usize)> {
+        first_crossing(self, p, q, &|i| i as u64)
+    }
+
+    /// [`nearest`], ties to the lowest index.
+    pub fn nearest(&self, p: DVec2) -> Option<(f64, DVec2, usize)> {
+        nearest(self, p, &|i| i as u64)
+    }
+
+    /// [`ray`], ties to the lowest index.
+    pub fn ray(&self, p: DVec2, dir: DVec2, limit: f64) -> Option<(f64, usize)> {
+        ray(self, p, dir, limit, &|i| i as u64)
     }
 }
