@@ -786,7 +786,7 @@ fn settle(scene: &Scene, l: &mut Live, used: &mut [u32], t: u32, out: &mut Vec<M
         // closest to its heading (the first of equals): several branches may
         // start at one point.
         let mut hit: Option<(f64, DVec2, DVec2)> = None;
-        for &(s0, s1) in l.grown[r.instance].segments() {
+        for &(s0, s1) in l.grown[r.instance].segments_near(r.from, tol) {
             if (s0 - r.from).length() > tol {
                 continue;
             }

@@ -47,6 +47,8 @@ pub(crate) struct KeptPart {
     pub(crate) id: usize,
     string: ModString,
     pub(crate) segments: Vec<(DVec2, DVec2)>,
+    /// The box of its segments (an empty box for none).
+    bounds: (DVec2, DVec2),
     /// Whether the guide's index holds its segments.
     pub(crate) indexed: bool,
 }
@@ -193,12 +195,38 @@ impl Grown {
     }
 
     /// All segments, in the order of the string.
+    #[cfg(test)]
     pub(crate) fn segments(&self) -> impl Iterator<Item = &(DVec2, DVec2)> {
         self.pieces
             .iter()
             .flat_map(|p| -> Box<dyn Iterator<Item = &(DVec2, DVec2)>> {
                 match p {
                     Piece::Kept(k) => Box::new(k.parts.iter().flat_map(|x| &x.segments)),
+                    Piece::Live(l) => Box::new(l.drawing.iter().flat_map(|d| &d.drawn.segments)),
+                }
+            })
+    }
+
+    /// The segments with an end within `tol` of `p` (and maybe others), in
+    /// the order of the string.
+    pub(crate) fn segments_near(
+        &self,
+        p: DVec2,
+        tol: f64,
+    ) -> impl Iterator<Item = &(DVec2, DVec2)> {
+        let near = move |(lo, hi): (DVec2, DVec2)| {
+            lo.x - tol <= p.x && p.x <= hi.x + tol && lo.y - tol <= p.y && p.y <= hi.y + tol
+        };
+        self.pieces
+            .iter()
+            .flat_map(move |p| -> Box<dyn Iterator<Item = &(DVec2, DVec2)>> {
+                match p {
+                    Piece::Kept(k) => Box::new(
+                        k.parts
+                            .iter()
+                            .filter(move |x| near(x.bounds))
+                            .flat_map(|x| &x.segments),
+                    ),
                     Piece::Live(l) => Box::new(l.drawing.iter().flat_map(|d| &d.drawn.segments)),
                 }
             })
@@ -338,6 +366,7 @@ impl Grown {
                             parts: vec![KeptPart {
                                 id,
                                 string: slice(&string, modules, params),
+                                bounds: bounds(&segments),
                                 segments,
                                 indexed: false,
                             }],
@@ -415,6 +444,14 @@ impl LivePiece {
         }
         true
     }
+}
+
+/// The box of some segments (an empty box, min above max, for none).
+fn bounds(segs: &[(DVec2, DVec2)]) -> (DVec2, DVec2) {
+    segs.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), s| (lo.min(s.0).min(s.1), hi.max(s.0).max(s.1)),
+    )
 }
 
 fn slice(
