@@ -12,6 +12,7 @@ use crate::derive::{self, Limits, ModString};
 use crate::diagnostic::{Code, Diagnostic};
 use crate::render::{self, Bounds, BoundsSink, View};
 use crate::turtle::{self, Drawn};
+use rayon::prelude::*;
 use serde::Serialize;
 use std::io::Write;
 use std::time::Instant;
@@ -618,7 +619,6 @@ fn scene_bounds(
     view: View,
     boxes: &[Option<(glam::DVec3, glam::DVec3)>],
 ) -> Result<(Drawn, Bounds), Diagnostic> {
-    use rayon::prelude::*;
     let centres = program_centres(&r.scene);
     let each: Vec<Result<(Drawn, Bounds), Diagnostic>> = r
         .outcome
@@ -786,10 +786,32 @@ fn scene_svg(
     let names: Vec<&str> = r.scene.guides.iter().map(|g| g.name.as_str()).collect();
     for (gi, g) in r.scene.guides.iter().enumerate() {
         w.begin_guide(names[gi]);
-        for inst in r.outcome.instances.iter().filter(|i| i.guide == gi) {
-            let mut clip = crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut w);
-            r.interpret(inst, seed, &mut clip)
-                .map_err(OutputError::Diagnostic)?;
+        let insts: Vec<&crate::env::Instance> = r
+            .outcome
+            .instances
+            .iter()
+            .filter(|i| i.guide == gi)
+            .collect();
+        // Each system written on its own in parallel, then in order (the
+        // bytes one writer would write).
+        let template = w.part();
+        let parts: Vec<Result<_, Diagnostic>> = insts
+            .par_iter()
+            .map(|inst| {
+                let mut part = template.part();
+                let mut clip =
+                    crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut part);
+                r.interpret(inst, seed, &mut clip)?;
+                Ok(part)
+            })
+            .collect();
+        for (inst, part) in insts.iter().zip(parts) {
+            if !w.append(part.map_err(OutputError::Diagnostic)?) {
+                // It goes on with the path open before it: written again here.
+                let mut clip = crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut w);
+                r.interpret(inst, seed, &mut clip)
+                    .map_err(OutputError::Diagnostic)?;
+            }
         }
         w.end_guide();
     }

@@ -38,6 +38,9 @@ pub struct SvgWriter<W: Write> {
     /// Each element's 3D organ and `fill`, if it is one.
     organs: Vec<Option<(std::sync::Arc<crate::organ::Solid>, Option<String>)>>,
     palette: super::Palette,
+    /// What was drawn first: `None` before anything, else the start, width
+    /// and colour of a first segment (`Some(None)`: something else).
+    first: Option<Option<(DVec2, f64, u32)>>,
 }
 
 impl<W: Write> SvgWriter<W> {
@@ -117,7 +120,49 @@ impl<W: Write> SvgWriter<W> {
                 .map(|e| e.solid.clone().map(|s| (s, e.fill.clone())))
                 .collect(),
             palette: super::Palette::default(),
+            first: None,
         })
+    }
+
+    /// A writer for a part of the drawing drawn on its own (on another
+    /// thread): the same view, numbers, elements and palette, no path open,
+    /// writing to memory. Its output goes into this writer with `append`.
+    pub fn part(&self) -> SvgWriter<Vec<u8>> {
+        SvgWriter {
+            out: Vec::new(),
+            view: self.view,
+            decimals: self.decimals,
+            scale: self.scale,
+            open: None,
+            buf: Vec::with_capacity(64),
+            error: None,
+            organs: self.organs.clone(),
+            palette: self.palette.clone(),
+            first: None,
+        }
+    }
+
+    /// Writes `part` (from `part`) as if what it drew had been drawn into
+    /// this writer; `false`, and nothing written, when its first segment
+    /// would have gone on with this writer's open path (draw that part into
+    /// this writer instead).
+    pub fn append(&mut self, part: SvgWriter<Vec<u8>>) -> bool {
+        let Some(first) = part.first else {
+            return true;
+        };
+        if let (Some(open), Some((pa, width, color))) = (&self.open, first)
+            && open.width == width
+            && open.color == color
+            && open.end == pa
+        {
+            return false;
+        }
+        // Whatever `part` drew first closed the path open here.
+        self.close_path();
+        self.write(&part.out);
+        self.open = part.open;
+        self.first.get_or_insert(first);
+        true
     }
 
     /// Paints `'(c)` colours from `palette` (the built-in one by default).
@@ -288,6 +333,7 @@ impl<W: Write> Sink for SvgWriter<W> {
         let pa = self.view.project(a);
         let pb = self.view.project(b);
         let d = pb - pa;
+        self.first.get_or_insert(Some((pa, width, color)));
         if let Some(open) = self.open.as_mut()
             && open.width == width
             && open.color == color
@@ -337,6 +383,7 @@ impl<W: Write> Sink for SvgWriter<W> {
     }
 
     fn polygon(&mut self, points: &[DVec3], color: u32) {
+        self.first.get_or_insert(None);
         self.close_path();
         let mut buf = Vec::new();
         buf.extend_from_slice(b"<polygon fill=\"");
@@ -348,6 +395,7 @@ impl<W: Write> Sink for SvgWriter<W> {
     }
 
     fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32) {
+        self.first.get_or_insert(None);
         self.close_path();
         if let Some(Some((solid, fill))) = self.organs.get(index as usize) {
             let base = super::organ_color(fill.as_deref(), color, &self.palette);
@@ -385,4 +433,78 @@ pub fn xml(s: &str) -> String {
         .replace('"', "&quot;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One "system": segments (from, to, colour) and maybe a polygon first.
+    type Drawing = (bool, Vec<((f64, f64), (f64, f64), u32)>);
+
+    fn draw(w: &mut impl Sink, d: &Drawing) {
+        let p = |(x, y): (f64, f64)| DVec3::new(x, y, 0.0);
+        if d.0 {
+            w.polygon(&[p((0.0, 0.0)), p((1.0, 0.0)), p((0.0, 1.0))], 2);
+        }
+        for &(a, b, c) in &d.1 {
+            w.segment(p(a), p(b), 0.0, c);
+        }
+    }
+
+    /// Systems written in parts (on their own, then appended, or drawn
+    /// again where a part goes on with the open path) make the bytes that
+    /// one writer drawing them in order makes.
+    #[test]
+    fn parts_appended_are_the_bytes_of_one_writer() {
+        let systems: Vec<Drawing> = vec![
+            // A collinear run, left open.
+            (
+                false,
+                vec![((0.0, 0.0), (1.0, 0.0), 1), ((1.0, 0.0), (2.0, 0.0), 1)],
+            ),
+            // Goes on from there, straight on: continues the open path.
+            (
+                false,
+                vec![((2.0, 0.0), (3.0, 0.0), 1), ((3.0, 0.0), (3.0, 1.0), 1)],
+            ),
+            // Draws nothing.
+            (false, vec![]),
+            // Goes on from there in another colour: a new path.
+            (false, vec![((3.0, 1.0), (4.0, 1.0), 3)]),
+            // Starts elsewhere.
+            (false, vec![((9.0, 9.0), (8.0, 9.0), 3)]),
+            // A polygon first, then a segment where the path before ended.
+            (true, vec![((8.0, 9.0), (7.0, 9.0), 3)]),
+            // Goes on from there, turning.
+            (false, vec![((7.0, 9.0), (7.0, 8.0), 3)]),
+        ];
+        let mut bounds = Bounds::default();
+        bounds.add(DVec2::new(-1.0, -1.0));
+        bounds.add(DVec2::new(10.0, 10.0));
+        let view = View::new(false);
+        let one = |out: Vec<u8>| SvgWriter::new(out, view, &bounds, &[], &[]).expect("writes");
+        let mut whole = one(Vec::new());
+        for s in &systems {
+            draw(&mut whole, s);
+        }
+        let whole = whole.finish().expect("writes");
+        let mut parts = one(Vec::new());
+        let mut again = 0;
+        for s in &systems {
+            let mut part = parts.part();
+            draw(&mut part, s);
+            if !parts.append(part) {
+                again += 1;
+                draw(&mut parts, s);
+            }
+        }
+        let parts = parts.finish().expect("writes");
+        assert_eq!(
+            String::from_utf8(parts).expect("utf-8"),
+            String::from_utf8(whole).expect("utf-8")
+        );
+        // The parts that went on with an open path were drawn again.
+        assert_eq!(again, 2);
+    }
 }
