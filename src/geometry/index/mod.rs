@@ -1,13 +1,16 @@
 //! The spatial indexes, one module: uniform grids over points (`PointGrid`:
 //! the k nearest, those within a distance) and over segments (`SegmentGrid`:
-//! first crossing, nearest segment, first ray hit) and over the segments of a
-//! drawing that grows step by step (`GrowingGrid`: the same searches over
-//! segments added in batches and kept, plus a live batch replaced at will,
-//! numbered by the caller).
+//! first crossing, nearest segment, first ray hit; the searches are written
+//! once, over any `segments::Cells`), over segments added and never removed
+//! (`AppendGrid`: cells that grow) and over the segments of a drawing that
+//! grows step by step (`GrowingGrid`: the same searches over segments added
+//! in batches and kept, plus a live batch replaced at will, numbered by the
+//! caller).
 //!
 //! Owns: every spatial search of the crate. Each search returns exactly what a
-//! scan of all items would, ties broken by the lower index, so an index changes
-//! speed, never answers (and never depends on thread count or hash order).
+//! scan of all items would, ties broken by the lower index (or the caller's
+//! order), so an index changes speed, never answers (and never depends on
+//! thread count or hash order).
 //! Must not know what the points and segments stand for.
 
 pub mod append;

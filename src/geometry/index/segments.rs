@@ -2,11 +2,13 @@
 //! and ray queries (the environment's `?X`, `?D_A` and `?N_A` over what a
 //! guide drew).
 //!
-//! Owns: choosing the cells (about one per segment, never smaller than the mean
-//! segment length, at most `MAX_CELLS_PER_AXIS` a side), registering each
-//! segment in the cells along it, and the three searches. Every search returns
-//! exactly what a scan of all segments would (ties go to the lowest index), so
-//! the index changes speed, never answers. Segments that touch the asking point
+//! Owns: choosing the cells (`Layout`: about one per segment, never smaller
+//! than the mean segment length, at most `MAX_CELLS_PER_AXIS` a side),
+//! registering each segment in the cells along it, and the three searches,
+//! written once over any store of cells (`Cells`: this grid's fixed lists,
+//! `AppendGrid`'s growing ones). Every search returns exactly what a scan of
+//! all segments would (ties go to the lowest index, or to the lowest `order`
+//! the caller gives), so the index changes speed, never answers. Segments that touch the asking point
 //! (a turtle's own last segment) are skipped, as the scan skips them. Must not
 //! know guides or systems.
 
