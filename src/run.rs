@@ -588,26 +588,10 @@ fn draw_scene(
             // Counts and bounds of what the centre rule keeps.
             let mut clip = crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut *sink);
             r.interpret(inst, seed, &mut clip)?;
-            add_drawn(&mut total, clip.kept);
+            total.add(&clip.kept);
         }
     }
     Ok(total)
-}
-
-/// Adds the counts and box of `d` to `total`.
-fn add_drawn(total: &mut Drawn, d: Drawn) {
-    total.segments += d.segments;
-    total.elements += d.elements;
-    total.polygons += d.polygons;
-    if let Some(b) = d.bbox {
-        let t = total.bbox.get_or_insert(b);
-        *t = [
-            t[0].min(b[0]),
-            t[1].min(b[1]),
-            t[2].max(b[2]),
-            t[3].max(b[3]),
-        ];
-    }
 }
 
 /// What `draw_scene` into a `BoundsSink` gives (counts, and the bounds of
@@ -645,7 +629,7 @@ fn scene_bounds(
                 continue;
             }
             let (d, b) = x.clone()?;
-            add_drawn(&mut total, d);
+            total.add(&d);
             if b.any {
                 bounds.add(b.min);
                 bounds.add(b.max);

@@ -201,6 +201,22 @@ pub struct Drawn {
 }
 
 impl Drawn {
+    /// Adds the counts and box of `other` (what was drawn after, or beside).
+    pub fn add(&mut self, other: &Drawn) {
+        self.segments += other.segments;
+        self.elements += other.elements;
+        self.polygons += other.polygons;
+        if let Some(b) = other.bbox {
+            let t = self.bbox.get_or_insert(b);
+            *t = [
+                t[0].min(b[0]),
+                t[1].min(b[1]),
+                t[2].max(b[2]),
+                t[3].max(b[3]),
+            ];
+        }
+    }
+
     fn grow(&mut self, p: DVec3) {
         let b = self.bbox.get_or_insert([p.x, p.y, p.x, p.y]);
         b[0] = b[0].min(p.x);

@@ -180,7 +180,7 @@ impl LayerCache {
                     &mut clip,
                 )
                 .map_err(|e| e.diagnostic(prog))?;
-                add(&mut kept, &clip.kept);
+                kept.add(&clip.kept);
             }
             let mut sink = BoundsSink {
                 view: style.view,
@@ -214,7 +214,7 @@ impl LayerCache {
                 bounds.add(l.bounds.min);
                 bounds.add(l.bounds.max);
             }
-            add(&mut total, &l.kept);
+            total.add(&l.kept);
         }
         for g in &scene.guides {
             for p in &g.polygon {
@@ -341,22 +341,6 @@ fn write_layer(
     w.end_guide();
     let bytes = std::mem::take(w.get_mut());
     String::from_utf8(bytes).map_err(std::io::Error::other)
-}
-
-/// Adds the counts and box of `b` to `a`.
-fn add(a: &mut Drawn, b: &Drawn) {
-    a.segments += b.segments;
-    a.elements += b.elements;
-    a.polygons += b.polygons;
-    if let Some(b) = b.bbox {
-        let t = a.bbox.get_or_insert(b);
-        *t = [
-            t[0].min(b[0]),
-            t[1].min(b[1]),
-            t[2].max(b[2]),
-            t[3].max(b[3]),
-        ];
-    }
 }
 
 /// The middle of edge `e` of guide `g`, where a link's line ends.
