@@ -194,21 +194,8 @@ impl Grown {
         }
     }
 
-    /// All segments, in the order of the string.
-    #[cfg(test)]
-    pub(crate) fn segments(&self) -> impl Iterator<Item = &(DVec2, DVec2)> {
-        self.pieces
-            .iter()
-            .flat_map(|p| -> Box<dyn Iterator<Item = &(DVec2, DVec2)>> {
-                match p {
-                    Piece::Kept(k) => Box::new(k.parts.iter().flat_map(|x| &x.segments)),
-                    Piece::Live(l) => Box::new(l.drawing.iter().flat_map(|d| &d.drawn.segments)),
-                }
-            })
-    }
-
-    /// The segments with an end within `tol` of `p` (and maybe others), in
-    /// the order of the string.
+    /// The segments with an end within `tol` of `p` (and maybe others; all
+    /// of them for an infinite `tol`), in the order of the string.
     pub(crate) fn segments_near(
         &self,
         p: DVec2,
@@ -219,8 +206,8 @@ impl Grown {
         };
         self.pieces
             .iter()
-            .flat_map(move |p| -> Box<dyn Iterator<Item = &(DVec2, DVec2)>> {
-                match p {
+            .flat_map(move |piece| -> Box<dyn Iterator<Item = &(DVec2, DVec2)>> {
+                match piece {
                     Piece::Kept(k) => Box::new(
                         k.parts
                             .iter()
@@ -507,7 +494,10 @@ mod tests {
                     );
                 }
                 let pieces = Probe {
-                    segments: grown.segments().copied().collect(),
+                    segments: grown
+                        .segments_near(DVec2::ZERO, f64::INFINITY)
+                        .copied()
+                        .collect(),
                     queries,
                 };
                 assert_eq!(bits(&pieces), bits(&whole.drawn), "{text} step {step}");
