@@ -249,6 +249,16 @@ pub(crate) trait Cells {
     fn for_items(&self, c: u32, f: impl FnMut(u32));
 }
 
+/// The segments in `cells`, each once, in index order, into `out`.
+fn candidates(g: &impl Cells, cells: &[u32], out: &mut Vec<u32>) {
+    out.clear();
+    for &c in cells {
+        g.for_items(c, |i| out.push(i));
+    }
+    out.sort_unstable();
+    out.dedup();
+}
+
 /// The segment that `p`–`q` meets first going from `p` (crossing, touching
 /// or overlapping on one line; [`crossing`]): (parameter along `p`–`q`,
 /// index), the lowest `order` among equally near ones. Segments touching `p`
@@ -305,12 +315,7 @@ pub(crate) fn first_crossing(
     SCRATCH.with_borrow_mut(|(cells, cands)| {
         cells.clear();
         l.walk(p, q, cells);
-        cands.clear();
-        for &c in cells.iter() {
-            g.for_items(c, |i| cands.push(i));
-        }
-        cands.sort_unstable();
-        cands.dedup();
+        candidates(g, cells, cands);
         cands
             .iter()
             .filter_map(|&i| hit(i as usize))
@@ -467,12 +472,7 @@ pub(crate) fn ray(
             } else if !l.boxed(p + dir * t0, p + dir * t1, cells) {
                 break;
             }
-            cands.clear();
-            for &c in cells.iter() {
-                g.for_items(c, |i| cands.push(i));
-            }
-            cands.sort_unstable();
-            cands.dedup();
+            candidates(g, cells, cands);
             for &i in cands.iter() {
                 let i = i as usize;
                 let s = &segs[i];
