@@ -758,18 +758,18 @@ fn reindex(scene: &Scene, live: &mut [Live]) {
                 x.indexed = true;
             }
         }
-        l.index.push(&segs, std::mem::take(&mut keys));
-        segs.clear();
-
-        for p in l.grown.iter().flat_map(|g| &g.pieces) {
-            if let Piece::Live(x) = p
-                && let Some(d) = &x.drawing
-            {
-                keys.extend((0..d.drawn.segments.len()).map(|i| key(x.id, i)));
-                segs.extend_from_slice(&d.drawn.segments);
+        l.index.push(&segs, keys);
+        let grown = &l.grown;
+        l.index.set_live_with(|segs, keys| {
+            for p in grown.iter().flat_map(|g| &g.pieces) {
+                if let Piece::Live(x) = p
+                    && let Some(d) = &x.drawing
+                {
+                    keys.extend((0..d.drawn.segments.len()).map(|i| key(x.id, i)));
+                    segs.extend_from_slice(&d.drawn.segments);
+                }
             }
-        }
-        l.index.set_live(segs, keys);
+        });
         l.redrawn = false;
     });
 }
@@ -969,10 +969,20 @@ fn answer_piece(
     let mut answers = Vec::new();
     let mut crossings = Vec::new();
     if let (Some(drawing), Some(piece)) = (grown.drawing(pi), grown.live_piece(pi)) {
-        let offsets = grown.param_offsets(prog, pi);
+        // The queries come in the order of their modules: their parameters'
+        // place is counted on from the last one's (from the start, were one
+        // ever before the last).
+        let (mut next, mut at) = (0, 0);
         for &(m, kind, state) in &drawing.drawn.queries {
             let q = &QUERIES[kind as usize];
-            let at = offsets[m];
+            if m < next {
+                (next, at) = (0, 0);
+            }
+            at += piece.string.syms[next..m]
+                .iter()
+                .map(|&x| prog.symbols.arity(x))
+                .sum::<usize>();
+            next = m;
             let arity = prog.symbols.arity(piece.string.syms[m]);
             let own = &piece.string.params[at..at + arity];
             let ans = match q.kind {

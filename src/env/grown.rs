@@ -371,20 +371,6 @@ impl Grown {
         self.pieces = out;
     }
 
-    /// Where the parameters of live piece `i`'s modules start, in its string.
-    pub(crate) fn param_offsets(&self, prog: &Program, i: usize) -> Vec<usize> {
-        let Piece::Live(l) = &self.pieces[i] else {
-            return Vec::new();
-        };
-        let mut off = Vec::with_capacity(l.string.len());
-        let mut p = 0;
-        for &x in &l.string.syms {
-            off.push(p);
-            p += prog.symbols.arity(x);
-        }
-        off
-    }
-
     /// The parameters of live piece `i`.
     pub(crate) fn params_mut(&mut self, i: usize) -> &mut [f64] {
         match &mut self.pieces[i] {

@@ -12,7 +12,7 @@
 //! speed, never answers. Must not know guides or systems.
 
 use super::append::AppendGrid;
-use super::segments::{self, Cells, SegmentGrid};
+use super::segments::{self, Cells, GridLists, SegmentGrid};
 use glam::DVec2;
 
 /// The live batch: a grid over it, and each segment's key.
@@ -28,6 +28,9 @@ pub struct GrowingGrid {
     /// The key of each kept segment, in the order added.
     keys: Vec<u64>,
     live: Option<Live>,
+    /// The lists of the live batch before, emptied (`set_live_with` fills
+    /// them rather than allocating new ones at every batch).
+    spare: Option<(GridLists, Vec<u64>)>,
 }
 
 /// The better of two answers: the smaller first value, then the lower number.
@@ -65,11 +68,33 @@ impl GrowingGrid {
     /// Replaces the live batch (segments that may still change) with `segs`
     /// and their keys (none held as kept).
     pub fn set_live(&mut self, segs: Vec<(DVec2, DVec2)>, keys: Vec<u64>) {
-        debug_assert_eq!(segs.len(), keys.len());
-        self.live = (!segs.is_empty()).then(|| Live {
-            grid: SegmentGrid::new(segs),
-            keys,
+        self.set_live_with(|s, k| {
+            *s = segs;
+            *k = keys;
         });
+    }
+
+    /// Replaces the live batch with the segments and keys that `fill` adds
+    /// to the two empty lists it is given (those of the batch before).
+    pub fn set_live_with(&mut self, fill: impl FnOnce(&mut Vec<(DVec2, DVec2)>, &mut Vec<u64>)) {
+        let (mut lists, mut keys) = match self.live.take() {
+            Some(l) => {
+                let mut keys = l.keys;
+                keys.clear();
+                (l.grid.into_lists(), keys)
+            }
+            None => self.spare.take().unwrap_or_default(),
+        };
+        fill(&mut lists.segs, &mut keys);
+        debug_assert_eq!(lists.segs.len(), keys.len());
+        if lists.segs.is_empty() {
+            self.spare = Some((lists, keys));
+        } else {
+            self.live = Some(Live {
+                grid: SegmentGrid::from_lists(lists),
+                keys,
+            });
+        }
     }
 
     /// How many grids hold segments.

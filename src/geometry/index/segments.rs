@@ -539,10 +539,61 @@ pub(crate) fn extent(segs: &[(DVec2, DVec2)]) -> (DVec2, DVec2, usize, f64) {
     (min, max, n, len)
 }
 
+/// Registers every finite segment of `segs` in the cells of `l` along it
+/// (counting sort: one pass counts, one pass places): cell `c` holds
+/// `items[start[c]..start[c + 1]]`. `start` and `items` come empty.
+fn fill(l: &Layout, segs: &[(DVec2, DVec2)], start: &mut Vec<u32>, items: &mut Vec<u32>) {
+    let cells = l.cells();
+    start.resize(cells + 1, 0);
+    let mut scratch = Vec::new();
+    for s in segs.iter().filter(|s| finite(s)) {
+        l.each_cell(s, &mut scratch, |c| start[c as usize + 1] += 1);
+    }
+    for c in 0..cells {
+        start[c + 1] += start[c];
+    }
+    items.resize(start[cells] as usize, 0);
+    // Each cell's start serves as its cursor, which ends at the next cell's
+    // start; the starts are then shifted back by one cell.
+    for (i, s) in segs.iter().enumerate().filter(|(_, s)| finite(s)) {
+        l.each_cell(s, &mut scratch, |c| {
+            let at = &mut start[c as usize];
+            items[*at as usize] = i as u32;
+            *at += 1;
+        });
+    }
+    start.copy_within(0..cells, 1);
+    start[0] = 0;
+}
+
+/// The lists a [`SegmentGrid`] is built in. A grid taken apart
+/// ([`SegmentGrid::into_lists`]) gives them back emptied, so that the next
+/// grid built from them ([`SegmentGrid::from_lists`]) allocates nothing new.
+#[derive(Default)]
+pub struct GridLists {
+    /// The segments to index.
+    pub segs: Vec<(DVec2, DVec2)>,
+    start: Vec<u32>,
+    items: Vec<u32>,
+}
+
 impl SegmentGrid {
     /// Indexes `segs` (the grid keeps them). Segments with a coordinate that
     /// is not finite are left out (they cross nothing).
     pub fn new(segs: Vec<(DVec2, DVec2)>) -> SegmentGrid {
+        SegmentGrid::from_lists(GridLists {
+            segs,
+            ..GridLists::default()
+        })
+    }
+
+    /// Indexes `lists.segs`, building the cells in the other lists.
+    pub fn from_lists(lists: GridLists) -> SegmentGrid {
+        let GridLists {
+            segs,
+            mut start,
+            mut items,
+        } = lists;
         let (min, max, n, len) = extent(&segs);
         let layout = if n == 0 {
             Layout::empty()
@@ -553,41 +604,28 @@ impl SegmentGrid {
             // About one cell per segment, and cells at least as long as a mean segment.
             Layout::fit(min, max, n as f64, len / n as f64)
         };
-        let mut grid = SegmentGrid {
+        start.clear();
+        items.clear();
+        if n > 0 {
+            fill(&layout, &segs, &mut start, &mut items);
+        }
+        SegmentGrid {
             segs,
             layout,
-            start: Vec::new(),
-            items: Vec::new(),
-        };
-        if n > 0 {
-            grid.fill();
+            start,
+            items,
         }
-        grid
     }
 
-    /// Registers every finite segment in the cells along it (counting sort:
-    /// one pass counts, one pass places).
-    fn fill(&mut self) {
-        let cells = self.layout.cells();
-        let mut start = vec![0u32; cells + 1];
-        let mut scratch = Vec::new();
-        let l = self.layout;
-        for s in self.segs.iter().filter(|s| finite(s)) {
-            l.each_cell(s, &mut scratch, |c| start[c as usize + 1] += 1);
-        }
-        for c in 0..cells {
-            start[c + 1] += start[c];
-        }
-        let mut at = start.clone();
-        let mut items = vec![0u32; start[cells] as usize];
-        for (i, s) in self.segs.iter().enumerate().filter(|(_, s)| finite(s)) {
-            l.each_cell(s, &mut scratch, |c| {
-                items[at[c as usize] as usize] = i as u32;
-                at[c as usize] += 1;
-            });
-        }
-        self.start = start;
-        self.items = items;
+    /// The grid's lists, emptied (see [`GridLists`]).
+    pub fn into_lists(self) -> GridLists {
+        let mut lists = GridLists {
+            segs: self.segs,
+            start: self.start,
+            items: self.items,
+        };
+        lists.segs.clear();
+        lists
     }
 
     /// How many cells the grid has (0 when it holds no finite segment).
