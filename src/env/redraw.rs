@@ -15,7 +15,9 @@
 //! the rules produced is drawn anew. The result is always what drawing the
 //! whole string gives: an alignment that is not the derivation's own only
 //! means that less is copied. Programs with interpretation rules or `cut` are
-//! drawn whole.
+//! drawn whole, and so are strings whose inactive runs are short on average
+//! (`RUN_WORTH_COPYING`): checking and copying a run costs more than drawing
+//! a few modules.
 //!
 //! A string can be drawn from a turtle other than the system's start (the
 //! state and stack a piece of a longer string starts with: `Resume`): the engine keeps the start of a system's
@@ -30,7 +32,6 @@ use crate::compile::{Program, Sym};
 use crate::derive::ModString;
 use crate::turtle::{State, Stepper};
 use glam::DVec2;
-use std::sync::Arc;
 
 /// The turtle where a string starts: `None` for the system's start state, or
 /// the state and stack a piece of a longer string starts with.
@@ -68,16 +69,56 @@ pub(crate) enum Cut {
 /// kept are never merged: a few large ones are cheaper than many small).
 const MIN_KEPT: usize = 16;
 
+/// The fewest modules per run of active modules a string must hold on
+/// average for `redraw` to copy its runs rather than draw it whole.
+const RUN_WORTH_COPYING: usize = 32;
+
 /// The turtle at one place of the string, and what was drawn before it.
-#[derive(Clone)]
+#[derive(Clone, Copy)]
 struct Snap {
     state: State,
-    /// Shared by the snaps of one drawing that have equal stacks.
-    stack: Arc<[State]>,
+    /// Its stack, in the drawing's `Stacks`.
+    stack: StackAt,
     /// A polygon was open (the turtle cannot be set to this place).
     polygon: bool,
     segs: usize,
     queries: usize,
+}
+
+/// Where a stack is in a drawing's `Stacks`: (first state, depth).
+type StackAt = (usize, usize);
+
+/// The stacks of a drawing's snaps, one after another; a snap with the same
+/// stack as the one added before shares it.
+#[derive(Default)]
+struct Stacks {
+    states: Vec<State>,
+    last: Option<StackAt>,
+}
+
+impl Stacks {
+    fn get(&self, (at, n): StackAt) -> &[State] {
+        &self.states[at..at + n]
+    }
+
+    fn add(&mut self, stack: &[State]) -> StackAt {
+        if let Some(r) = self.last
+            && r.1 == stack.len()
+            && shared(self.get(r), stack) == stack.len()
+        {
+            return r;
+        }
+        let r = (self.states.len(), stack.len());
+        self.states.extend_from_slice(stack);
+        self.last = Some(r);
+        r
+    }
+
+    /// `x` of the drawing with `stacks`, its stack added here.
+    fn adopt(&mut self, stacks: &Stacks, mut x: Snap) -> Snap {
+        x.stack = self.add(stacks.get(x.stack));
+        x
+    }
 }
 
 /// A run of active modules: where it is (modules and parameters) and the
@@ -98,6 +139,8 @@ pub(crate) struct Sketch {
     marks: Option<Vec<Mark>>,
     /// The turtle after the last module (with marks only).
     end: Option<Snap>,
+    /// The stacks of the marks and `end`.
+    stacks: Stacks,
     /// The segment list of the drawing before, emptied: the next redraw
     /// fills it instead of allocating a list as large.
     spare: Vec<(glam::DVec2, glam::DVec2)>,
@@ -110,6 +153,7 @@ impl Sketch {
             drawn,
             marks: None,
             end: None,
+            stacks: Stacks::default(),
             spare: Vec::new(),
         }
     }
@@ -184,6 +228,8 @@ pub(crate) fn cut(
     let d = slot.as_ref()?;
     let marks = d.marks.as_deref()?;
     let end = d.end.as_ref()?;
+    // The stacks of the snaps drawn again below (`Kept::snap_a`).
+    let mut redrawn = Stacks::default();
     // Where the turtle is fixed again after each run of active modules
     // (`None`: not before the next run), by the branches' nesting.
     let mut fixed_from: Vec<Option<usize>> = Vec::with_capacity(marks.len());
@@ -271,7 +317,7 @@ pub(crate) fn cut(
                 let mut st = stepper(
                     prog,
                     start,
-                    Some((&prev.after.state, &prev.after.stack[..])),
+                    Some((&prev.after.state, d.stacks.get(prev.after.stack))),
                 );
                 let pa = prev.pend
                     + s.syms[prev.end..a]
@@ -286,7 +332,7 @@ pub(crate) fn cut(
                     prev.end,
                     None,
                 );
-                let mut snap_a = snap(&st, &scratch, &mut None);
+                let mut snap_a = snap(&st, &scratch, &mut redrawn);
                 snap_a.segs += prev.after.segs;
                 snap_a.queries += prev.after.queries;
                 (a, pa, snap_a.segs, snap_a.queries, Some(snap_a))
@@ -308,7 +354,7 @@ pub(crate) fn cut(
                         .sum::<usize>(),
                 sb: at_b.segs,
                 qb: at_b.queries,
-                exit: (at_b.state, at_b.stack.to_vec()),
+                exit: (at_b.state, d.stacks.get(at_b.stack).to_vec()),
             });
         }
     }
@@ -316,7 +362,11 @@ pub(crate) fn cut(
         return None;
     }
     let Some(Sketch {
-        drawn, marks, end, ..
+        drawn,
+        marks,
+        end,
+        stacks,
+        ..
     }) = slot.take()
     else {
         unreachable!("looked at above")
@@ -340,6 +390,7 @@ pub(crate) fn cut(
             x.queries -= qc;
             x
         };
+        let mut own = Stacks::default();
         let mut inside = Vec::new();
         while let Some(m) = marks.next_if(|m| m.start < a) {
             inside.push(Mark {
@@ -347,16 +398,16 @@ pub(crate) fn cut(
                 end: m.end - c,
                 pstart: m.pstart - pc,
                 pend: m.pend - pc,
-                before: rebase(m.before),
-                after: rebase(m.after),
+                before: rebase(own.adopt(&stacks, m.before)),
+                after: rebase(own.adopt(&stacks, m.after)),
             });
         }
         let end_at = match snap_a {
-            Some(x) => x,
-            None if a == s.len() => end.clone(),
+            Some(x) => own.adopt(&redrawn, x),
+            None if a == s.len() => own.adopt(&stacks, end),
             None => {
                 let last = inside.last().expect("a live piece ends after a mark");
-                let mut x = last.after.clone();
+                let mut x = last.after;
                 x.segs += sc;
                 x.queries += qc;
                 x
@@ -377,6 +428,7 @@ pub(crate) fn cut(
                 },
                 marks: Some(inside),
                 end: Some(rebase(end_at)),
+                stacks: own,
                 spare: Vec::new(),
             }),
         }
@@ -412,12 +464,24 @@ pub(crate) fn draw(prog: &Program, s: &ModString, start: State, at: Resume) -> S
     let mut st = stepper(prog, start, at);
     let mut out = Probe::default();
     let mut marks = Vec::new();
-    fresh(prog, &mut st, &mut out, &mut marks, s, 0, s.len(), 0);
+    let mut stacks = Stacks::default();
+    fresh(
+        prog,
+        &mut st,
+        &mut out,
+        &mut marks,
+        &mut stacks,
+        s,
+        0,
+        s.len(),
+        0,
+    );
     let marks = keep(marks, s.len());
     Sketch {
-        end: marks.as_ref().map(|_| snap(&st, &out, &mut None)),
+        end: marks.as_ref().map(|_| snap(&st, &out, &mut stacks)),
         drawn: out,
         marks,
+        stacks,
         spare: Vec::new(),
     }
 }
@@ -426,23 +490,15 @@ pub(crate) fn draw(prog: &Program, s: &ModString, start: State, at: Resume) -> S
 fn keep(marks: Vec<Mark>, len: usize) -> Option<Vec<Mark>> {
     let held: usize = marks
         .iter()
-        .map(|m| 2 + m.before.stack.len() + m.after.stack.len())
+        .map(|m| 2 + m.before.stack.1 + m.after.stack.1)
         .sum();
     (held <= len / 2 + 4096).then_some(marks)
 }
 
-fn snap(st: &Stepper, out: &Probe, share: &mut Option<Arc<[State]>>) -> Snap {
-    let stack = match share {
-        Some(x) if x.len() == st.stack.len() && shared(x, &st.stack) == x.len() => x.clone(),
-        _ => {
-            let x: Arc<[State]> = Arc::from(&st.stack[..]);
-            *share = Some(x.clone());
-            x
-        }
-    };
+fn snap(st: &Stepper, out: &Probe, stacks: &mut Stacks) -> Snap {
     Snap {
         state: st.state,
-        stack,
+        stack: stacks.add(&st.stack),
         polygon: st.in_polygon(),
         segs: out.segments.len(),
         queries: out.queries.len(),
@@ -457,6 +513,7 @@ fn fresh(
     st: &mut Stepper,
     out: &mut Probe,
     marks: &mut Vec<Mark>,
+    stacks: &mut Stacks,
     s: &ModString,
     from: usize,
     to: usize,
@@ -468,7 +525,6 @@ fn fresh(
             .map(|&x| prog.symbols.arity(x))
             .sum::<usize>()
     };
-    let mut share = None;
     let mut i = from;
     while i < to {
         let is_active = active(prog, s.syms[i]);
@@ -478,7 +534,7 @@ fn fresh(
         }
         let q = params(i, j, p);
         if is_active {
-            let before = snap(st, out, &mut share);
+            let before = snap(st, out, stacks);
             st.run(out, &s.syms[i..j], &s.params[p..q], i, None);
             marks.push(Mark {
                 start: i,
@@ -486,7 +542,7 @@ fn fresh(
                 pstart: p,
                 pend: q,
                 before,
-                after: snap(st, out, &mut share),
+                after: snap(st, out, stacks),
             });
         } else {
             st.run(out, &s.syms[i..j], &s.params[p..q], i, None);
@@ -598,6 +654,24 @@ fn align(prog: &Program, old: &ModString, marks: &[Mark], new: &ModString) -> Op
 pub(crate) fn redraw(
     prog: &Program,
     old: &ModString,
+    last: Sketch,
+    new: &ModString,
+    start: State,
+    at: Resume,
+) -> Sketch {
+    // Copying a run costs more than drawing a few modules: a string whose
+    // runs of inactive modules are short on average is drawn whole.
+    let marks = last.marks.as_ref().map_or(0, Vec::len);
+    if old.len() < RUN_WORTH_COPYING * (marks + 1) {
+        return draw(prog, new, start, at);
+    }
+    copy_runs(prog, old, last, new, start, at)
+}
+
+/// `redraw`, copying every run it can.
+fn copy_runs(
+    prog: &Program,
+    old: &ModString,
     mut last: Sketch,
     new: &ModString,
     start: State,
@@ -616,11 +690,14 @@ pub(crate) fn redraw(
     let mut st = stepper(prog, start, at);
     let begin = Snap {
         state: st.state,
-        stack: Arc::from(&st.stack[..]),
+        stack: (0, 0),
         polygon: false,
         segs: 0,
         queries: 0,
     };
+    // The stepper's stack: the one `at` gives.
+    let begin_stack: &[State] = at.map_or(&[], |(_, stack)| stack);
+    let mut stacks = Stacks::default();
     let mut segments = std::mem::take(&mut last.spare);
     segments.reserve(drawn.segments.len() + drawn.segments.len() / 8);
     let mut out = Probe {
@@ -631,28 +708,37 @@ pub(crate) fn redraw(
     let (mut k, mut pk) = (0usize, 0usize);
     for (ri, r) in runs.iter().enumerate() {
         // What the rules produced before this run: drawn anew.
-        fresh(prog, &mut st, &mut out, &mut next, new, k, r.new, pk);
-        let (entry, exit) = (
-            if ri == 0 {
-                &begin
-            } else {
-                &marks[ri - 1].after
-            },
-            marks.get(ri),
+        fresh(
+            prog,
+            &mut st,
+            &mut out,
+            &mut next,
+            &mut stacks,
+            new,
+            k,
+            r.new,
+            pk,
         );
+        let (entry, entry_stack, exit) = match ri {
+            0 => (&begin, begin_stack, marks.first()),
+            _ => {
+                let m = &marks[ri - 1].after;
+                (m, last.stacks.get(m.stack), marks.get(ri))
+            }
+        };
         // Segments and queries the last drawing made in this run from where
         // the two drawings agree (`skip` modules in, `segs` and `queries`
         // drawn by then).
         let agree = if same_state(&st.state, &entry.state)
-            && shared(&st.stack, &entry.stack) == entry.stack.len()
-            && st.stack.len() == entry.stack.len()
+            && shared(&st.stack, entry_stack) == entry_stack.len()
+            && st.stack.len() == entry_stack.len()
             && !st.in_polygon()
             && !entry.polygon
         {
             Some((0, 0, 0))
         } else {
-            let depth = shared(&st.stack, &entry.stack);
-            let below = (st.stack.len() == entry.stack.len()
+            let depth = shared(&st.stack, entry_stack);
+            let below = (st.stack.len() == entry_stack.len()
                 && !st.in_polygon()
                 && !entry.polygon
                 && depth > 0)
@@ -685,7 +771,7 @@ pub(crate) fn redraw(
                 if let Some(m) = exit {
                     st.state = m.before.state;
                     st.stack.clear();
-                    st.stack.extend_from_slice(&m.before.stack);
+                    st.stack.extend_from_slice(last.stacks.get(m.before.stack));
                 }
             }
             (Some((skip, _, _)), _) => {
@@ -713,9 +799,10 @@ pub(crate) fn redraw(
     let mut spare = std::mem::take(&mut last.drawn.segments);
     spare.clear();
     Sketch {
-        end: marks.as_ref().map(|_| snap(&st, &out, &mut None)),
+        end: marks.as_ref().map(|_| snap(&st, &out, &mut stacks)),
         drawn: out,
         marks,
+        stacks,
         spare,
     }
 }
@@ -772,9 +859,10 @@ pub(crate) mod tests {
          Y(n) : n > 0 -> F(1) -(10) Y(n - 1); Y(n) -> ; }",
     ];
 
-    /// Derives each program step by step; every step's redraw must equal a
-    /// whole drawing of the string (segments bit for bit, queries with their
-    /// modules), and the redraws must have copied most of the drawing.
+    /// Derives each program step by step; every step's redraw (as `redraw`
+    /// chooses, and copying every run it can) must equal a whole drawing of
+    /// the string (segments bit for bit, queries with their modules), and
+    /// the redraws must have copied most of the drawing.
     #[test]
     fn a_redraw_is_the_whole_drawing() {
         let mut copied = 0;
@@ -788,7 +876,14 @@ pub(crate) mod tests {
                 let whole = draw(&prog, &next, start, None);
                 let before = sketch.drawn.segments.len();
                 let (old, new) = (&s, &next);
-                sketch = redraw(&prog, old, sketch, new, start, None);
+                // As `redraw` chooses, and copying every run it can.
+                let chosen = redraw(&prog, old, draw(&prog, old, start, None), new, start, None);
+                assert_eq!(
+                    bits(&chosen.drawn),
+                    bits(&whole.drawn),
+                    "{text} step {step}"
+                );
+                sketch = copy_runs(&prog, old, sketch, new, start, None);
                 assert_eq!(
                     bits(&sketch.drawn),
                     bits(&whole.drawn),
