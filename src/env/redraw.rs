@@ -332,7 +332,7 @@ pub(crate) fn cut(
                     prev.end,
                     None,
                 );
-                let mut snap_a = snap(&st, &scratch, &mut redrawn);
+                let mut snap_a = snap(&st, &scratch, redrawn.add(&st.stack));
                 snap_a.segs += prev.after.segs;
                 snap_a.queries += prev.after.queries;
                 (a, pa, snap_a.segs, snap_a.queries, Some(snap_a))
@@ -478,7 +478,7 @@ pub(crate) fn draw(prog: &Program, s: &ModString, start: State, at: Resume) -> S
     );
     let marks = keep(marks, s.len());
     Sketch {
-        end: marks.as_ref().map(|_| snap(&st, &out, &mut stacks)),
+        end: marks.as_ref().map(|_| snap(&st, &out, stacks.add(&st.stack))),
         drawn: out,
         marks,
         stacks,
@@ -495,10 +495,11 @@ fn keep(marks: Vec<Mark>, len: usize) -> Option<Vec<Mark>> {
     (held <= len / 2 + 4096).then_some(marks)
 }
 
-fn snap(st: &Stepper, out: &Probe, stacks: &mut Stacks) -> Snap {
+/// The turtle of `st` (its stack at `stack`) and what `out` holds.
+fn snap(st: &Stepper, out: &Probe, stack: StackAt) -> Snap {
     Snap {
         state: st.state,
-        stack: stacks.add(&st.stack),
+        stack,
         polygon: st.in_polygon(),
         segs: out.segments.len(),
         queries: out.queries.len(),
@@ -519,33 +520,40 @@ fn fresh(
     to: usize,
     mut p: usize,
 ) {
-    let params = |a: usize, b: usize, p: usize| -> usize {
-        p + s.syms[a..b]
-            .iter()
-            .map(|&x| prog.symbols.arity(x))
-            .sum::<usize>()
+    // Without interpretation rules only `[` and `]` change the stack: after
+    // a run without them it is the one last added to `stacks` (`known`).
+    let plain = redrawable(prog);
+    let mut known: Option<StackAt> = None;
+    let mut snap_at = |st: &Stepper, out: &Probe, known: &mut Option<StackAt>| {
+        snap(st, out, *known.get_or_insert_with(|| stacks.add(&st.stack)))
     };
     let mut i = from;
     while i < to {
         let is_active = active(prog, s.syms[i]);
-        let mut j = i + 1;
-        while j < to && active(prog, s.syms[j]) == is_active {
+        let (mut j, mut q, mut brackets) = (i, p, false);
+        while j < to && (j == i || active(prog, s.syms[j]) == is_active) {
+            let x = s.syms[j];
+            q += prog.symbols.arity(x);
+            brackets |= matches!(
+                prog.symbols.info[x as usize].action,
+                crate::compile::Action::Push | crate::compile::Action::Pop
+            );
             j += 1;
         }
-        let q = params(i, j, p);
-        if is_active {
-            let before = snap(st, out, stacks);
-            st.run(out, &s.syms[i..j], &s.params[p..q], i, None);
+        let before = is_active.then(|| snap_at(st, out, &mut known));
+        st.run(out, &s.syms[i..j], &s.params[p..q], i, None);
+        if brackets || !plain {
+            known = None;
+        }
+        if let Some(before) = before {
             marks.push(Mark {
                 start: i,
                 end: j,
                 pstart: p,
                 pend: q,
                 before,
-                after: snap(st, out, stacks),
+                after: snap_at(st, out, &mut known),
             });
-        } else {
-            st.run(out, &s.syms[i..j], &s.params[p..q], i, None);
         }
         i = j;
         p = q;
@@ -799,7 +807,7 @@ fn copy_runs(
     let mut spare = std::mem::take(&mut last.drawn.segments);
     spare.clear();
     Sketch {
-        end: marks.as_ref().map(|_| snap(&st, &out, &mut stacks)),
+        end: marks.as_ref().map(|_| snap(&st, &out, stacks.add(&st.stack))),
         drawn: out,
         marks,
         stacks,
