@@ -390,29 +390,34 @@ pub(crate) fn cut(
             x.queries -= qc;
             x
         };
-        let mut own = Stacks::default();
         let mut inside = Vec::new();
         while let Some(m) = marks.next_if(|m| m.start < a) {
-            inside.push(Mark {
-                start: m.start - c,
-                end: m.end - c,
-                pstart: m.pstart - pc,
-                pend: m.pend - pc,
-                before: rebase(own.adopt(&stacks, m.before)),
-                after: rebase(own.adopt(&stacks, m.after)),
-            });
+            inside.push(m);
         }
-        let end_at = match snap_a {
-            Some(x) => own.adopt(&redrawn, x),
-            None if a == s.len() => own.adopt(&stacks, end),
-            None => {
-                let last = inside.last().expect("a live piece ends after a mark");
-                let mut x = last.after;
-                x.segs += sc;
-                x.queries += qc;
-                x
-            }
-        };
+        // Marks serve only to copy runs at the next redraw: a piece that
+        // will be drawn whole keeps none.
+        let mut own = Stacks::default();
+        let copies = a - c >= RUN_WORTH_COPYING * (inside.len() + 1);
+        let marked = copies.then(|| {
+            let last_after = inside.last().map(|m| m.after);
+            let inside: Vec<Mark> = inside
+                .into_iter()
+                .map(|m| Mark {
+                    start: m.start - c,
+                    end: m.end - c,
+                    pstart: m.pstart - pc,
+                    pend: m.pend - pc,
+                    before: rebase(own.adopt(&stacks, m.before)),
+                    after: rebase(own.adopt(&stacks, m.after)),
+                })
+                .collect();
+            let end_at = match snap_a {
+                Some(x) => own.adopt(&redrawn, x),
+                None if a == s.len() => own.adopt(&stacks, end),
+                None => own.adopt(&stacks, last_after.expect("a live piece ends after a mark")),
+            };
+            (inside, rebase(end_at))
+        });
         let queries = drawn.queries[qc..qa]
             .iter()
             .map(|&(m, kind, state)| (m - c, kind, state))
@@ -426,8 +431,8 @@ pub(crate) fn cut(
                     segments: drawn.segments[sc..sa].to_vec(),
                     queries,
                 },
-                marks: Some(inside),
-                end: Some(rebase(end_at)),
+                end: marked.as_ref().map(|m| m.1),
+                marks: marked.map(|m| m.0),
                 stacks: own,
                 spare: Vec::new(),
             }),
@@ -461,10 +466,20 @@ pub(crate) fn cut(
 /// `at`), as `turtle::interpret_from` does (segments, elements' axes,
 /// queries), with marks when the program has no interpretation rules.
 pub(crate) fn draw(prog: &Program, s: &ModString, start: State, at: Resume) -> Sketch {
+    draw_in(prog, s, start, at, Sketch::whole(Probe::default()))
+}
+
+/// `draw`, in the lists of the drawing `old` (emptied, not read).
+fn draw_in(prog: &Program, s: &ModString, start: State, at: Resume, old: Sketch) -> Sketch {
     let mut st = stepper(prog, start, at);
-    let mut out = Probe::default();
-    let mut marks = Vec::new();
-    let mut stacks = Stacks::default();
+    let mut out = old.drawn;
+    out.segments.clear();
+    out.queries.clear();
+    let mut marks = old.marks.unwrap_or_default();
+    marks.clear();
+    let mut stacks = old.stacks;
+    stacks.states.clear();
+    stacks.last = None;
     fresh(
         prog,
         &mut st,
@@ -478,7 +493,9 @@ pub(crate) fn draw(prog: &Program, s: &ModString, start: State, at: Resume) -> S
     );
     let marks = keep(marks, s.len());
     Sketch {
-        end: marks.as_ref().map(|_| snap(&st, &out, stacks.add(&st.stack))),
+        end: marks
+            .as_ref()
+            .map(|_| snap(&st, &out, stacks.add(&st.stack))),
         drawn: out,
         marks,
         stacks,
@@ -671,7 +688,7 @@ pub(crate) fn redraw(
     // runs of inactive modules are short on average is drawn whole.
     let marks = last.marks.as_ref().map_or(0, Vec::len);
     if old.len() < RUN_WORTH_COPYING * (marks + 1) {
-        return draw(prog, new, start, at);
+        return draw_in(prog, new, start, at, last);
     }
     copy_runs(prog, old, last, new, start, at)
 }
@@ -807,7 +824,9 @@ fn copy_runs(
     let mut spare = std::mem::take(&mut last.drawn.segments);
     spare.clear();
     Sketch {
-        end: marks.as_ref().map(|_| snap(&st, &out, stacks.add(&st.stack))),
+        end: marks
+            .as_ref()
+            .map(|_| snap(&st, &out, stacks.add(&st.stack))),
         drawn: out,
         marks,
         stacks,
