@@ -591,8 +591,9 @@ fn the_server_serves_the_page_and_runs_programs() {
 fn a_newer_run_supersedes_an_older_one() {
     let (_dir, file) = scratch("monopodial-tree.lsy");
     let s = serve(&file);
-    // A run long enough that the newer request arrives while it works.
-    let slow = "lsystem A { derive 8; axiom F; F -> F[+F]F[-F]F; }";
+    // A run long enough in any build that the newer request arrives while
+    // it works (a million steps; the newer request stops it).
+    let slow = "lsystem A { derive 1000000; axiom A(0); A(x) -> A(x + 1); }";
     let port = s.port;
     let first =
         std::thread::spawn(move || post(port, "/api/run", &json!({ "seq": 10, "source": slow })));
