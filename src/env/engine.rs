@@ -480,12 +480,13 @@ fn run_unit(
     inbox: &[Message],
 ) -> Result<Vec<GuideRun>, Diagnostic> {
     let mut live = start(scene, cfg, unit)?;
+    let plans: Vec<derive::Plan> = scene.programs.iter().map(derive::Plan::new).collect();
     let mut used = vec![0u32; scene.links.len()];
     answer(scene, cfg, &mut live, &used, 0)?;
     let mut next = 0; // the first message of `inbox` not yet delivered
     let mut t = 1;
     while t <= cfg.cap {
-        let any = derive_all(scene, cfg, &mut live, t)?;
+        let any = derive_all(scene, cfg, &plans, &mut live, t)?;
         if !any {
             // Idle: wait for the next message from outside, if any.
             match inbox.get(next) {
@@ -608,8 +609,15 @@ impl Live {
     }
 }
 
-/// Derives every system with steps left, once; whether any did.
-fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<bool, Diagnostic> {
+/// Derives every system with steps left, once (step `t`, each program by
+/// its plan in `plans`); whether any did.
+fn derive_all(
+    scene: &Scene,
+    cfg: Config,
+    plans: &[derive::Plan],
+    live: &mut [Live],
+    t: u32,
+) -> Result<bool, Diagnostic> {
     type Job<'a> = (&'a mut Instance, &'a mut Grown, &'a mut bool, &'a mut bool);
     let mut jobs: Vec<Job> = Vec::new();
     let mut any = false;
@@ -639,7 +647,6 @@ fn derive_all(scene: &Scene, cfg: Config, live: &mut [Live], t: u32) -> Result<b
             l.run.last_step = t;
         }
     }
-    let plans: Vec<derive::Plan> = scene.programs.iter().map(derive::Plan::new).collect();
     let results: Vec<Result<(), Diagnostic>> = jobs
         .into_par_iter()
         .map(|(inst, grown, fresh, settled)| {
