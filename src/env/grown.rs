@@ -332,10 +332,11 @@ impl Grown {
                 push(&mut out, p);
                 continue;
             }
-            let Some((_, pieces, string)) = cuts.next() else {
+            let Some((_, pieces, mut string)) = cuts.next() else {
                 continue;
             };
-            for c in pieces {
+            let n = pieces.len();
+            for (k, c) in pieces.into_iter().enumerate() {
                 let id = *next_id;
                 *next_id += 1;
                 push(
@@ -363,7 +364,18 @@ impl Grown {
                             params,
                             entry,
                             sketch,
-                        } => Piece::live(id, slice(&string, modules, params), entry, Some(*sketch)),
+                        } => {
+                            // The last piece keeps the string's lists.
+                            let own = if k + 1 == n {
+                                let mut own = std::mem::take(&mut string);
+                                own.syms.drain(..modules.start);
+                                own.params.drain(..params.start);
+                                own
+                            } else {
+                                slice(&string, modules, params)
+                            };
+                            Piece::live(id, own, entry, Some(*sketch))
+                        }
                     },
                 );
             }

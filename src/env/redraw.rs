@@ -378,10 +378,13 @@ pub(crate) fn cut(
     let mut out = Vec::with_capacity(2 * runs.len() + 1);
     let mut from = (0, 0, 0, 0);
     let mut entry: Option<(State, Vec<State>)> = at.map(|(a, b)| (*a, b.to_vec()));
+    // A live piece from `from` to `to`, given its drawing (queries at
+    // their modules in the span).
     let mut live = |from: (usize, usize, usize, usize),
                     to: (usize, usize, usize, usize),
                     snap_a: Option<Snap>,
-                    entry: Option<(State, Vec<State>)>|
+                    entry: Option<(State, Vec<State>)>,
+                    mut drawn: Probe|
      -> Cut {
         let (c, pc, sc, qc) = from;
         let (a, pa, sa, qa) = to;
@@ -418,19 +421,17 @@ pub(crate) fn cut(
             };
             (inside, rebase(end_at))
         });
-        let queries = drawn.queries[qc..qa]
-            .iter()
-            .map(|&(m, kind, state)| (m - c, kind, state))
-            .collect();
+        debug_assert_eq!(
+            (drawn.segments.len(), drawn.queries.len()),
+            (sa - sc, qa - qc)
+        );
+        drawn.queries.iter_mut().for_each(|q| q.0 -= c);
         Cut::Live {
             modules: c..a,
             params: pc..pa,
             entry,
             sketch: Box::new(Sketch {
-                drawn: Probe {
-                    segments: drawn.segments[sc..sa].to_vec(),
-                    queries,
-                },
+                drawn,
                 end: marked.as_ref().map(|m| m.1),
                 marks: marked.map(|m| m.0),
                 stacks: own,
@@ -440,7 +441,17 @@ pub(crate) fn cut(
     };
     for r in runs {
         if r.a > from.0 {
-            out.push(live(from, (r.a, r.pa, r.sa, r.qa), r.snap_a, entry.take()));
+            let part = Probe {
+                segments: drawn.segments[from.2..r.sa].to_vec(),
+                queries: drawn.queries[from.3..r.qa].to_vec(),
+            };
+            out.push(live(
+                from,
+                (r.a, r.pa, r.sa, r.qa),
+                r.snap_a,
+                entry.take(),
+                part,
+            ));
         }
         out.push(Cut::Kept {
             modules: r.a..r.b,
@@ -457,7 +468,11 @@ pub(crate) fn cut(
             drawn.segments.len(),
             drawn.queries.len(),
         );
-        out.push(live(from, to, None, entry));
+        // The last piece keeps the drawing's lists.
+        let mut rest = drawn;
+        rest.segments.drain(..from.2);
+        rest.queries.drain(..from.3);
+        out.push(live(from, to, None, entry, rest));
     }
     Some(out)
 }
