@@ -251,4 +251,38 @@ mod tests {
             Some(1)
         );
     }
+
+    #[test]
+    fn segments_gathered_in_a_corner_get_finer_cells_and_the_same_answers() {
+        // A dense lattice of short streets in one corner of a wide box (the
+        // growing tips of a drawing, far from one another), a few far away.
+        let mut segs = Vec::new();
+        for i in 0..40 {
+            for j in 0..40 {
+                let p = DVec2::new(i as f64, j as f64);
+                segs.push((p, p + DVec2::X));
+                segs.push((p, p + DVec2::Y));
+            }
+        }
+        segs.push((DVec2::new(1000.0, 1000.0), DVec2::new(1001.0, 1000.0)));
+        segs.push((DVec2::new(1000.0, 0.0), DVec2::new(1000.0, 1.0)));
+        let n = segs.len();
+        let grid = crate::geometry::index::segments::SegmentGrid::new(segs.clone());
+        // One cell per segment over the whole box would make cells of about
+        // 22 units, each holding some 1,000 segments of the lattice.
+        assert!(grid.cells() > 4 * n, "{} cells", grid.cells());
+        let mut r = Lcg(11);
+        let mut asks = Vec::new();
+        for _ in 0..300 {
+            let a = r.next() * std::f64::consts::TAU;
+            // On the lattice's points and lines, and between them.
+            let p = DVec2::new((r.next() * 45.0).round(), r.next() * 45.0);
+            asks.push((p, DVec2::new(a.cos(), a.sin())));
+            asks.push((DVec2::new(p.y, p.x), DVec2::X));
+        }
+        asks.push((DVec2::new(500.0, 500.0), DVec2::ONE.normalize()));
+        asks.push((DVec2::new(999.0, 0.5), DVec2::X));
+        let found = check(&segs, &asks);
+        assert!(found.iter().all(|&f| f > 200), "{found:?}");
+    }
 }

@@ -2,8 +2,10 @@
 //! and ray queries (the environment's `?X`, `?D_A` and `?N_A` over what a
 //! guide drew).
 //!
-//! Owns: choosing the cells (`Layout`: about one per segment, never smaller
-//! than the mean segment length, at most `MAX_CELLS_PER_AXIS` a side),
+//! Owns: choosing the cells (`Layout`: about one per segment where the
+//! segments are, up to `DENSER` per segment when they gather in a small part
+//! of their box; never smaller than the mean segment length, at most
+//! `MAX_CELLS_PER_AXIS` a side),
 //! registering each segment in the cells along it, and the three searches,
 //! written once over any store of cells (`Cells`: this grid's fixed lists,
 //! `AppendGrid`'s growing ones). Every search returns exactly what a scan of
@@ -573,6 +575,26 @@ fn fill(l: &Layout, segs: &[(DVec2, DVec2)], start: &mut Vec<u32>, items: &mut V
     start[0] = 0;
 }
 
+/// The most cells per segment a grid is given where its segments gather in
+/// a small part of their box.
+const DENSER: f64 = 16.0;
+
+/// How many cells of `l` hold the middle of a finite segment of `segs`.
+fn occupied(l: &Layout, segs: &[(DVec2, DVec2)]) -> usize {
+    let mut seen = vec![0u64; l.cells().div_ceil(64)];
+    let mut n = 0;
+    for s in segs.iter().filter(|s| finite(s)) {
+        let m = (s.0 + s.1) * 0.5;
+        let c = l.row(m.y) * l.nx + l.col(m.x);
+        let bit = 1u64 << (c % 64);
+        if seen[c / 64] & bit == 0 {
+            seen[c / 64] |= bit;
+            n += 1;
+        }
+    }
+    n
+}
+
 /// The lists a [`SegmentGrid`] is built in. A grid taken apart
 /// ([`SegmentGrid::into_lists`]) gives them back emptied, so that the next
 /// grid built from them ([`SegmentGrid::from_lists`]) allocates nothing new.
@@ -608,8 +630,12 @@ impl SegmentGrid {
             // A few segments: a scan of one cell is cheaper than sorting them into cells.
             Layout::single(min, max)
         } else {
-            // About one cell per segment, and cells at least as long as a mean segment.
-            Layout::fit(min, max, n as f64, len / n as f64)
+            // About one cell per segment where the segments are, and cells
+            // at least as long as a mean segment.
+            let mean = len / n as f64;
+            let coarse = Layout::fit(min, max, n as f64, mean);
+            let spread = coarse.cells() as f64 / occupied(&coarse, &segs).max(1) as f64;
+            Layout::fit(min, max, n as f64 * spread.clamp(1.0, DENSER), mean)
         };
         start.clear();
         items.clear();
