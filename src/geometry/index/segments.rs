@@ -577,7 +577,7 @@ fn fill(l: &Layout, segs: &[(DVec2, DVec2)], start: &mut Vec<u32>, items: &mut V
 
 /// The most cells per segment a grid is given where its segments gather in
 /// a small part of their box.
-const DENSER: f64 = 16.0;
+const DENSER: f64 = 8.0;
 
 /// How many cells of `l` hold the middle of a finite segment of `segs`.
 fn occupied(l: &Layout, segs: &[(DVec2, DVec2)]) -> usize {
