@@ -16,6 +16,9 @@
 //! messages, systems, steps). Timed on rayon's default pool (all cores) and on
 //! a one-thread pool.
 //!
+//! It allocates with mimalloc, as the `lsyc` binary does (a scene makes and
+//! drops many lists per step on every thread).
+//!
 //! `cargo bench --bench scene`.
 
 use criterion::{Criterion, SamplingMode, criterion_group};
@@ -24,6 +27,9 @@ use lsyc::frontend;
 use lsyc::run::{self, Options};
 use std::hint::black_box;
 use std::time::Duration;
+
+#[global_allocator]
+static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 /// The size of the benchmark's layout (the gallery picture uses the file's 0.25).
 const SIZE: &str = "SIZE=0.95";
