@@ -594,17 +594,23 @@ fn draw_scene(
     Ok(total)
 }
 
+/// An SVG writer into memory: a part of a drawing, or its template.
+type SvgPart = render::svg::SvgWriter<Vec<u8>>;
+
 /// What `draw_scene` into a `BoundsSink` gives (counts, and the bounds of
 /// the view), with the systems drawn in parallel: sums, minima and maxima
-/// do not depend on the order.
+/// do not depend on the order. With `svg`, each system is also written into
+/// a part of that writer in the same pass (per system, in the scene's order).
 fn scene_bounds(
     r: &SceneRun,
     seed: u64,
     view: View,
     boxes: &[Option<(glam::DVec3, glam::DVec3)>],
-) -> Result<(Drawn, Bounds), Diagnostic> {
+    svg: Option<&SvgPart>,
+) -> Result<(Drawn, Bounds, Vec<Option<SvgPart>>), Diagnostic> {
     let centres = program_centres(&r.scene);
-    let each: Vec<Result<(Drawn, Bounds), Diagnostic>> = r
+    type Each = Result<(Drawn, Bounds), Diagnostic>;
+    let (each, parts): (Vec<Each>, Vec<_>) = r
         .outcome
         .instances
         .par_iter()
@@ -615,12 +621,23 @@ fn scene_bounds(
                 bounds: Bounds::default(),
                 element_boxes: boxes,
             };
-            let mut clip = crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut sink);
-            r.interpret(inst, seed, &mut clip)?;
-            let kept = clip.kept;
-            Ok((kept, sink.bounds))
+            let mut part = svg.map(|w| w.part());
+            let drawn = match &mut part {
+                Some(part) => {
+                    let mut both = turtle::Tee(&mut sink, part);
+                    let mut clip =
+                        crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut both);
+                    r.interpret(inst, seed, &mut clip).map(|_| clip.kept)
+                }
+                None => {
+                    let mut clip =
+                        crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut sink);
+                    r.interpret(inst, seed, &mut clip).map(|_| clip.kept)
+                }
+            };
+            (drawn.map(|kept| (kept, sink.bounds)), part)
         })
-        .collect();
+        .unzip();
     let (mut total, mut bounds) = (Drawn::default(), Bounds::default());
     // In the order `draw_scene` meets them (the first error is its).
     for gi in 0..r.scene.guides.len() {
@@ -636,7 +653,7 @@ fn scene_bounds(
             }
         }
     }
-    Ok((total, bounds))
+    Ok((total, bounds, parts))
 }
 
 /// The `--stats` of a scene: the contract's fields plus answered queries and messages.
@@ -694,8 +711,24 @@ pub fn write_scene(
     let elements: &[crate::compile::ElementDef] =
         r.scene.programs.first().map_or(&[], |p| &p.elements);
     let boxes: Vec<_> = r.scene.programs.first().map_or(Vec::new(), element_boxes);
-    let (drawn, mut bounds) =
-        scene_bounds(r, seed, view, &boxes).map_err(OutputError::Diagnostic)?;
+    // SVG numbers have as many decimals as the picture's size asks; the
+    // guides' outlines are in the picture, and a drawing kept by the centre
+    // rule seldom reaches far beyond them. So every system is written once
+    // with the decimals the outlines give, in the pass that finds the
+    // bounds, and written again only when the bounds ask for others.
+    let guess = (format == Some(Format::Svg))
+        .then(|| {
+            let mut outlines = Bounds::default();
+            for g in &r.scene.guides {
+                for p in &g.polygon {
+                    outlines.add(view.project(p.extend(0.0)));
+                }
+            }
+            scene_svg_writer(Vec::new(), &outlines, view, elements)
+        })
+        .transpose()?;
+    let (drawn, mut bounds, parts) =
+        scene_bounds(r, seed, view, &boxes, guess.as_ref()).map_err(OutputError::Diagnostic)?;
     for g in &r.scene.guides {
         for p in &g.polygon {
             bounds.add(view.project(p.extend(0.0)));
@@ -711,7 +744,11 @@ pub fn write_scene(
     };
     let mut materials = Vec::new();
     match format {
-        Some(Format::Svg) => scene_svg(r, &frame, seed, guides, out)?,
+        Some(Format::Svg) => {
+            let w = scene_svg_writer(out, &frame.bounds, frame.view, frame.elements)?;
+            let parts = guess.filter(|g| g.same_numbers(&w)).map(|_| parts);
+            scene_svg(r, seed, guides, w, parts)?
+        }
         Some(Format::Png) => scene_png(r, &frame, picture, seed, guides, out)?,
         Some(Format::Obj) => {
             let options = scene_mesh_options(r);
@@ -756,32 +793,50 @@ pub fn write_scene(
     })
 }
 
-/// A scene as SVG: one layer per guide, then outlines and links.
-fn scene_svg(
+/// The SVG writer of a scene whose drawing has the (projected) `bounds`.
+fn scene_svg_writer<W: Write>(
+    out: W,
+    bounds: &Bounds,
+    view: View,
+    elements: &[crate::compile::ElementDef],
+) -> std::io::Result<render::svg::SvgWriter<W>> {
+    let used = vec![true; elements.len()];
+    render::svg::SvgWriter::new(out, view, bounds, elements, &used)
+}
+
+/// A scene as SVG into `w` (made by `scene_svg_writer`): one layer per
+/// guide, then outlines and links. `parts`, when given, are the systems
+/// already written into parts of a writer with the same numbers, one per
+/// system in the scene's order.
+fn scene_svg<W: Write>(
     r: &SceneRun,
-    frame: &SceneFrame,
     seed: u64,
     guides: bool,
-    out: &mut dyn Write,
+    mut w: render::svg::SvgWriter<W>,
+    mut parts: Option<Vec<Option<SvgPart>>>,
 ) -> Result<(), OutputError> {
-    let used = vec![true; frame.elements.len()];
-    let mut w = render::svg::SvgWriter::new(out, frame.view, &frame.bounds, frame.elements, &used)?;
     let centres = program_centres(&r.scene);
     let names: Vec<&str> = r.scene.guides.iter().map(|g| g.name.as_str()).collect();
     for (gi, g) in r.scene.guides.iter().enumerate() {
         w.begin_guide(names[gi]);
-        let insts: Vec<&crate::env::Instance> = r
+        let (insts, mut made): (Vec<&crate::env::Instance>, Vec<_>) = r
             .outcome
             .instances
             .iter()
-            .filter(|i| i.guide == gi)
-            .collect();
-        // Each system written on its own in parallel, then in order (the
-        // bytes one writer would write).
+            .enumerate()
+            .filter(|(_, i)| i.guide == gi)
+            .map(|(k, i)| (i, parts.as_mut().and_then(|p| p[k].take())))
+            .unzip();
+        // Each system written on its own in parallel (unless it was in the
+        // bounds' pass), then in order (the bytes one writer would write).
         let template = w.part();
         let parts: Vec<Result<_, Diagnostic>> = insts
             .par_iter()
-            .map(|inst| {
+            .zip(made.par_iter_mut())
+            .map(|(inst, made)| {
+                if let Some(part) = made.take() {
+                    return Ok(part);
+                }
                 let mut part = template.part();
                 let mut clip =
                     crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut part);

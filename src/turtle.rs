@@ -39,6 +39,32 @@ pub trait Sink {
     fn query(&mut self, _module: usize, _kind: u8, _state: &State) {}
 }
 
+/// Sends everything drawn to two sinks, the first first.
+pub struct Tee<'a>(pub &'a mut dyn Sink, pub &'a mut dyn Sink);
+
+impl Sink for Tee<'_> {
+    fn segment(&mut self, a: DVec3, b: DVec3, width: f64, color: u32) {
+        self.0.segment(a, b, width, color);
+        self.1.segment(a, b, width, color);
+    }
+    fn polygon(&mut self, points: &[DVec3], color: u32) {
+        self.0.polygon(points, color);
+        self.1.polygon(points, color);
+    }
+    fn element(&mut self, index: u16, at: DVec3, h: DVec3, l: DVec3, scale: f64, color: u32) {
+        self.0.element(index, at, h, l, scale, color);
+        self.1.element(index, at, h, l, scale, color);
+    }
+    fn contour(&mut self, element: Option<u16>) {
+        self.0.contour(element);
+        self.1.contour(element);
+    }
+    fn query(&mut self, module: usize, kind: u8, state: &State) {
+        self.0.query(module, kind, state);
+        self.1.query(module, kind, state);
+    }
+}
+
 /// The turtle's state, saved by `[` and restored by `]`.
 #[derive(Clone, Copy, Debug)]
 pub struct State {

@@ -142,6 +142,12 @@ impl<W: Write> SvgWriter<W> {
         }
     }
 
+    /// Whether `other`, made for the same view, writes numbers as this
+    /// writer does (the same decimals): its parts can be appended here.
+    pub fn same_numbers<V: Write>(&self, other: &SvgWriter<V>) -> bool {
+        self.decimals == other.decimals
+    }
+
     /// Writes `part` (from `part`) as if what it drew had been drawn into
     /// this writer; `false`, and nothing written, when its first segment
     /// would have gone on with this writer's open path (draw that part into

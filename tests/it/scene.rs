@@ -137,6 +137,59 @@ scene S {
 }
 ";
 
+/// A scene's SVG writes every system in the pass that finds the picture's
+/// bounds, with the decimals the guides' outlines ask for. A kept segment
+/// that reaches far beyond its small guide changes them: what was written is
+/// written again with the right ones.
+#[test]
+fn a_scene_svg_reaching_far_beyond_its_guides_has_the_right_numbers() {
+    let second = 0.2;
+    for reach in [0.4, 500.0] {
+        // The first F reaches `reach` both sides of the guide's middle (its
+        // centre is inside: kept); the second is within the guide.
+        let text = format!(
+            "lsystem Far {{ derive 0; axiom +(90) f({reach}) -(180) F({}) -(180) f({reach}) -(90) F({second}); }}
+scene S {{
+    guide a {{ polygon (0, 0) (1, 0) (1, 1) (0, 1); system Far; seed (0.5, 0.5) heading 0; }}
+    guide b {{ polygon (2, 0) (3, 0) (3, 1) (2, 1); system Far; seed (2.5, 0.25) heading 0; }}
+}}",
+            2.0 * reach
+        );
+        let r = run_scene(&text);
+        let mut svg = Vec::new();
+        run::write_scene(
+            &r,
+            Some(lsyc::run::Format::Svg),
+            Default::default(),
+            0,
+            false,
+            &mut svg,
+        )
+        .unwrap_or_else(|_| panic!("writes"));
+        let layers = read_layers(&String::from_utf8(svg).expect("utf-8"));
+        for (guide, at) in [("a", DVec2::new(0.5, 0.5)), ("b", DVec2::new(2.5, 0.25))] {
+            let mut ends: Vec<[f64; 2]> = layers
+                .segments(guide)
+                .iter()
+                .flat_map(|&(p, q)| [p - at, q - at])
+                .map(|d| [d.x, d.y])
+                .collect();
+            ends.sort_by(|x, y| x.partial_cmp(y).expect("numbers"));
+            ends.dedup();
+            // From (-reach, 0) to (reach, 0), then up from the middle.
+            let want = [[-reach, 0.0], [0.0, 0.0], [0.0, second], [reach, 0.0]];
+            assert_eq!(ends.len(), want.len(), "{guide} at {reach}: {ends:?}");
+            for (e, w) in ends.iter().zip(want) {
+                let tol = 1e-3 * (1.0 + reach);
+                assert!(
+                    (e[0] - w[0]).abs() < tol && (e[1] - w[1]).abs() < tol,
+                    "{guide} at {reach}: {e:?}, not {w:?}"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn a_crossing_sends_a_message_that_seeds_the_end_guide() {
     let r = run_scene(&LINKED.replace("TOKENS", "1"));

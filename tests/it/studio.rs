@@ -592,8 +592,10 @@ fn a_newer_run_supersedes_an_older_one() {
     let (_dir, file) = scratch("monopodial-tree.lsy");
     let s = serve(&file);
     // A run long enough in any build that the newer request arrives while
-    // it works (a million steps; the newer request stops it).
-    let slow = "lsystem A { derive 1000000; axiom A(0); A(x) -> A(x + 1); }";
+    // it works (a million steps of a hundred modules, over a second in a
+    // release build; the newer request stops it).
+    let slow = "lsystem A { derive 1000000; axiom B; B -> C C C C C C C C C C; \
+                C -> A(0) A(0) A(0) A(0) A(0) A(0) A(0) A(0) A(0) A(0); A(x) -> A(x + 1); }";
     let port = s.port;
     let first =
         std::thread::spawn(move || post(port, "/api/run", &json!({ "seq": 10, "source": slow })));
@@ -613,8 +615,9 @@ fn a_newer_run_supersedes_an_older_one() {
 fn a_newer_edit_stops_a_run_in_progress() {
     let (_dir, file) = scratch("monopodial-tree.lsy");
     let s = serve(&file);
-    // A million cheap steps: over a minute in a debug build if left to run.
-    let slow = "lsystem A {\n    derive 1000000;\n    axiom A(0);\n    A(x) -> A(x + 1);\n}\n";
+    // A million cheap steps of a hundred modules: over a second in a
+    // release build, many minutes in a debug build if left to run.
+    let slow = "lsystem A {\n    derive 1000000;\n    axiom B;\n    B -> C C C C C C C C C C;\n    C -> A(0) A(0) A(0) A(0) A(0) A(0) A(0) A(0) A(0) A(0);\n    A(x) -> A(x + 1);\n}\n";
     let port = s.port;
     let started = std::time::Instant::now();
     let first =
