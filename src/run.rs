@@ -622,19 +622,14 @@ fn scene_bounds(
                 element_boxes: boxes,
             };
             let mut part = svg.map(|w| w.part());
-            let drawn = match &mut part {
-                Some(part) => {
-                    let mut both = turtle::Tee(&mut sink, part);
-                    let mut clip =
-                        crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut both);
-                    r.interpret(inst, seed, &mut clip).map(|_| clip.kept)
-                }
-                None => {
-                    let mut clip =
-                        crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut sink);
-                    r.interpret(inst, seed, &mut clip).map(|_| clip.kept)
-                }
+            let mut discard = turtle::Discard;
+            let written: &mut dyn turtle::Sink = match &mut part {
+                Some(part) => part,
+                None => &mut discard,
             };
+            let mut both = turtle::Tee(&mut sink, written);
+            let mut clip = crate::env::clip::Clip::new(&g.polygon, &centres[g.program], &mut both);
+            let drawn = r.interpret(inst, seed, &mut clip).map(|_| clip.kept);
             (drawn.map(|kept| (kept, sink.bounds)), part)
         })
         .unzip();
@@ -716,23 +711,20 @@ pub fn write_scene(
     // rule seldom reaches far beyond them. So every system is written once
     // with the decimals the outlines give, in the pass that finds the
     // bounds, and written again only when the bounds ask for others.
+    let mut outlines = Bounds::default();
+    for g in &r.scene.guides {
+        for p in &g.polygon {
+            outlines.add(view.project(p.extend(0.0)));
+        }
+    }
     let guess = (format == Some(Format::Svg))
-        .then(|| {
-            let mut outlines = Bounds::default();
-            for g in &r.scene.guides {
-                for p in &g.polygon {
-                    outlines.add(view.project(p.extend(0.0)));
-                }
-            }
-            scene_svg_writer(Vec::new(), &outlines, view, elements)
-        })
+        .then(|| scene_svg_writer(Vec::new(), &outlines, view, elements))
         .transpose()?;
     let (drawn, mut bounds, parts) =
         scene_bounds(r, seed, view, &boxes, guess.as_ref()).map_err(OutputError::Diagnostic)?;
-    for g in &r.scene.guides {
-        for p in &g.polygon {
-            bounds.add(view.project(p.extend(0.0)));
-        }
+    if outlines.any {
+        bounds.add(outlines.min);
+        bounds.add(outlines.max);
     }
     if let Some(first) = r.scene.programs.first() {
         check_extent(&bounds, first).map_err(OutputError::Diagnostic)?;
