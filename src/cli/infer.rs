@@ -1,7 +1,7 @@
 //! `lsyc infer ART.svg [-o OUT.lsy]`: a line drawing to the D0L system that
 //! draws it (see `lsyc::infer::lines`), or, when it is not a line drawing or
 //! no D0L system is found within `--budget-ms`, a drawing of repeated
-//! elements to sequence and branching rules (see `lsyc::infer::art`), and
+//! elements to sequence and branching rules (see `lsyc::infer::elements`), and
 //! `lsyc infer --skeleton SKETCH.svg [-o TREE.lsy] [--3d]`: a tree sketch to a
 //! recursive L-system (see `lsyc::infer`).
 //!
@@ -9,7 +9,7 @@
 //! file written atomically, never over the sketch) and the exit statuses.
 
 use super::Reporter;
-use lsyc::infer::art::{self, rules::Weights};
+use lsyc::infer::elements::{self, rules::Weights};
 use lsyc::infer::lines::{self, Lines};
 use lsyc::infer::{self, MAX_SVG_BYTES, Options};
 use lsyc::source;
@@ -91,10 +91,10 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         );
         return 2;
     };
-    let mut opts = art::Options {
+    let mut opts = elements::Options {
         symmetrize: args.symmetrize,
         reflect: args.reflect,
-        ..art::Options::default()
+        ..elements::Options::default()
     };
     if !(args.similarity.is_finite() && args.similarity > 0.0 && args.similarity < 1.0) {
         reporter.error(
@@ -204,7 +204,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
             }
         }
     };
-    let result = art::from_svg(&data, &name, &opts, &mut progress);
+    let result = elements::from_svg(&data, &name, &opts, &mut progress);
     if let Some(b) = &bar {
         b.finish_and_clear();
     }

@@ -6,11 +6,11 @@
 //! (`skeleton`), productions, pre-reduction, the reduction table and the reduced
 //! productions (`productions`), and the program as an AST (`emit`), printed by
 //! `fmt::format_file`; and `lsyc infer ART.svg`, repeated elements to sequence
-//! and branching rules (`art`), or, for a line drawing, the D0L system
+//! and branching rules (`elements`), or, for a line drawing, the D0L system
 //! that draws it (`lines`). Must not write files or print: the CLI does that, and
 //! must not panic on any input.
 
-pub mod art;
+pub mod elements;
 pub mod emit;
 pub mod lines;
 pub mod productions;
@@ -82,12 +82,12 @@ pub enum InferError {
     NoElements { file: String, skipped: usize },
     #[error(
         "`{file}` has coordinates as large as {largest:.1e}; lsyc infers drawings whose coordinates stay within ±{:e} user units (scale the drawing down)",
-        art::read::MAX_COORDINATE
+        elements::read::MAX_COORDINATE
     )]
     Huge { file: String, largest: f64 },
     #[error(
         "`{file}` has {elements} elements; lsyc infers drawings of up to {}",
-        art::MAX_ELEMENTS
+        elements::MAX_ELEMENTS
     )]
     TooManyElements { file: String, elements: usize },
 }

@@ -1,5 +1,5 @@
 //! Reading an SVG document safely: the checks a drawing passes before usvg
-//! sees it, and the usvg options both readers (`strokes`, `art::read`) use.
+//! sees it, and the usvg options both readers (`strokes`, `elements::read`) use.
 //!
 //! Owns: refusing what would make usvg (or lsyc after it) run out of memory,
 //! stack or time on a hostile file: compressed data (usvg inflates it without

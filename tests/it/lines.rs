@@ -25,7 +25,7 @@ use crate::support::root;
 use glam::DVec2;
 use lsyc::ast::{File, Item, Module, Stmt};
 use lsyc::geometry::index::PointGrid;
-use lsyc::infer::art::read;
+use lsyc::infer::elements::read;
 use lsyc::infer::lines::{self, Lines};
 use std::collections::HashMap;
 use std::path::Path;

@@ -22,7 +22,7 @@ pub mod turtle;
 pub mod verify;
 
 use crate::ast::{Expr, Module};
-use crate::infer::art::emit::nice;
+use crate::infer::elements::emit::nice;
 use crate::infer::emit::sym;
 use glam::DVec2;
 use grammar::{Grammar, Outcome};
