@@ -19,7 +19,7 @@ use crate::ast::{
     ModName, Module, ModuleDecl, Node, Prop, PropValue, Rule, Stmt,
 };
 use crate::infer::emit::{comment, node, sym, var};
-use crate::infer::strokes::Seg;
+use crate::infer::svg::Seg;
 use crate::span::Span;
 use glam::DVec2;
 use std::collections::{BTreeMap, BTreeSet};

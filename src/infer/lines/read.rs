@@ -8,8 +8,7 @@
 //! steps (`turtle::Builder`). Must not search grammars.
 
 use super::turtle::{Angles, Builder, Tree, Unfit};
-use crate::infer::strokes::{self, Seg};
-use crate::infer::svg;
+use crate::infer::svg::{self, Seg};
 use glam::DVec2;
 
 /// The most points a line drawing may have (as `infer ART.svg` reads).
@@ -33,7 +32,7 @@ pub enum NotLines {
 /// The polylines of a line drawing, document order, world coordinates.
 pub fn polylines(data: &[u8]) -> Result<Vec<Vec<DVec2>>, NotLines> {
     let tree = svg::parse(data).map_err(|_| NotLines::Shapes("not an SVG lsyc reads"))?;
-    let user = strokes::user_space(data, &tree);
+    let user = svg::user_space(data, &tree);
     let mut out: Vec<Vec<DVec2>> = Vec::new();
     let mut points = 0usize;
     for (path, t) in svg::paths(&tree) {
@@ -54,7 +53,7 @@ pub fn polylines(data: &[u8]) -> Result<Vec<Vec<DVec2>>, NotLines> {
         if points > MAX_POINTS {
             return Err(NotLines::Shapes("too many points"));
         }
-        for sub in strokes::subpaths(path, user.pre_concat(t)) {
+        for sub in svg::subpaths(path, user.pre_concat(t)) {
             let mut line: Vec<DVec2> = Vec::new();
             let mut first = None;
             for s in sub {
@@ -101,7 +100,7 @@ fn filled_area(path: &usvg::Path) -> f64 {
     );
     let size = (hi - lo).max_element();
     let mut total = 0.0;
-    for sub in strokes::subpaths(path, usvg::Transform::identity()) {
+    for sub in svg::subpaths(path, usvg::Transform::identity()) {
         let ring: Vec<DVec2> = sub
             .iter()
             .filter_map(|s| match *s {
