@@ -3,15 +3,16 @@
 //! no D0L system is found within `--budget-ms`, a drawing of repeated
 //! elements to sequence and branching rules (see `lsyc::infer::elements`), and
 //! `lsyc infer --skeleton SKETCH.svg [-o TREE.lsy] [--3d]`: a tree sketch to a
-//! recursive L-system (see `lsyc::infer`).
+//! recursive L-system (see `lsyc::infer::sketch`).
 //!
 //! Owns: the options, reading the sketch, where the program goes (stdout, or a
 //! file written atomically, never over the sketch) and the exit statuses.
 
 use super::Reporter;
+use lsyc::infer::MAX_SVG_BYTES;
 use lsyc::infer::elements::{self, rules::Weights};
 use lsyc::infer::lines::{self, Lines};
-use lsyc::infer::{self, MAX_SVG_BYTES, Options};
+use lsyc::infer::sketch::{self, Options};
 use lsyc::source;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -362,7 +363,7 @@ fn run_sketch(args: &Args, sketch: &std::path::Path, reporter: &Reporter) -> u8 
         three_d: args.three_d,
         seed: args.seed,
     };
-    let inferred = match infer::skeleton_from_svg(&data, &name, &opts) {
+    let inferred = match sketch::from_svg(&data, &name, &opts) {
         Ok(i) => i,
         Err(e) => {
             reporter.error(&e.to_string(), None);

@@ -9,8 +9,8 @@
 //! `KW`; in 3D each child also pitches out of the sketch plane. Measurements
 //! are rounded here. Must not print text: `fmt::format_file` does.
 
-use super::productions::{Analysis, Child, Production};
-use super::skeleton::{Branch, Skeleton, angle};
+use super::sketch::productions::{Analysis, Child, Production};
+use super::sketch::skeleton::{Branch, Skeleton, angle};
 use crate::ast::{
     BinOp, Block, ConstDecl, Expr, ExprKind, File, Ident, Item, Lsystem, ModName, Module,
     ModuleDecl, Node, Rule, Stmt,

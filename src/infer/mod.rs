@@ -1,44 +1,22 @@
-//! Inference: drawings become `.lsy` programs.
-//!
-//! Owns: `lsyc infer --skeleton`, a tree sketch (SVG strokes) to a recursive
-//! L-system after Hegde & Rathi, *Modeling Vegetation with L-systems Using an
-//! Image*: strokes (`strokes`), the tree with Douglas–Peucker simplification
-//! (`skeleton`), productions, pre-reduction, the reduction table and the reduced
-//! productions (`productions`), and the program as an AST (`emit`), printed by
-//! `fmt::format_file`; and `lsyc infer ART.svg`, repeated elements to sequence
+//! Inference: drawings become `.lsy` programs, one folder for each kind of
+//! drawing read: `lsyc infer --skeleton`, a tree sketch to a recursive
+//! L-system (`sketch`); `lsyc infer ART.svg`, repeated elements to sequence
 //! and branching rules (`elements`), or, for a line drawing, the D0L system
-//! that draws it (`lines`). Must not write files or print: the CLI does that, and
-//! must not panic on any input.
+//! that draws it (`lines`). `svg` reads drawings safely for all three.
+//!
+//! Owns: the errors of inference and the size limit of a drawing. Must not
+//! write files or print: the CLI does that, and must not panic on any input.
 
 pub mod elements;
 pub mod emit;
 pub mod lines;
-pub mod productions;
-pub mod skeleton;
-pub mod strokes;
+pub mod sketch;
 pub mod svg;
 
-use crate::ast::File;
-use productions::Analysis;
-use skeleton::Skeleton;
 use thiserror::Error;
 
 /// The largest sketch read, in bytes.
 pub const MAX_SVG_BYTES: usize = 64 * 1024 * 1024;
-/// The most strokes a sketch may have (attaching them is quadratic).
-pub const MAX_STROKES: usize = 10_000;
-
-/// Options of `lsyc infer --skeleton`.
-#[derive(Clone, Debug, Default)]
-pub struct Options {
-    /// Douglas–Peucker tolerance in drawing units; relative to the drawing's
-    /// size when `None`.
-    pub epsilon: Option<f64>,
-    /// Emit a 3D program.
-    pub three_d: bool,
-    /// Seed of the 3D perturbation.
-    pub seed: u64,
-}
 
 /// Why a sketch cannot be inferred. Each message names the file.
 #[derive(Debug, Error, PartialEq)]
@@ -61,7 +39,9 @@ pub enum InferError {
     #[error("`{file}` is larger than {} MiB", MAX_SVG_BYTES >> 20)]
     TooLarge { file: String },
     #[error(
-        "`{file}` has more than {MAX_STROKES} strokes; lsyc infers trees of up to {MAX_STROKES}"
+        "`{file}` has more than {} strokes; lsyc infers trees of up to {}",
+        sketch::MAX_STROKES,
+        sketch::MAX_STROKES
     )]
     TooManyStrokes { file: String },
     #[error(
@@ -122,52 +102,4 @@ pub fn names(name: &str) -> (String, String) {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| name.to_string());
     (source, emit::system_name(&stem))
-}
-
-/// A sketch and what was inferred from it.
-pub struct Inferred {
-    pub skeleton: Skeleton,
-    pub analysis: Analysis,
-    /// The program.
-    pub file: File,
-    /// The program in canonical text.
-    pub text: String,
-}
-
-/// Infers a program from the bytes of an SVG sketch named `name` (a file name,
-/// for messages and the header).
-pub fn skeleton_from_svg(data: &[u8], name: &str, opts: &Options) -> Result<Inferred, InferError> {
-    if data.len() > MAX_SVG_BYTES {
-        return Err(InferError::TooLarge { file: name.into() });
-    }
-    let strokes = strokes::read(data, MAX_STROKES).map_err(|why| InferError::refused(name, why))?;
-    if strokes.is_empty() {
-        return Err(InferError::NoStrokes { file: name.into() });
-    }
-    if strokes.len() > MAX_STROKES {
-        return Err(InferError::TooManyStrokes { file: name.into() });
-    }
-    let sk = skeleton::build(&strokes, opts.epsilon).map_err(|d| InferError::Detached {
-        file: name.into(),
-        stroke: d.stroke,
-        distance: d.distance,
-        limit: d.limit,
-    })?;
-    let analysis = Analysis::new(&sk.children());
-    let (source, system) = names(name);
-    let settings = emit::Settings {
-        source: &source,
-        name: system,
-        strokes: strokes.len(),
-        numbers: strokes.iter().map(|s| s.number).collect(),
-        seed_3d: opts.three_d.then_some(opts.seed),
-    };
-    let file = emit::program(&sk, &analysis, &settings);
-    let text = crate::fmt::format_file(&file);
-    Ok(Inferred {
-        skeleton: sk,
-        analysis,
-        file,
-        text,
-    })
 }

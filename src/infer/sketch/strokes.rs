@@ -7,7 +7,7 @@
 //! messages, with its element's id and its stroke width in world units, and
 //! the limits on strokes and points. Must not decide what a stroke means.
 
-use super::svg::{self, Refusal, flatten, subpaths, user_space};
+use crate::infer::svg::{self, Refusal, flatten, subpaths, user_space};
 use glam::DVec2;
 use usvg::Transform;
 
