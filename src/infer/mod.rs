@@ -8,8 +8,8 @@
 //! write files or print: the CLI does that, and must not panic on any input.
 
 pub mod elements;
-pub mod emit;
 pub mod lines;
+pub mod program;
 pub mod sketch;
 pub mod svg;
 
@@ -87,19 +87,4 @@ impl InferError {
             },
         }
     }
-}
-
-/// For a drawing's file name: the name the header gives (the file's own name)
-/// and the lsystem's name (from its stem: `sketch-tree.svg` → `SketchTree`).
-pub fn names(name: &str) -> (String, String) {
-    let path = std::path::Path::new(name);
-    let stem = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let source = path
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| name.to_string());
-    (source, emit::system_name(&stem))
 }

@@ -215,7 +215,7 @@ pub fn from_svg(
     stats.clusters = grammar.clusters;
     stats.rules_ms = ms(t);
     let t = Instant::now();
-    let (source, system) = super::names(name);
+    let (source, system) = super::program::names(name);
     let settings = emit::Settings {
         source: &source,
         name: system,

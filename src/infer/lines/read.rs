@@ -190,8 +190,8 @@ pub fn reading(lines: &[Vec<DVec2>], split: u32) -> Result<Reading, NotLines> {
         if r < 1.0 || (u - r).abs() > 0.2 {
             return Err(NotLines::Steps(format!(
                 "a segment of length {} is not a whole number of steps of {}",
-                crate::number::source(crate::infer::elements::emit::nice(len, len * 1e-4)),
-                crate::number::source(crate::infer::elements::emit::nice(step, step * 1e-4))
+                crate::number::source(crate::infer::program::nice(len, len * 1e-4)),
+                crate::number::source(crate::infer::program::nice(step, step * 1e-4))
             )));
         }
         rr += r * r;
@@ -351,10 +351,10 @@ fn refine(
     // within three standard errors, whichever is shorter when both fit the
     // segments as well (25.7 rather than 360/14 = 25.714286; 60 rather than
     // a 60.01 that rounding in the drawing suggests; 22.5 = 360/16).
-    let written = crate::infer::elements::emit::nice(delta, (3.0 * err).max(1e-6));
+    let written = crate::infer::program::nice(delta, (3.0 * err).max(1e-6));
     let m = (360.0 / delta).round();
     let exact = 360.0 / m;
-    let decimals = |v: f64| crate::number::decimals(crate::infer::elements::emit::nice(v, 1e-9));
+    let decimals = |v: f64| crate::number::decimals(crate::infer::program::nice(v, 1e-9));
     let periodic = if m >= 2.0 && (exact - delta).abs() <= 0.02 * exact {
         let (_, rw) = fit(written);
         let (_, re) = fit(exact);

@@ -9,6 +9,7 @@
 //! `fmt::format_file`. Must not write files or print (the CLI does), and must
 //! not panic on any input.
 
+pub mod emit;
 pub mod productions;
 pub mod skeleton;
 pub mod strokes;
@@ -63,15 +64,15 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Result<Inferred, Inf
         limit: d.limit,
     })?;
     let analysis = Analysis::new(&sk.children());
-    let (source, system) = super::names(name);
-    let settings = super::emit::Settings {
+    let (source, system) = super::program::names(name);
+    let settings = emit::Settings {
         source: &source,
         name: system,
         strokes: strokes.len(),
         numbers: strokes.iter().map(|s| s.number).collect(),
         seed_3d: opts.three_d.then_some(opts.seed),
     };
-    let file = super::emit::program(&sk, &analysis, &settings);
+    let file = emit::program(&sk, &analysis, &settings);
     let text = crate::fmt::format_file(&file);
     Ok(Inferred {
         skeleton: sk,
