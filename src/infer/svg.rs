@@ -1,7 +1,7 @@
-//! Reading an SVG document safely, for every reader of drawings (`strokes`,
-//! `elements::read`, `lines::read`): the checks a drawing passes before usvg
-//! sees it, the usvg options, the walk over its paths, and each path's
-//! subpaths in the language's world.
+//! Reading an SVG document safely, for every reader of drawings
+//! (`sketch::strokes`, `elements::read`, `lines::read`): the checks a drawing
+//! passes before usvg sees it, the usvg options, the walk over its paths, and
+//! each path's subpaths in the language's world.
 //!
 //! Owns: refusing what would make usvg (or lsyc after it) run out of memory,
 //! stack or time on a hostile file: compressed data (usvg inflates it without
