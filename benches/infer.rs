@@ -24,7 +24,7 @@
 
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, Criterion, SamplingMode, criterion_group};
-use lsyc::infer::art::{self, Options};
+use lsyc::infer::elements::{self, Options};
 use std::fmt::Write;
 use std::hint::black_box;
 use std::time::Duration;
@@ -108,7 +108,7 @@ fn bench(c: &mut Criterion) {
     group.sample_size(10);
     group.warm_up_time(Duration::from_millis(1));
     // Not the grid: its windows have five subpaths each, and 504,000 subpaths are
-    // over the reader's limit (`art::read::MAX_SUBPATHS`), so it ends with an error.
+    // over the reader's limit (`elements::read::MAX_SUBPATHS`), so it ends with an error.
     for kind in ["rings", "clutter"] {
         measure(&mut group, kind, 100_800);
     }
@@ -122,7 +122,7 @@ fn bench(c: &mut Criterion) {
 fn measure(group: &mut BenchmarkGroup<WallTime>, kind: &str, n: usize) {
     let svg = drawing(kind, n);
     let name = format!("{kind}-{n}.svg");
-    match art::from_svg(svg.as_bytes(), &name, &Options::default(), &mut |_| {}) {
+    match elements::from_svg(svg.as_bytes(), &name, &Options::default(), &mut |_| {}) {
         Ok(first) => eprintln!(
             "{name}: {} elements, {} kinds, {} rules in {} rounds",
             first.stats.elements, first.stats.kinds, first.stats.rules, first.stats.rounds
@@ -139,7 +139,7 @@ fn measure(group: &mut BenchmarkGroup<WallTime>, kind: &str, n: usize) {
     }
     group.bench_function(&name, |b| {
         b.iter(|| {
-            art::from_svg(
+            elements::from_svg(
                 black_box(svg.as_bytes()),
                 &name,
                 &Options::default(),

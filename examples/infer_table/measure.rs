@@ -11,7 +11,7 @@
 
 use glam::DVec2;
 use lsyc::geometry::index::PointGrid;
-use lsyc::infer::art::{self, Options, read};
+use lsyc::infer::elements::{self, Options, read};
 use lsyc::{frontend, run};
 use std::path::Path;
 use std::time::Instant;
@@ -58,7 +58,7 @@ pub fn measure(path: &Path) -> Result<Row, String> {
         .unwrap_or_default();
     let data = std::fs::read(path).map_err(|e| format!("cannot read: {e}"))?;
     let t = Instant::now();
-    let inferred = art::from_svg(&data, &name, &Options::default(), &mut |_| {})
+    let inferred = elements::from_svg(&data, &name, &Options::default(), &mut |_| {})
         .map_err(|e| format!("infer: {e}"))?;
     let infer_ms = t.elapsed().as_secs_f64() * 1e3;
     let t = Instant::now();

@@ -5,7 +5,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use lsyc::infer::{self, Options};
+use lsyc::infer::sketch::{self, Options};
 use lsyc::{fmt, parser};
 
 fuzz_target!(|data: &[u8]| {
@@ -15,7 +15,7 @@ fuzz_target!(|data: &[u8]| {
         three_d,
         ..Options::default()
     };
-    let Ok(inferred) = infer::skeleton_from_svg(data, "fuzz.svg", &opts) else {
+    let Ok(inferred) = sketch::from_svg(data, "fuzz.svg", &opts) else {
         return;
     };
     let parsed = parser::parse(&inferred.text);

@@ -1,20 +1,23 @@
 //! `lsyc infer ART.svg [-o OUT.lsy]`: a line drawing to the D0L system that
-//! draws it (see `lsyc::infer::lines`), or, when it is not a line drawing or
-//! no D0L system is found within `--budget-ms`, a drawing of repeated
-//! elements to sequence and branching rules (see `lsyc::infer::art`), and
+//! draws it, or, when it is not a line drawing or no D0L system is found
+//! within `--budget-ms`, a drawing of repeated elements to sequence and
+//! branching rules (see `lsyc::infer::from_svg`, which chooses), and
 //! `lsyc infer --skeleton SKETCH.svg [-o TREE.lsy] [--3d]`: a tree sketch to a
-//! recursive L-system (see `lsyc::infer`).
+//! recursive L-system (see `lsyc::infer::sketch`).
 //!
-//! Owns: the options, reading the sketch, where the program goes (stdout, or a
-//! file written atomically, never over the sketch) and the exit statuses.
+//! Owns: the arguments and their checks (into one `infer::Options`), reading
+//! the drawing, printing what inference tells (notes, warnings, `--stats`),
+//! where the program goes (stdout, or a file written atomically, never over
+//! the drawing) and the exit statuses. Must not choose what a drawing is:
+//! `lsyc::infer` does.
 
 use super::Reporter;
-use lsyc::infer::art::{self, rules::Weights};
-use lsyc::infer::lines::{self, Lines};
-use lsyc::infer::{self, MAX_SVG_BYTES, Options};
+use lsyc::infer::elements::{self, rules::Weights};
+use lsyc::infer::{self, MAX_SVG_BYTES, Options, Outcome, lines, sketch};
 use lsyc::source;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
+use std::time::Duration;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -81,110 +84,99 @@ pub struct Args {
 }
 
 pub fn run(args: &Args, reporter: &Reporter) -> u8 {
-    if let Some(sketch) = &args.skeleton {
-        return run_sketch(args, sketch, reporter);
-    }
-    let Some(art) = &args.art else {
-        reporter.error(
-            "give a drawing to infer from",
-            Some("lsyc infer ART.svg [-o OUT.lsy] (repeated elements), or lsyc infer --skeleton SKETCH.svg [-o TREE.lsy] (a tree sketch)"),
-        );
-        return 2;
-    };
-    let mut opts = art::Options {
-        symmetrize: args.symmetrize,
-        reflect: args.reflect,
-        ..art::Options::default()
-    };
-    if !(args.similarity.is_finite() && args.similarity > 0.0 && args.similarity < 1.0) {
-        reporter.error(
-            &format!(
-                "--similarity must be between 0 and 1 (a misfit relative to the element's size), not {}",
-                args.similarity
-            ),
-            None,
-        );
-        return 2;
-    }
-    opts.similarity = args.similarity;
-    if let Some(j) = args.jitter {
-        if !(j.is_finite() && j > 0.0 && j < 1.0) {
+    let (input, what) = match (&args.skeleton, &args.art) {
+        (Some(sketch), _) => (sketch, "sketch"),
+        (None, Some(art)) => (art, "drawing"),
+        (None, None) => {
             reporter.error(
-                &format!(
-                    "--jitter must be between 0 and 1 (0.1: turns vary by ±3°, steps by ±10%), not {j}"
-                ),
-                None,
+                "give a drawing to infer from",
+                Some("lsyc infer ART.svg [-o OUT.lsy] (repeated elements), or lsyc infer --skeleton SKETCH.svg [-o TREE.lsy] (a tree sketch)"),
             );
             return 2;
         }
-        opts.jitter = Some(j);
-    }
-    if let Some(w) = &args.weights {
-        match parse_weights(w) {
-            Ok(w) => opts.weights = w,
-            Err(why) => {
-                reporter.error(&format!("--weights {w}: {why}"), None);
-                return 2;
-            }
+    };
+    let opts = match options(args) {
+        Ok(o) => o,
+        Err(why) => {
+            reporter.error(&why, None);
+            return 2;
         }
-    }
-    if let Some(code) = same_as_input(args.output.as_deref(), art, "drawing", reporter) {
+    };
+    if let Some(code) = same_as_input(args.output.as_deref(), input, what, reporter) {
         return code;
     }
-    let name = art.display().to_string();
-    let data = match read_input(art, &name, reporter) {
+    let name = input.display().to_string();
+    let data = match read_input(input, &name, reporter) {
         Ok(d) => d,
         Err(code) => return code,
     };
-    if !args.no_lines {
-        let opts = lines::Options {
-            budget: std::time::Duration::from_millis(args.budget_ms),
-            ..lines::Options::default()
-        };
-        match lines::from_svg(&data, &name, &opts) {
-            Lines::Found(found) => {
-                if args.stats {
-                    print_stats(args, &found.stats);
-                }
-                let g = &found.grammar;
-                let summary = format!(
-                    "{name}: a line drawing of {} steps, drawn by a D0L system of {} rule{} at derive {}",
-                    found.redraw.steps,
-                    found.stats.rules,
-                    if found.stats.rules == 1 { "" } else { "s" },
-                    g.depth
-                );
-                return write_program(args.output.as_deref(), &found.text, &summary, reporter);
-            }
-            Lines::Unexplained {
-                why,
-                steps,
-                timed_out,
-                stats,
-            } => {
-                if args.stats {
-                    print_stats(args, &stats);
-                }
-                let what = if steps > 0 {
-                    format!("a line drawing of {steps} steps")
-                } else {
-                    "a line drawing".to_string()
-                };
-                let how = if timed_out {
-                    format!(
-                        "no D0L system found within {} ms (--budget-ms)",
-                        args.budget_ms
-                    )
-                } else {
-                    why
-                };
-                reporter.note(&format!(
-                    "{name}: {what}, but {how}; inferring its elements instead"
-                ));
-            }
-            Lines::NotLines(_) => {}
-        }
+    let inferred = if args.skeleton.is_some() {
+        infer_sketch(&data, &name, &opts, reporter)
+    } else {
+        infer_drawing(args, &data, &name, &opts, reporter)
+    };
+    match inferred {
+        Ok((text, summary)) => write_program(args.output.as_deref(), &text, &summary, reporter),
+        Err(code) => code,
     }
+}
+
+/// The one `Options` of inference from the arguments, or what is wrong with
+/// them.
+fn options(args: &Args) -> Result<Options, String> {
+    if let Some(e) = args.epsilon
+        && !(e.is_finite() && e >= 0.0)
+    {
+        return Err(format!(
+            "--epsilon must be a distance of 0 or more, not {e}"
+        ));
+    }
+    if !(args.similarity.is_finite() && args.similarity > 0.0 && args.similarity < 1.0) {
+        return Err(format!(
+            "--similarity must be between 0 and 1 (a misfit relative to the element's size), not {}",
+            args.similarity
+        ));
+    }
+    if let Some(j) = args.jitter
+        && !(j.is_finite() && j > 0.0 && j < 1.0)
+    {
+        return Err(format!(
+            "--jitter must be between 0 and 1 (0.1: turns vary by ±3°, steps by ±10%), not {j}"
+        ));
+    }
+    let weights = match &args.weights {
+        Some(w) => parse_weights(w).map_err(|why| format!("--weights {w}: {why}"))?,
+        None => Weights::default(),
+    };
+    Ok(Options {
+        sketch: sketch::Options {
+            epsilon: args.epsilon,
+            three_d: args.three_d,
+            seed: args.seed,
+        },
+        elements: elements::Options {
+            weights,
+            symmetrize: args.symmetrize,
+            similarity: args.similarity,
+            jitter: args.jitter,
+            reflect: args.reflect,
+        },
+        lines: (!args.no_lines).then(|| lines::Options {
+            budget: Duration::from_millis(args.budget_ms),
+            ..lines::Options::default()
+        }),
+    })
+}
+
+/// `lsyc infer ART.svg`: the program and its summary, with what inference
+/// tells printed on the way, or the exit status.
+fn infer_drawing(
+    args: &Args,
+    data: &[u8],
+    name: &str,
+    opts: &Options,
+    reporter: &Reporter,
+) -> Result<(String, String), u8> {
     let bar = std::io::stderr()
         .is_terminal()
         .then(|| indicatif::ProgressBar::new(0));
@@ -204,17 +196,36 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
             }
         }
     };
-    let result = art::from_svg(&data, &name, &opts, &mut progress);
+    let outcome = infer::from_svg(data, name, opts, &mut progress);
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let inferred = match result {
-        Ok(i) => i,
-        Err(e) => {
-            reporter.error(&e.to_string(), None);
-            return 1;
+    let (lines, elements) = match outcome {
+        Outcome::Lines(found) => {
+            if args.stats {
+                print_stats(args, &found.stats);
+            }
+            let summary = format!(
+                "{name}: a line drawing of {} steps, drawn by a D0L system of {} rule{} at derive {}",
+                found.redraw.steps,
+                found.stats.rules,
+                if found.stats.rules == 1 { "" } else { "s" },
+                found.grammar.depth
+            );
+            return Ok((found.text, summary));
         }
+        Outcome::Elements { lines, elements } => (lines, elements),
     };
+    if let Some(gave_way) = lines {
+        if args.stats {
+            print_stats(args, &gave_way.stats);
+        }
+        reporter.note(&gave_way.note);
+    }
+    let inferred = elements.map_err(|e| {
+        reporter.error(&e.to_string(), None);
+        1
+    })?;
     for s in &inferred.skipped {
         reporter.warning(&format!(
             "{name}: skipped {s} (only paths and shapes are elements)"
@@ -232,7 +243,27 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         st.rules,
         if st.rules == 1 { "" } else { "s" },
     );
-    write_program(args.output.as_deref(), &inferred.text, &summary, reporter)
+    Ok((inferred.text, summary))
+}
+
+/// `lsyc infer --skeleton SKETCH.svg`: the program and its summary, or the
+/// exit status.
+fn infer_sketch(
+    data: &[u8],
+    name: &str,
+    opts: &Options,
+    reporter: &Reporter,
+) -> Result<(String, String), u8> {
+    let inferred = sketch::from_svg(data, name, &opts.sketch).map_err(|e| {
+        reporter.error(&e.to_string(), None);
+        1
+    })?;
+    let summary = format!(
+        "{name}: {} strokes, {} productions after reduction",
+        inferred.skeleton.branches.len(),
+        inferred.analysis.reduced.len().max(1)
+    );
+    Ok((inferred.text, summary))
 }
 
 /// Whether the program goes to stdout (no `-o`, or `-o -`).
@@ -337,42 +368,4 @@ fn write_program(
         }
     }
     0
-}
-
-fn run_sketch(args: &Args, sketch: &std::path::Path, reporter: &Reporter) -> u8 {
-    if let Some(e) = args.epsilon
-        && !(e.is_finite() && e >= 0.0)
-    {
-        reporter.error(
-            &format!("--epsilon must be a distance of 0 or more, not {e}"),
-            None,
-        );
-        return 2;
-    }
-    if let Some(code) = same_as_input(args.output.as_deref(), sketch, "sketch", reporter) {
-        return code;
-    }
-    let name = sketch.display().to_string();
-    let data = match read_input(sketch, &name, reporter) {
-        Ok(d) => d,
-        Err(code) => return code,
-    };
-    let opts = Options {
-        epsilon: args.epsilon,
-        three_d: args.three_d,
-        seed: args.seed,
-    };
-    let inferred = match infer::skeleton_from_svg(&data, &name, &opts) {
-        Ok(i) => i,
-        Err(e) => {
-            reporter.error(&e.to_string(), None);
-            return 1;
-        }
-    };
-    let summary = format!(
-        "{name}: {} strokes, {} productions after reduction",
-        inferred.skeleton.branches.len(),
-        inferred.analysis.reduced.len().max(1)
-    );
-    write_program(args.output.as_deref(), &inferred.text, &summary, reporter)
 }

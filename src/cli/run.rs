@@ -301,7 +301,7 @@ fn load(
             reporter.error(&format!("cannot read `{file}`: {e}"), None);
             1u8
         })?;
-        if let Err(why) = lsyc::infer::art::replace_element(&mut fe.file, name, &data) {
+        if let Err(why) = lsyc::infer::elements::replace_element(&mut fe.file, name, &data) {
             reporter.error(&format!("--element {spec}: {why}"), None);
             return Err(1);
         }

@@ -1,46 +1,28 @@
-//! Inference: drawings become `.lsy` programs.
+//! Inference: drawings become `.lsy` programs, one folder for each kind of
+//! drawing read: `lsyc infer --skeleton`, a tree sketch to a recursive
+//! L-system (`sketch`); `lsyc infer ART.svg`, a line drawing to the D0L
+//! system that draws it (`lines`), or else repeated elements to sequence and
+//! branching rules (`elements`). `svg` reads drawings safely for all three,
+//! and each writes its program with the one kit of `program`.
 //!
-//! Owns: `lsyc infer --skeleton`, a tree sketch (SVG strokes) to a recursive
-//! L-system after Hegde & Rathi, *Modeling Vegetation with L-systems Using an
-//! Image*: strokes (`strokes`), the tree with Douglas–Peucker simplification
-//! (`skeleton`), productions, pre-reduction, the reduction table and the reduced
-//! productions (`productions`), and the program as an AST (`emit`), printed by
-//! `fmt::format_file`; and `lsyc infer ART.svg`, repeated elements to sequence
-//! and branching rules (`art`), or, for a line drawing, the D0L system
-//! that draws it (`lines`). Must not write files or print: the CLI does that, and
-//! must not panic on any input.
+//! Owns: the one `Options` of inference, the choice between a line drawing's
+//! grammar and the elements (`from_svg`), the errors and the size limit of a
+//! drawing. Must not write files or print: the CLI does that, and must not
+//! panic on any input.
 
-pub mod art;
-pub mod emit;
+pub mod elements;
 pub mod lines;
-pub mod productions;
-pub mod skeleton;
-pub mod strokes;
+pub mod program;
+pub mod sketch;
 pub mod svg;
 
-use crate::ast::File;
-use productions::Analysis;
-use skeleton::Skeleton;
+use std::time::Duration;
 use thiserror::Error;
 
-/// The largest sketch read, in bytes.
+/// The largest drawing read, in bytes.
 pub const MAX_SVG_BYTES: usize = 64 * 1024 * 1024;
-/// The most strokes a sketch may have (attaching them is quadratic).
-pub const MAX_STROKES: usize = 10_000;
 
-/// Options of `lsyc infer --skeleton`.
-#[derive(Clone, Debug, Default)]
-pub struct Options {
-    /// Douglas–Peucker tolerance in drawing units; relative to the drawing's
-    /// size when `None`.
-    pub epsilon: Option<f64>,
-    /// Emit a 3D program.
-    pub three_d: bool,
-    /// Seed of the 3D perturbation.
-    pub seed: u64,
-}
-
-/// Why a sketch cannot be inferred. Each message names the file.
+/// Why a drawing cannot be inferred. Each message names the file.
 #[derive(Debug, Error, PartialEq)]
 pub enum InferError {
     #[error("`{file}` is not an SVG drawing lsyc can read: {why}")]
@@ -61,7 +43,9 @@ pub enum InferError {
     #[error("`{file}` is larger than {} MiB", MAX_SVG_BYTES >> 20)]
     TooLarge { file: String },
     #[error(
-        "`{file}` has more than {MAX_STROKES} strokes; lsyc infers trees of up to {MAX_STROKES}"
+        "`{file}` has more than {} strokes; lsyc infers trees of up to {}",
+        sketch::MAX_STROKES,
+        sketch::MAX_STROKES
     )]
     TooManyStrokes { file: String },
     #[error(
@@ -82,12 +66,12 @@ pub enum InferError {
     NoElements { file: String, skipped: usize },
     #[error(
         "`{file}` has coordinates as large as {largest:.1e}; lsyc infers drawings whose coordinates stay within ±{:e} user units (scale the drawing down)",
-        art::read::MAX_COORDINATE
+        elements::read::MAX_COORDINATE
     )]
     Huge { file: String, largest: f64 },
     #[error(
         "`{file}` has {elements} elements; lsyc infers drawings of up to {}",
-        art::MAX_ELEMENTS
+        elements::MAX_ELEMENTS
     )]
     TooManyElements { file: String, elements: usize },
 }
@@ -109,65 +93,115 @@ impl InferError {
     }
 }
 
-/// For a drawing's file name: the name the header gives (the file's own name)
-/// and the lsystem's name (from its stem: `sketch-tree.svg` → `SketchTree`).
-pub fn names(name: &str) -> (String, String) {
-    let path = std::path::Path::new(name);
-    let stem = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let source = path
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| name.to_string());
-    (source, emit::system_name(&stem))
+/// Options of inference, a part for each kind of drawing.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Tree sketches (`lsyc infer --skeleton`).
+    pub sketch: sketch::Options,
+    /// Drawings of repeated elements.
+    pub elements: elements::Options,
+    /// The search for a line drawing's D0L system, tried before the
+    /// elements; `None` infers the elements at once.
+    pub lines: Option<lines::Options>,
 }
 
-/// A sketch and what was inferred from it.
-pub struct Inferred {
-    pub skeleton: Skeleton,
-    pub analysis: Analysis,
-    /// The program.
-    pub file: File,
-    /// The program in canonical text.
-    pub text: String,
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            sketch: sketch::Options::default(),
+            elements: elements::Options::default(),
+            lines: Some(lines::Options::default()),
+        }
+    }
 }
 
-/// Infers a program from the bytes of an SVG sketch named `name` (a file name,
-/// for messages and the header).
-pub fn skeleton_from_svg(data: &[u8], name: &str, opts: &Options) -> Result<Inferred, InferError> {
-    if data.len() > MAX_SVG_BYTES {
-        return Err(InferError::TooLarge { file: name.into() });
+/// What `from_svg` made of a drawing.
+pub enum Outcome {
+    /// A line drawing, and the D0L system that draws it.
+    Lines(Box<lines::Inferred>),
+    /// The drawing's elements and the rules that place them, or why there
+    /// are none.
+    Elements {
+        /// Why it is not a line drawing's grammar, when it is a line drawing.
+        lines: Option<LinesGaveWay>,
+        elements: Result<Box<elements::Inferred>, InferError>,
+    },
+}
+
+/// A line drawing no D0L system was found for, so its elements are inferred
+/// instead.
+pub struct LinesGaveWay {
+    /// What the search did.
+    pub stats: lines::Stats,
+    /// What to tell: `walk.svg: a line drawing of 400 steps, but …; inferring
+    /// its elements instead`.
+    pub note: String,
+}
+
+impl LinesGaveWay {
+    fn new(
+        file: &str,
+        budget: Duration,
+        why: String,
+        steps: usize,
+        timed_out: bool,
+        stats: lines::Stats,
+    ) -> LinesGaveWay {
+        let what = if steps > 0 {
+            format!("a line drawing of {steps} steps")
+        } else {
+            "a line drawing".to_string()
+        };
+        let how = if timed_out {
+            format!(
+                "no D0L system found within {} ms (--budget-ms)",
+                budget.as_millis()
+            )
+        } else {
+            why
+        };
+        LinesGaveWay {
+            stats,
+            note: format!("{file}: {what}, but {how}; inferring its elements instead"),
+        }
     }
-    let strokes = strokes::read(data, MAX_STROKES).map_err(|why| InferError::refused(name, why))?;
-    if strokes.is_empty() {
-        return Err(InferError::NoStrokes { file: name.into() });
+}
+
+/// Infers a program from the bytes of an SVG drawing named `name` (a file
+/// name, for messages and the header): the D0L system of a line drawing
+/// when `opts.lines` finds one, else sequence and branching rules of its
+/// elements; `progress` is told how many instances are left as the
+/// elements' rules are found.
+pub fn from_svg(
+    data: &[u8],
+    name: &str,
+    opts: &Options,
+    progress: &mut dyn FnMut(usize),
+) -> Outcome {
+    let mut gave_way = None;
+    if let Some(search) = &opts.lines {
+        match lines::from_svg(data, name, search) {
+            lines::Lines::Found(found) => return Outcome::Lines(found),
+            lines::Lines::Unexplained {
+                why,
+                steps,
+                timed_out,
+                stats,
+            } => {
+                gave_way = Some(LinesGaveWay::new(
+                    name,
+                    search.budget,
+                    why,
+                    steps,
+                    timed_out,
+                    stats,
+                ));
+            }
+            lines::Lines::NotLines(_) => {}
+        }
     }
-    if strokes.len() > MAX_STROKES {
-        return Err(InferError::TooManyStrokes { file: name.into() });
+    Outcome::Elements {
+        lines: gave_way,
+        elements: elements::from_svg(data, name, &opts.elements, progress).map(Box::new),
     }
-    let sk = skeleton::build(&strokes, opts.epsilon).map_err(|d| InferError::Detached {
-        file: name.into(),
-        stroke: d.stroke,
-        distance: d.distance,
-        limit: d.limit,
-    })?;
-    let analysis = Analysis::new(&sk.children());
-    let (source, system) = names(name);
-    let settings = emit::Settings {
-        source: &source,
-        name: system,
-        strokes: strokes.len(),
-        numbers: strokes.iter().map(|s| s.number).collect(),
-        seed_3d: opts.three_d.then_some(opts.seed),
-    };
-    let file = emit::program(&sk, &analysis, &settings);
-    let text = crate::fmt::format_file(&file);
-    Ok(Inferred {
-        skeleton: sk,
-        analysis,
-        file,
-        text,
-    })
 }

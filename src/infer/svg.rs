@@ -1,5 +1,7 @@
-//! Reading an SVG document safely: the checks a drawing passes before usvg
-//! sees it, and the usvg options both readers (`strokes`, `art::read`) use.
+//! Reading an SVG document safely, for every reader of drawings
+//! (`sketch::strokes`, `elements::read`, `lines::read`): the checks a drawing
+//! passes before usvg sees it, the usvg options, the walk over its paths, and
+//! each path's subpaths in the language's world.
 //!
 //! Owns: refusing what would make usvg (or lsyc after it) run out of memory,
 //! stack or time on a hostile file: compressed data (usvg inflates it without
@@ -7,12 +9,16 @@
 //! that draw themselves or expand to too many elements (a "billion laughs"
 //! of `<use>`s), and images (never loaded: an `href` may name any file, even
 //! a device). The checks are one pass over the XML, iterative and linear in
-//! its size. Must not decide what an element means.
+//! its size. Also owns the map back to the document's user space (so that
+//! what lsyc draws lies on the input), turning the SVG's y-down user space
+//! into the language's y-up world (x, −y), subpaths as segments (`Seg`) and
+//! flattening them into points. Must not decide what an element means.
 
+use glam::DVec2;
 use std::collections::HashMap;
 use thiserror::Error;
-use usvg::Transform;
 use usvg::roxmltree;
+use usvg::tiny_skia_path::{PathSegment, Point, Transform};
 
 /// The most XML nodes (elements, text, comments) a document may have.
 pub const MAX_XML_NODES: u32 = 2_000_000;
@@ -22,6 +28,8 @@ pub const MAX_NESTING: usize = 1_000;
 /// The most elements a document may draw once every `<use>` is expanded
 /// (usvg's own bound).
 pub const MAX_EXPANDED: u64 = 1_000_000;
+/// Points per flattened curve segment.
+pub const CURVE_STEPS: usize = 12;
 
 /// Why a document is not read. The messages say what to change; the file
 /// name is added by whoever reports it.
@@ -212,7 +220,7 @@ fn expansion(doc: &roxmltree::Document) -> Result<(), Refusal> {
 /// The paths of a parsed drawing, groups depth first in document order, each
 /// with its transform (usvg's user space to the path's own coordinates),
 /// with an explicit stack (the walk never recurses, however deep the
-/// groups). Both readers, elements and strokes, walk drawings through this.
+/// groups). Every reader (strokes, elements, lines) walks drawings through this.
 /// The transform composes the groups' own transforms: usvg 0.49's
 /// `abs_transform` applies a `<use>`'s transform twice when it draws a
 /// `<symbol>` (linebender/resvg#1056).
@@ -234,6 +242,142 @@ pub fn paths(tree: &usvg::Tree) -> impl Iterator<Item = (&usvg::Path, Transform)
         }
         None
     })
+}
+
+/// The map from usvg's coordinates back to the document's user space: usvg
+/// puts the root `viewBox` (and a root `transform`) into one group around the
+/// content, which the paths' transforms include; lsyc works in user units so that
+/// what it draws back lies on the input.
+pub fn user_space(data: &[u8], tree: &usvg::Tree) -> Transform {
+    let root_group = || match tree.root().children() {
+        [usvg::Node::Group(g)] if g.id().is_empty() => g.transform().invert(),
+        _ => None,
+    };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return Transform::identity();
+    };
+    let Ok(doc) = usvg::roxmltree::Document::parse(text) else {
+        return Transform::identity();
+    };
+    let svg = doc.root_element();
+    let size = tree.size();
+    let moved = svg.attribute("transform").is_some()
+        || svg.attribute("viewBox").is_some_and(|v| {
+            v.parse::<svgtypes::ViewBox>().is_ok_and(|b| {
+                b.x != 0.0
+                    || b.y != 0.0
+                    || (b.w - f64::from(size.width())).abs() > 1e-9
+                    || (b.h - f64::from(size.height())).abs() > 1e-9
+            })
+        });
+    if moved {
+        root_group().unwrap_or_default()
+    } else {
+        Transform::identity()
+    }
+}
+
+/// One segment of a subpath in world coordinates (y up); each starts where the
+/// previous one ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Seg {
+    Move(DVec2),
+    Line(DVec2),
+    Quad(DVec2, DVec2),
+    Cubic(DVec2, DVec2, DVec2),
+    Close,
+}
+
+/// The subpaths of a path in world coordinates (`t`, the map from its own
+/// coordinates to the document's user space, applied, and y flipped up),
+/// exactly: curves stay curves. A subpath whose points are not all finite is
+/// dropped.
+pub fn subpaths(path: &usvg::Path, t: Transform) -> Vec<Vec<Seg>> {
+    let map = |mut p: Point| {
+        t.map_point(&mut p);
+        DVec2::new(f64::from(p.x), -f64::from(p.y))
+    };
+    let mut out: Vec<Vec<Seg>> = Vec::new();
+    let mut current: Vec<Seg> = Vec::new();
+    for seg in path.data().segments() {
+        let s = match seg {
+            PathSegment::MoveTo(p) => {
+                if !current.is_empty() {
+                    out.push(std::mem::take(&mut current));
+                }
+                Seg::Move(map(p))
+            }
+            PathSegment::LineTo(p) => Seg::Line(map(p)),
+            PathSegment::QuadTo(c, p) => Seg::Quad(map(c), map(p)),
+            PathSegment::CubicTo(c1, c2, p) => Seg::Cubic(map(c1), map(c2), map(p)),
+            PathSegment::Close => Seg::Close,
+        };
+        current.push(s);
+    }
+    if !current.is_empty() {
+        out.push(current);
+    }
+    out.retain(|sub| {
+        sub.iter()
+            .all(|s| seg_points(s).iter().all(|p| p.is_finite()))
+    });
+    out
+}
+
+/// The points a segment names (controls, then its end).
+pub fn seg_points(s: &Seg) -> Vec<DVec2> {
+    match *s {
+        Seg::Move(p) | Seg::Line(p) => vec![p],
+        Seg::Quad(c, p) => vec![c, p],
+        Seg::Cubic(a, b, p) => vec![a, b, p],
+        Seg::Close => Vec::new(),
+    }
+}
+
+/// A subpath as a polyline: curves flattened into `CURVE_STEPS` pieces, no two
+/// consecutive points equal; a closed subpath ends where it started.
+pub fn flatten(sub: &[Seg]) -> Vec<DVec2> {
+    let pt = |p: DVec2| kurbo::Point::new(p.x, p.y);
+    let mut bez = kurbo::BezPath::new();
+    // A subpath that does not begin with a move starts at the origin, which is
+    // not one of its points.
+    let implicit = !matches!(sub.first(), Some(Seg::Move(_)) | None);
+    if implicit {
+        bez.move_to(pt(DVec2::ZERO));
+    }
+    for s in sub {
+        match *s {
+            Seg::Move(p) => bez.move_to(pt(p)),
+            Seg::Line(p) => bez.line_to(pt(p)),
+            Seg::Quad(c, p) => bez.quad_to(pt(c), pt(p)),
+            Seg::Cubic(c1, c2, p) => bez.curve_to(pt(c1), pt(c2), pt(p)),
+            Seg::Close => bez.close_path(),
+        }
+    }
+    // The one flattener, with inference's finer count; then no repeated
+    // points, and a closed subpath ends at its start.
+    let mut points = Vec::new();
+    for (i, line) in crate::path::flatten_steps(&bez, CURVE_STEPS)
+        .into_iter()
+        .enumerate()
+    {
+        let first = line.points.first().copied();
+        let skip = usize::from(i == 0 && implicit);
+        for &p in &line.points[skip..] {
+            push(&mut points, p);
+        }
+        if let (true, Some(f)) = (line.closed, first) {
+            push(&mut points, f);
+        }
+    }
+    points
+}
+
+/// Appends `p` unless it repeats the last point.
+fn push(points: &mut Vec<DVec2>, q: DVec2) {
+    if points.last().is_none_or(|l| l.distance(q) > 1e-9) {
+        points.push(q);
+    }
 }
 
 #[cfg(test)]

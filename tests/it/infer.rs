@@ -6,15 +6,16 @@
 //! programs are snapshots.
 
 use crate::support::{drawing_distance as distance, rel, render_plain, root};
-use lsyc::infer::art::{self, Options, read};
+use lsyc::infer::elements::{self, Options, read};
 use lsyc::{fmt, frontend};
 use std::path::Path;
 use std::process::Command;
 
-fn infer(path: &Path, opts: &Options) -> art::Inferred {
+fn infer(path: &Path, opts: &Options) -> elements::Inferred {
     let data = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", rel(path)));
     let name = path.file_name().unwrap().to_string_lossy().into_owned();
-    art::from_svg(&data, &name, opts, &mut |_| {}).unwrap_or_else(|e| panic!("{}: {e}", rel(path)))
+    elements::from_svg(&data, &name, opts, &mut |_| {})
+        .unwrap_or_else(|e| panic!("{}: {e}", rel(path)))
 }
 
 /// Infers, checks, runs with the `lsyc` binary, and returns the program and
@@ -132,7 +133,7 @@ fn recovered_counts_and_transforms_are_the_generators() {
     // Weighting only proximity groups the nearer neighbours first: the
     // columns (10 apart) before the rows (13 apart).
     let near = Options {
-        weights: art::rules::Weights {
+        weights: elements::rules::Weights {
             n: 0.0,
             h: 1.0,
             phi: 0.0,

@@ -18,14 +18,15 @@
 //! taken off the list.
 //!
 //! Also: a random walk on the square lattice, which no D0L system explains,
-//! falls back to element inference within the time bound, and hostile or
-//! unrelated drawings end quickly without a panic.
+//! falls back to element inference within the time bound (a choice
+//! `infer::from_svg` makes), and hostile or unrelated drawings end quickly
+//! without a panic.
 
 use crate::support::root;
 use glam::DVec2;
 use lsyc::ast::{File, Item, Module, Stmt};
 use lsyc::geometry::index::PointGrid;
-use lsyc::infer::art::read;
+use lsyc::infer::elements::read;
 use lsyc::infer::lines::{self, Lines};
 use std::collections::HashMap;
 use std::path::Path;
@@ -648,5 +649,54 @@ fn hostile_line_drawings_end_within_the_budget() {
             Lines::Found(i) => panic!("{what}: a D0L system?\n{}", i.text),
             _ => {}
         }
+    }
+}
+
+/// `infer::from_svg` makes the choice `lsyc infer ART.svg` prints: a line
+/// drawing's D0L system when one draws it, else the elements, with a note
+/// when a line drawing gave way.
+#[test]
+fn inference_chooses_between_lines_and_elements() {
+    use lsyc::infer::{self, Options, Outcome};
+    let dir = tempfile::tempdir().expect("tempdir");
+    let koch = dir.path().join("koch.svg");
+    let example = root().join("lang-examples/koch-curve-a.lsy");
+    let out = lsyc(&[
+        "run",
+        example.to_str().unwrap(),
+        "-n",
+        "2",
+        "-o",
+        koch.to_str().unwrap(),
+    ]);
+    ok(&out, "koch");
+    let koch = std::fs::read(&koch).expect("reads");
+    let infer = |data: &[u8], opts: &Options| infer::from_svg(data, "x.svg", opts, &mut |_| {});
+    let opts = Options::default();
+    assert!(matches!(infer(&koch, &opts), Outcome::Lines(_)));
+    let no_lines = Options {
+        lines: None,
+        ..Options::default()
+    };
+    assert!(matches!(
+        infer(&koch, &no_lines),
+        Outcome::Elements {
+            lines: None,
+            elements: Ok(_)
+        }
+    ));
+    let mut no_time = Options::default();
+    if let Some(search) = &mut no_time.lines {
+        search.budget = Duration::ZERO;
+    }
+    match infer(random_walk(40).as_bytes(), &no_time) {
+        Outcome::Elements {
+            lines: Some(gave_way),
+            elements: Ok(_),
+        } => assert_eq!(
+            gave_way.note,
+            "x.svg: a line drawing, but no D0L system found within 0 ms (--budget-ms); inferring its elements instead"
+        ),
+        _ => panic!("a random walk: not its elements, with a note"),
     }
 }

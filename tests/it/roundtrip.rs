@@ -27,7 +27,7 @@ use glam::DVec2;
 use lsyc::ast::{Expr, ExprKind, File, Item, ModName, Module, PropValue, Stmt};
 use lsyc::check::Checked;
 use lsyc::frontend;
-use lsyc::infer::art::{self, Options, read};
+use lsyc::infer::elements::{self, Options, read};
 use lsyc::vm::Random;
 use lsyc::vm::expr::evaluate;
 use std::collections::{BTreeMap, HashMap};
@@ -555,7 +555,7 @@ struct Original {
 fn measure(case: &str, column: &str, svg: &[u8], orig: &Original, dir: &Path) -> Outcome {
     let mut broken = Vec::new();
     let name = format!("{case}.svg");
-    let program = match art::from_svg(svg, &name, &Options::default(), &mut |_| {}) {
+    let program = match elements::from_svg(svg, &name, &Options::default(), &mut |_| {}) {
         Ok(inferred) => inferred.text,
         Err(e) => {
             return Outcome {

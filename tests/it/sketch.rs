@@ -3,7 +3,7 @@
 //! derivation redraws the sketch, `-n` grows it, 3D programs write valid OBJ.
 
 use crate::support::{render_plain, root};
-use lsyc::infer::{self, Inferred, Options};
+use lsyc::infer::sketch::{self, Inferred, Options};
 use lsyc::run::{self, Derived, Format, Picture};
 use lsyc::{fmt, frontend};
 use std::process::Command;
@@ -15,8 +15,7 @@ fn sketch_path(name: &str) -> std::path::PathBuf {
 fn infer_sketch(name: &str, opts: &Options) -> Inferred {
     let path = sketch_path(name);
     let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
-    infer::skeleton_from_svg(&data, &format!("{name}.svg"), opts)
-        .unwrap_or_else(|e| panic!("{name}: {e}"))
+    sketch::from_svg(&data, &format!("{name}.svg"), opts).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 /// Checks the program (no diagnostic at all), checks it is canonical, derives it.
@@ -115,7 +114,7 @@ fn every_sketch_is_drawn_where_it_was_and_grows_with_more_steps() {
 fn figure_2_sketched_gives_the_papers_productions() {
     let inf = infer_sketch("figure2", &Options::default());
     let a = &inf.analysis;
-    let show = |ps: &[lsyc::infer::productions::Production]| {
+    let show = |ps: &[lsyc::infer::sketch::productions::Production]| {
         ps.iter().map(|p| p.to_string()).collect::<Vec<_>>()
     };
     assert_eq!(a.initial.len(), 15);

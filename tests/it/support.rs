@@ -59,7 +59,7 @@ pub fn parse_errors(text: &str) -> Vec<Diagnostic> {
 
 /// Points spread along every element outline of an SVG drawing, `step` apart.
 fn drawing_samples(svg: &[u8], step: f64) -> Vec<glam::DVec2> {
-    let d = lsyc::infer::art::read::read(svg).expect("reads");
+    let d = lsyc::infer::elements::read::read(svg).expect("reads");
     let mut out = Vec::new();
     for e in &d.elements {
         for line in &e.outline {

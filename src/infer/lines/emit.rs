@@ -1,8 +1,8 @@
-//! The program of a line drawing as an `ast::File`: a header comment saying
-//! how well it matches, then one lsystem with `angle`, `derive`, `step`
-//! (when it is not 1), the axiom behind the moves that place it on the
-//! drawing, the rules, and `interpret` rules for drawing letters other
-//! than `F`.
+//! The program of a line drawing as an `ast::File`, built with the shared kit
+//! (`infer::program`): a header comment saying how well it matches, then one
+//! lsystem with `angle`, `derive`, `step` (when it is not 1), the axiom behind
+//! the moves that place it on the drawing, the rules, and `interpret` rules
+//! for drawing letters other than `F`.
 //!
 //! Owns: the shape of programs inferred from line drawings (see
 //! `docs/language.md`, "Line drawings"). Must not print text:
@@ -10,8 +10,8 @@
 
 use super::grammar::{Action, Grammar, Sym};
 use super::verify::Redraw;
-use crate::ast::{Block, Expr, File, Ident, Item, Lsystem, ModName, Module, Node, Rule, Stmt};
-use crate::infer::emit::{comment, node, sym};
+use crate::ast::{Expr, File, ModName, Module, Node, Rule, Stmt};
+use crate::infer::program::{self, comment, file, lsystem, named, node, sym, var};
 
 /// What the emitter needs besides the grammar.
 pub struct Settings<'a> {
@@ -44,15 +44,8 @@ fn modules(g: &Grammar, syms: &[Sym]) -> Vec<Module> {
 
 fn rule(pred: Module, succ: Vec<Module>, interpret: bool) -> Node<Stmt> {
     node(Stmt::Rule(Rule {
-        label: None,
         interpret,
-        decompose: false,
-        left: None,
-        pred,
-        right: None,
-        cond: None,
-        weight: None,
-        succ,
+        ..program::rule(pred, succ)
     }))
 }
 
@@ -124,12 +117,8 @@ pub fn program(g: &Grammar, s: &Settings) -> File {
     // The move that places the drawing is not one of the grammar's moves.
     let placed = s.frame.iter().any(|m| m.name == ModName::Name("f".into()));
     if placed && g.letters.iter().any(|l| l.name == 'f' && l.rule.is_some()) {
-        let d = || crate::infer::emit::var("d");
-        let mut r = rule(
-            Module::new(ModName::Name("f".into()), Some(vec![d()])),
-            vec![Module::new(ModName::Name("f".into()), Some(vec![d()]))],
-            false,
-        );
+        let f = || named("f", vec![var("d")]);
+        let mut r = rule(f(), vec![f()], false);
         r.trivia.trailing = Some(comment("the move that puts the drawing in place"));
         stmts.push(r);
     }
@@ -139,20 +128,8 @@ pub fn program(g: &Grammar, s: &Settings) -> File {
             stmts.push(rule(sym(l.name, None), vec![sym('F', None)], true));
         }
     }
-    let mut sys = node(Item::Lsystem(Lsystem {
-        name: Ident::new(s.name.clone()),
-        params: Vec::new(),
-        body: Block {
-            stmts,
-            end_comments: Vec::new(),
-        },
-    }));
+    let mut sys = lsystem(&s.name, stmts);
     sys.trivia.leading = header(g, s).iter().map(comment).collect();
     sys.trivia.blank_after_leading = true;
-    File {
-        items: Block {
-            stmts: vec![sys],
-            end_comments: Vec::new(),
-        },
-    }
+    file(vec![sys])
 }

@@ -22,8 +22,7 @@ pub mod turtle;
 pub mod verify;
 
 use crate::ast::{Expr, Module};
-use crate::infer::art::emit::nice;
-use crate::infer::emit::sym;
+use crate::infer::program::{nice, sym};
 use glam::DVec2;
 use grammar::{Grammar, Outcome};
 use read::{NotLines, Reading};
@@ -368,7 +367,7 @@ fn finish(
     if !(round.start == DVec2::ZERO && p_c == DVec2::ZERO) {
         round.start = place(r.start, p_c, round.heading, step);
     }
-    let (source, system) = super::names(name);
+    let (source, system) = super::program::names(name);
     let settings = |(angle, f): (f64, Frame)| emit::Settings {
         source: &source,
         name: system.clone(),

@@ -8,8 +8,7 @@
 //! steps (`turtle::Builder`). Must not search grammars.
 
 use super::turtle::{Angles, Builder, Tree, Unfit};
-use crate::infer::strokes::{self, Seg};
-use crate::infer::svg;
+use crate::infer::svg::{self, Seg};
 use glam::DVec2;
 
 /// The most points a line drawing may have (as `infer ART.svg` reads).
@@ -33,7 +32,7 @@ pub enum NotLines {
 /// The polylines of a line drawing, document order, world coordinates.
 pub fn polylines(data: &[u8]) -> Result<Vec<Vec<DVec2>>, NotLines> {
     let tree = svg::parse(data).map_err(|_| NotLines::Shapes("not an SVG lsyc reads"))?;
-    let user = strokes::user_space(data, &tree);
+    let user = svg::user_space(data, &tree);
     let mut out: Vec<Vec<DVec2>> = Vec::new();
     let mut points = 0usize;
     for (path, t) in svg::paths(&tree) {
@@ -54,7 +53,7 @@ pub fn polylines(data: &[u8]) -> Result<Vec<Vec<DVec2>>, NotLines> {
         if points > MAX_POINTS {
             return Err(NotLines::Shapes("too many points"));
         }
-        for sub in strokes::subpaths(path, user.pre_concat(t)) {
+        for sub in svg::subpaths(path, user.pre_concat(t)) {
             let mut line: Vec<DVec2> = Vec::new();
             let mut first = None;
             for s in sub {
@@ -101,7 +100,7 @@ fn filled_area(path: &usvg::Path) -> f64 {
     );
     let size = (hi - lo).max_element();
     let mut total = 0.0;
-    for sub in strokes::subpaths(path, usvg::Transform::identity()) {
+    for sub in svg::subpaths(path, usvg::Transform::identity()) {
         let ring: Vec<DVec2> = sub
             .iter()
             .filter_map(|s| match *s {
@@ -191,8 +190,8 @@ pub fn reading(lines: &[Vec<DVec2>], split: u32) -> Result<Reading, NotLines> {
         if r < 1.0 || (u - r).abs() > 0.2 {
             return Err(NotLines::Steps(format!(
                 "a segment of length {} is not a whole number of steps of {}",
-                crate::number::source(crate::infer::art::emit::nice(len, len * 1e-4)),
-                crate::number::source(crate::infer::art::emit::nice(step, step * 1e-4))
+                crate::number::source(crate::infer::program::nice(len, len * 1e-4)),
+                crate::number::source(crate::infer::program::nice(step, step * 1e-4))
             )));
         }
         rr += r * r;
@@ -352,10 +351,10 @@ fn refine(
     // within three standard errors, whichever is shorter when both fit the
     // segments as well (25.7 rather than 360/14 = 25.714286; 60 rather than
     // a 60.01 that rounding in the drawing suggests; 22.5 = 360/16).
-    let written = crate::infer::art::emit::nice(delta, (3.0 * err).max(1e-6));
+    let written = crate::infer::program::nice(delta, (3.0 * err).max(1e-6));
     let m = (360.0 / delta).round();
     let exact = 360.0 / m;
-    let decimals = |v: f64| crate::number::decimals(crate::infer::art::emit::nice(v, 1e-9));
+    let decimals = |v: f64| crate::number::decimals(crate::infer::program::nice(v, 1e-9));
     let periodic = if m >= 2.0 && (exact - delta).abs() <= 0.02 * exact {
         let (_, rw) = fit(written);
         let (_, re) = fit(exact);

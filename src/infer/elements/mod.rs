@@ -1,12 +1,14 @@
-//! `lsyc infer ART.svg`: a drawing of repeated elements to an L-system that
+//! `lsyc infer ART.svg` when it is not a line drawing's grammar (see
+//! `infer::from_svg`): a drawing of repeated elements to an L-system that
 //! draws it back, after Šťava, Beneš, Měch, Aliaga & Krištof, *Inverse
 //! Procedural Modeling by Automatic Generation of L-systems* (CGF 2010).
 //!
 //! Owns: the pipeline and its options and statistics: elements (`read`),
 //! kinds and frames (`shape`), the kinds' origins (`origin`) and local frames
-//! (`pivot`) where the drawing gives none, transformation spaces and clustering (`space`),
-//! rules level by level (`rules`) and the program (`emit`). Must not write
-//! files or print (the CLI does), and must not panic on any input.
+//! (`pivot`) where the drawing gives none, transformation spaces and
+//! clustering (`space`), rules level by level (`rules`) and the program
+//! (`emit`). Must not write files or print (the CLI does), and must not panic
+//! on any input.
 
 pub mod emit;
 pub mod origin;
@@ -215,7 +217,7 @@ pub fn from_svg(
     stats.clusters = grammar.clusters;
     stats.rules_ms = ms(t);
     let t = Instant::now();
-    let (source, system) = super::names(name);
+    let (source, system) = super::program::names(name);
     let settings = emit::Settings {
         source: &source,
         name: system,

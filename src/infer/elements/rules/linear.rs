@@ -30,8 +30,8 @@ use super::{
     Budget, Candidate, Edge, Index, Inst, LINEAR_STEP_MAX, Plan, Tolerance, TooMuchWork, close,
     point, seq_candidate,
 };
-use crate::infer::art::shape::{Frame, wrap};
-use crate::infer::art::space::{Point, Tr, cluster};
+use crate::infer::elements::shape::{Frame, wrap};
+use crate::infer::elements::space::{Point, Tr, cluster};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::collections::{BTreeMap, HashSet};

@@ -1,7 +1,8 @@
-//! The inferred program as an `ast::File`: header comment, constants, module
-//! declarations and one lsystem whose rules are the reduced productions.
+//! The program of a tree sketch as an `ast::File`, built with the shared kit
+//! (`infer::program`): header comment, constants, module declarations and one
+//! lsystem whose rules are the reduced productions.
 //!
-//! Owns: the shape of inferred programs (see `docs/language.md`, "Inferring a
+//! Owns: the shape of programs inferred from sketches (see `docs/language.md`, "Inferring a
 //! tree from a sketch"): module `R` is the root `r`, `B<k>` is id `k`; every rule
 //! `M(l, w)` draws its base branch as sketched (segments as fractions of `l`,
 //! bends as turns), with each child in brackets at its junction, turned by a
@@ -11,12 +12,8 @@
 
 use super::productions::{Analysis, Child, Production};
 use super::skeleton::{Branch, Skeleton, angle};
-use crate::ast::{
-    BinOp, Block, ConstDecl, Expr, ExprKind, File, Ident, Item, Lsystem, ModName, Module,
-    ModuleDecl, Node, Rule, Stmt,
-};
-use crate::lexer::Comment;
-use crate::span::Span;
+use crate::ast::{BinOp, ConstDecl, Expr, File, Ident, Item, Module, ModuleDecl, Node, Stmt};
+use crate::infer::program::{self, bin, comment, named, node, sym, var};
 use glam::DVec2;
 use std::collections::HashMap;
 
@@ -41,47 +38,14 @@ pub struct Settings<'a> {
     pub seed_3d: Option<u64>,
 }
 
-pub(crate) fn round(v: f64, digits: i32) -> f64 {
+/// `v` rounded to `digits` decimals.
+fn round(v: f64, digits: i32) -> f64 {
     let k = 10f64.powi(digits);
     (v * k).round() / k + 0.0
 }
 
-pub(crate) fn comment(text: impl AsRef<str>) -> Comment {
-    let t = text.as_ref();
-    Comment {
-        text: if t.is_empty() {
-            "//".to_string()
-        } else {
-            format!("// {t}")
-        },
-        span: Span::default(),
-    }
-}
-
-pub(crate) fn node<T>(node: T) -> Node<T> {
-    Node::new(node, Span::default())
-}
-
-pub(crate) fn var(name: &str) -> Expr {
-    Expr::new(ExprKind::Var(name.to_string()))
-}
-
-pub(crate) fn mul(a: Expr, b: Expr) -> Expr {
-    Expr::new(ExprKind::Binary(BinOp::Mul, Box::new(a), Box::new(b)))
-}
-
-/// A turtle symbol or a single letter (`F`, `f`) with an optional parameter.
-pub(crate) fn sym(c: char, arg: Option<Expr>) -> Module {
-    let name = if c.is_alphabetic() {
-        ModName::Name(c.to_string())
-    } else {
-        ModName::Symbol(c)
-    };
-    Module::new(name, arg.map(|a| vec![a]))
-}
-
-pub(crate) fn named(name: &str, args: Vec<Expr>) -> Module {
-    Module::new(ModName::Name(name.to_string()), Some(args))
+fn mul(a: Expr, b: Expr) -> Expr {
+    bin(BinOp::Mul, a, b)
 }
 
 /// `+(a)` for a left turn, `-(a)` for a right one (by `a`'s sign), nothing for 0.
@@ -413,17 +377,8 @@ fn rule(
         succ.push(sym('F', Some(f)));
     }
     at(segs, &mut succ);
-    let mut rule = node(Stmt::Rule(Rule {
-        label: None,
-        interpret: false,
-        decompose: false,
-        left: None,
-        pred: Module::new(ModName::Name(m.to_string()), Some(vec![var("l"), var("w")])),
-        right: None,
-        cond: None,
-        weight: None,
-        succ,
-    }));
+    let pred = named(m, vec![var("l"), var("w")]);
+    let mut rule = node(Stmt::Rule(program::rule(pred, succ)));
     rule.trivia.leading.push(comment(format!(
         "{p}: module {m}, drawn like {}{}",
         stroke_name(s, base),
@@ -568,22 +523,10 @@ fn assemble(
         d.trivia.blank_before = k == 0;
         items.push(d);
     }
-    let mut sys = node(Item::Lsystem(Lsystem {
-        name: Ident::new(name.to_string()),
-        params: Vec::new(),
-        body: Block {
-            stmts,
-            end_comments: Vec::new(),
-        },
-    }));
+    let mut sys = program::lsystem(name, stmts);
     sys.trivia.blank_before = true;
     items.push(sys);
-    File {
-        items: Block {
-            stmts: items,
-            end_comments: Vec::new(),
-        },
-    }
+    program::file(items)
 }
 
 fn stroke_name(s: &Settings, branch: usize) -> String {
@@ -593,37 +536,9 @@ fn stroke_name(s: &Settings, branch: usize) -> String {
     )
 }
 
-/// A file stem as an lsystem name: `sketch-tree` becomes `SketchTree`.
-pub fn system_name(stem: &str) -> String {
-    let mut out = String::new();
-    for part in stem.split(|c: char| !c.is_ascii_alphanumeric()) {
-        let mut cs = part.chars();
-        if let Some(c) = cs.next() {
-            out.push(c.to_ascii_uppercase());
-            out.extend(cs);
-        }
-    }
-    // All capitals could be a module (`R`, `AB`) or a constant (`KW`).
-    let clashes = out == out.to_ascii_uppercase();
-    if out.is_empty() || out.starts_with(|c: char| c.is_ascii_digit()) || clashes {
-        out = format!("Sketch{out}");
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn system_names() {
-        assert_eq!(system_name("sketch-tree"), "SketchTree");
-        assert_eq!(system_name("3d_oak"), "Sketch3dOak");
-        assert_eq!(system_name("r"), "SketchR");
-        assert_eq!(system_name("KW"), "SketchKW");
-        assert_eq!(system_name("b12"), "SketchB12");
-        assert_eq!(system_name("é"), "Sketch");
-    }
 
     #[test]
     fn module_names_are_letters() {

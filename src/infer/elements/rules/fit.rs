@@ -11,7 +11,7 @@
 //! say which round values the members support; `nice_angle` and `nice`
 //! snap to them. Must not choose rules or know turtle commands.
 
-use crate::infer::art::shape::{Frame, rotate, wrap};
+use crate::infer::elements::shape::{Frame, rotate, wrap};
 use glam::DVec2;
 
 /// A placed instance a structure draws: which copy (group) it belongs to,

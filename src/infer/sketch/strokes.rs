@@ -1,18 +1,15 @@
 //! Strokes of a sketch: every path, line, polyline or polygon of an SVG, in
 //! document order, as a polyline in world coordinates.
 //!
-//! Owns: reading SVG with usvg (which turns shapes into paths and resolves
-//! `<g transform>`, `<use>` and the viewBox), applying each path's absolute
-//! transform, flattening curves into points, turning the SVG's y-down user
-//! space into the language's y-up world (x, −y), and the stroke width in the
-//! same units. Each subpath is a stroke. Must not decide what a stroke means.
+//! Owns: the strokes of a sketch read through `svg` (which reads the document
+//! safely and gives each path's subpaths in the language's y-up world, curves
+//! flattened): one stroke per subpath, numbered in document order for
+//! messages, with its element's id and its stroke width in world units, and
+//! the limits on strokes and points. Must not decide what a stroke means.
 
-use super::svg::{self, Refusal};
+use crate::infer::svg::{self, Refusal, flatten, subpaths, user_space};
 use glam::DVec2;
-use usvg::tiny_skia_path::{PathSegment, Point, Transform};
-
-/// Points per flattened curve segment.
-const CURVE_STEPS: usize = 12;
+use usvg::Transform;
 
 /// One stroke of the sketch.
 #[derive(Clone, Debug)]
@@ -69,7 +66,7 @@ pub fn read(data: &[u8], max_strokes: usize) -> Result<Vec<Stroke>, Refusal> {
         max_strokes,
     };
     let user = user_space(data, &tree);
-    for (p, t) in super::svg::paths(&tree) {
+    for (p, t) in svg::paths(&tree) {
         if !r.path(p, user.pre_concat(t))? {
             break;
         }
@@ -132,142 +129,6 @@ impl Reader {
     }
 }
 
-/// The map from usvg's coordinates back to the document's user space: usvg
-/// puts the root `viewBox` (and a root `transform`) into one group around the
-/// content, which the paths' transforms include; lsyc works in user units so that
-/// what it draws back lies on the input.
-pub fn user_space(data: &[u8], tree: &usvg::Tree) -> Transform {
-    let root_group = || match tree.root().children() {
-        [usvg::Node::Group(g)] if g.id().is_empty() => g.transform().invert(),
-        _ => None,
-    };
-    let Ok(text) = std::str::from_utf8(data) else {
-        return Transform::identity();
-    };
-    let Ok(doc) = usvg::roxmltree::Document::parse(text) else {
-        return Transform::identity();
-    };
-    let svg = doc.root_element();
-    let size = tree.size();
-    let moved = svg.attribute("transform").is_some()
-        || svg.attribute("viewBox").is_some_and(|v| {
-            v.parse::<svgtypes::ViewBox>().is_ok_and(|b| {
-                b.x != 0.0
-                    || b.y != 0.0
-                    || (b.w - f64::from(size.width())).abs() > 1e-9
-                    || (b.h - f64::from(size.height())).abs() > 1e-9
-            })
-        });
-    if moved {
-        root_group().unwrap_or_default()
-    } else {
-        Transform::identity()
-    }
-}
-
-/// One segment of a subpath in world coordinates (y up); each starts where the
-/// previous one ended.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Seg {
-    Move(DVec2),
-    Line(DVec2),
-    Quad(DVec2, DVec2),
-    Cubic(DVec2, DVec2, DVec2),
-    Close,
-}
-
-/// The subpaths of a path in world coordinates (`t`, the map from its own
-/// coordinates to the document's user space, applied, and y flipped up),
-/// exactly: curves stay curves. A subpath whose points are not all finite is
-/// dropped.
-pub fn subpaths(path: &usvg::Path, t: Transform) -> Vec<Vec<Seg>> {
-    let map = |mut p: Point| {
-        t.map_point(&mut p);
-        DVec2::new(f64::from(p.x), -f64::from(p.y))
-    };
-    let mut out: Vec<Vec<Seg>> = Vec::new();
-    let mut current: Vec<Seg> = Vec::new();
-    for seg in path.data().segments() {
-        let s = match seg {
-            PathSegment::MoveTo(p) => {
-                if !current.is_empty() {
-                    out.push(std::mem::take(&mut current));
-                }
-                Seg::Move(map(p))
-            }
-            PathSegment::LineTo(p) => Seg::Line(map(p)),
-            PathSegment::QuadTo(c, p) => Seg::Quad(map(c), map(p)),
-            PathSegment::CubicTo(c1, c2, p) => Seg::Cubic(map(c1), map(c2), map(p)),
-            PathSegment::Close => Seg::Close,
-        };
-        current.push(s);
-    }
-    if !current.is_empty() {
-        out.push(current);
-    }
-    out.retain(|sub| {
-        sub.iter()
-            .all(|s| seg_points(s).iter().all(|p| p.is_finite()))
-    });
-    out
-}
-
-/// The points a segment names (controls, then its end).
-pub fn seg_points(s: &Seg) -> Vec<DVec2> {
-    match *s {
-        Seg::Move(p) | Seg::Line(p) => vec![p],
-        Seg::Quad(c, p) => vec![c, p],
-        Seg::Cubic(a, b, p) => vec![a, b, p],
-        Seg::Close => Vec::new(),
-    }
-}
-
-/// A subpath as a polyline: curves flattened into `CURVE_STEPS` pieces, no two
-/// consecutive points equal; a closed subpath ends where it started.
-pub fn flatten(sub: &[Seg]) -> Vec<DVec2> {
-    let pt = |p: DVec2| kurbo::Point::new(p.x, p.y);
-    let mut bez = kurbo::BezPath::new();
-    // A subpath that does not begin with a move starts at the origin, which is
-    // not one of its points.
-    let implicit = !matches!(sub.first(), Some(Seg::Move(_)) | None);
-    if implicit {
-        bez.move_to(pt(DVec2::ZERO));
-    }
-    for s in sub {
-        match *s {
-            Seg::Move(p) => bez.move_to(pt(p)),
-            Seg::Line(p) => bez.line_to(pt(p)),
-            Seg::Quad(c, p) => bez.quad_to(pt(c), pt(p)),
-            Seg::Cubic(c1, c2, p) => bez.curve_to(pt(c1), pt(c2), pt(p)),
-            Seg::Close => bez.close_path(),
-        }
-    }
-    // The one flattener, with inference's finer count; then no repeated
-    // points, and a closed subpath ends at its start.
-    let mut points = Vec::new();
-    for (i, line) in crate::path::flatten_steps(&bez, CURVE_STEPS)
-        .into_iter()
-        .enumerate()
-    {
-        let first = line.points.first().copied();
-        let skip = usize::from(i == 0 && implicit);
-        for &p in &line.points[skip..] {
-            push(&mut points, p);
-        }
-        if let (true, Some(f)) = (line.closed, first) {
-            push(&mut points, f);
-        }
-    }
-    points
-}
-
-/// Appends `p` unless it repeats the last point.
-fn push(points: &mut Vec<DVec2>, q: DVec2) {
-    if points.last().is_none_or(|l| l.distance(q) > 1e-9) {
-        points.push(q);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -295,7 +156,7 @@ mod tests {
         assert_eq!(s[1].width, Some(2.0));
         // The zero-length line is skipped, but keeps its number.
         assert_eq!(s[2].number, 4);
-        assert_eq!(s[2].points.len(), CURVE_STEPS + 1);
+        assert_eq!(s[2].points.len(), svg::CURVE_STEPS + 1);
         assert_eq!(s[3].subpath, 1);
         assert_eq!(
             s[3].describe(),

@@ -9,8 +9,7 @@
 //! transforms and turns rects, circles, ellipses, lines, polylines and
 //! polygons into paths. Must not decide which elements are alike.
 
-use crate::infer::strokes::{self, Seg};
-use crate::infer::svg::{self, Refusal};
+use crate::infer::svg::{self, Refusal, Seg};
 use glam::DVec2;
 use usvg::tiny_skia_path::{PathVerb, Transform};
 
@@ -116,7 +115,7 @@ pub fn read(data: &[u8]) -> Result<Drawing, Refusal> {
     let tree = svg::parse(data)?;
     let mut d = Drawing::default();
     let mut work = Work::default();
-    let user = strokes::user_space(data, &tree);
+    let user = svg::user_space(data, &tree);
     // Images and text are reported from the document (see `skipped_in_xml`).
     for (p, t) in svg::paths(&tree) {
         path_elements(p, user.pre_concat(t), &mut d, &mut work)?;
@@ -284,13 +283,13 @@ fn path_elements(
             .map(|s| f64::from(s.width().get()) * scale)
             .filter(|w| w.is_finite() && *w > 0.0),
     };
-    let subs = strokes::subpaths(path, t);
+    let subs = svg::subpaths(path, t);
     work.subpaths(subs.len())?;
     // Each subpath with its polyline and box.
     type Part = (Vec<Seg>, Vec<DVec2>, (DVec2, DVec2));
     let mut parts: Vec<Part> = Vec::new();
     for sub in subs {
-        let flat = strokes::flatten(&sub);
+        let flat = svg::flatten(&sub);
         work.points(flat.len())?;
         for p in &flat {
             d.largest = d.largest.max(p.x.abs()).max(p.y.abs());

@@ -16,7 +16,7 @@
 
 use super::read::Element;
 use super::{Budget, TooMuchWork};
-use crate::infer::strokes::Seg;
+use crate::infer::svg::Seg;
 use glam::DVec2;
 use rayon::prelude::*;
 use std::collections::HashMap;

@@ -1,6 +1,7 @@
-//! The inferred grammar as an `ast::File`: a comment header, the element
-//! kinds as `element` items, named constants for the counts and transforms of
-//! the repeated structures, and one lsystem.
+//! The grammar of a drawing's elements as an `ast::File`, built with the
+//! shared kit (`infer::program`): a comment header, the element kinds as
+//! `element` items, named constants for the counts and transforms of the
+//! repeated structures, and one lsystem.
 //!
 //! Owns: names (elements `A`, `B`, … without `F`; sequence rules `P1`, `P2`, …,
 //! branchings `R1`, …, pairs `Q1`, …), the paper's post-processing (no `t0`
@@ -15,11 +16,11 @@ use super::rules::{Body, Grammar, Sym};
 use super::shape::{Frame, Instancing, map_subpaths, rotate};
 use super::space::Tr;
 use crate::ast::{
-    BinOp, Block, ConstDecl, Element as ElementItem, Expr, ExprKind, File, Ident, Item, Lsystem,
-    ModName, Module, ModuleDecl, Node, Prop, PropValue, Rule, Stmt,
+    BinOp, Block, ConstDecl, Element as ElementItem, Expr, ExprKind, File, Ident, Item, ModName,
+    Module, ModuleDecl, Node, Prop, PropValue, Rule, Stmt,
 };
-use crate::infer::emit::{comment, node, sym, var};
-use crate::infer::strokes::Seg;
+use crate::infer::program::{bin, comment, file, lsystem, named, nice, node, rule, sym, var};
+use crate::infer::svg::Seg;
 use crate::span::Span;
 use glam::DVec2;
 use std::collections::{BTreeMap, BTreeSet};
@@ -37,23 +38,6 @@ pub struct Settings<'a> {
     /// (turns by ±30·J degrees, steps and scales by ±J of their value), drawn
     /// anew at each use from `lsyc run --seed`.
     pub jitter: Option<f64>,
-}
-
-/// The shortest decimal within `tol` of `v` (at most 6 decimals).
-pub fn nice(v: f64, tol: f64) -> f64 {
-    for digits in 0..=6 {
-        let k = 10f64.powi(digits);
-        let r = (v * k).round() / k;
-        if (r - v).abs() <= tol {
-            return r + 0.0;
-        }
-    }
-    let k = 1e6;
-    (v * k).round() / k + 0.0
-}
-
-fn bin(op: BinOp, a: Expr, b: Expr) -> Expr {
-    Expr::new(ExprKind::Binary(op, Box::new(a), Box::new(b)))
 }
 
 fn element_name(k: usize) -> String {
@@ -509,14 +493,7 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
     stmts.push(node(Stmt::Derive(derive)));
     stmts.push(node(Stmt::Axiom(axiom)));
     stmts.extend(rules);
-    let mut sys = node(Item::Lsystem(Lsystem {
-        name: Ident::new(s.name.clone()),
-        params: Vec::new(),
-        body: Block {
-            stmts,
-            end_comments: Vec::new(),
-        },
-    }));
+    let mut sys = lsystem(&s.name, stmts);
     sys.trivia.blank_before = true;
     let header = header(elements, inst, g, s, &count_of, &consts.used);
     assemble(&header, element_items, consts, decls, sys)
@@ -730,20 +707,13 @@ impl RuleWriter<'_> {
     }
 
     fn recurse(&self) -> Module {
-        Module::new(ModName::Name(self.name.clone()), Some(vec![m_minus_1()]))
+        named(&self.name, vec![m_minus_1()])
     }
 
     fn add(&mut self, cond: Option<Expr>, succ: Vec<Module>, note: Option<String>) {
         let mut n = node(Stmt::Rule(Rule {
-            label: None,
-            interpret: false,
-            decompose: false,
-            left: None,
-            pred: self.pred.clone(),
-            right: None,
             cond,
-            weight: None,
-            succ,
+            ..rule(self.pred.clone(), succ)
         }));
         if let Some(note) = note {
             n.trivia.leading.push(comment(note));
@@ -1125,10 +1095,5 @@ fn assemble(
         push_item(d, &mut items);
     }
     push_item(sys, &mut items);
-    File {
-        items: Block {
-            stmts: items,
-            end_comments: Vec::new(),
-        },
-    }
+    file(items)
 }

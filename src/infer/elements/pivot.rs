@@ -20,7 +20,7 @@ use super::rules::Tolerance;
 use super::shape::{Frame, Instancing, wrap};
 use super::space::{Point, Tr, cluster};
 use crate::geometry::index::PointGrid;
-use crate::infer::strokes::Seg;
+use crate::infer::svg::Seg;
 use glam::DVec2;
 
 /// Neighbours of the same kind compared per instance.

@@ -190,7 +190,7 @@ impl Inst {
     fn variants(&self, rot: f64) -> Vec<Frame> {
         let f = self.frame;
         let turn = |a: f64| Frame {
-            pos: self.centroid + crate::infer::art::shape::rotate(f.pos - self.centroid, a),
+            pos: self.centroid + crate::infer::elements::shape::rotate(f.pos - self.centroid, a),
             rot: wrap(f.rot + a),
             scale: f.scale,
         };

@@ -11,8 +11,8 @@
 //! candidates.
 
 use super::{Candidate, Edge, Index, Inst, Plan, Tolerance, close, supported_mean};
-use crate::infer::art::shape::Frame;
-use crate::infer::art::space::Tr;
+use crate::infer::elements::shape::Frame;
+use crate::infer::elements::space::Tr;
 use std::collections::{HashMap, HashSet};
 
 /// An empty slot of a per-instance array. Slots hold a number plus one, so

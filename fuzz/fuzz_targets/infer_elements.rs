@@ -5,11 +5,12 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use lsyc::infer::art::{self, Options};
+use lsyc::infer::elements::{self, Options};
 use lsyc::{fmt, parser};
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(inferred) = art::from_svg(data, "fuzz.svg", &Options::default(), &mut |_| {}) else {
+    let Ok(inferred) = elements::from_svg(data, "fuzz.svg", &Options::default(), &mut |_| {})
+    else {
         return;
     };
     let parsed = parser::parse(&inferred.text);

@@ -11,8 +11,8 @@
 
 use super::fit::{Fit, Member, Solution, nice, nice_angle};
 use super::{Inst, Tolerance};
-use crate::infer::art::shape::{Frame, rotate, wrap};
-use crate::infer::art::space::Tr;
+use crate::infer::elements::shape::{Frame, rotate, wrap};
+use crate::infer::elements::space::Tr;
 use glam::DVec2;
 use std::f64::consts::TAU;
 
