@@ -16,8 +16,10 @@
 
 pub mod emit;
 pub mod grammar;
+pub mod graph;
 pub mod read;
 pub mod search;
+pub mod synth;
 pub mod turtle;
 pub mod verify;
 
@@ -106,7 +108,8 @@ fn ms(t: Instant) -> f64 {
 /// Infers the D0L system of the line drawing in `data` (named `name`).
 pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
     let start = Instant::now();
-    // No deadline for a budget beyond what a clock can count.
+    // No deadline for a budget beyond what a clock can count. The stroke
+    // graph's search comes after it, bounded by its count of work.
     let deadline = start.checked_add(opts.budget);
     let late = || deadline.is_some_and(|d| Instant::now() >= d);
     if data.len() > super::MAX_SVG_BYTES {
@@ -189,7 +192,7 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
             }
             stats.search_ms += ms(t);
             let tv = Instant::now();
-            if let Some(found) = finish(&g, &reading, name, work) {
+            if let Some(found) = finish(&g, &reading, name, work, 0.0) {
                 stats.verify_ms = ms(tv);
                 stats.rules = g.letters.iter().filter(|l| l.rule.is_some()).count();
                 stats.rule_symbols = g.rule_size();
@@ -206,6 +209,15 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
         }
         stats.search_ms += ms(t);
     }
+    // The drawing as a set of segments: a grammar that draws each once,
+    // whatever the order, direction and splitting of its paths.
+    let t = Instant::now();
+    let by_graph = from_graph(&lines, name, None, &mut stats);
+    stats.search_ms += ms(t);
+    match by_graph {
+        Ok(found) => return Lines::Found(found),
+        Err(late) => timed_out |= late,
+    }
     // Read as steps but unexplained: say that, not why another reading failed.
     if why.is_empty() || steps > 0 {
         why = "no D0L system with one or two rewritten letters draws it".into();
@@ -216,6 +228,106 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
         timed_out,
         stats,
     }
+}
+
+/// A grammar that draws every segment of the drawing's stroke graph once
+/// (`synth`), checked as every candidate is: its walk read as steps, the
+/// grammar matched against them and redrawn by the library. `Err(true)`
+/// when the budget ended the search.
+fn from_graph(
+    lines: &[Vec<DVec2>],
+    name: &str,
+    deadline: Option<Instant>,
+    stats: &mut Stats,
+) -> Result<Box<Inferred>, bool> {
+    let late = || deadline.is_some_and(|d| Instant::now() >= d);
+    for split in [1, 2] {
+        if late() {
+            return Err(true);
+        }
+        let Ok(g) = graph::build(lines, split) else {
+            continue;
+        };
+        let branches =
+            g.adj.iter().any(|a| a.len() > 2) || g.adj.iter().filter(|a| a.len() == 1).count() > 2;
+        let limits = synth::Limits {
+            deadline,
+            brackets: branches,
+            ..synth::Limits::default()
+        };
+        let Some(found) = synth::search(&g, &limits) else {
+            continue;
+        };
+        stats.candidates += 1;
+        let reading = match read::reading(&found.walk, 1) {
+            Ok(r) => r,
+            Err(_) => continue,
+        };
+        let Some(gr) = to_grammar(&found, &reading.angles) else {
+            continue;
+        };
+        stats.compared += 1;
+        stats.steps = reading.steps;
+        stats.angle = reading.angles.delta;
+        let work = 64 * reading.tree.nodes.len() as u64 + 100_000;
+        if grammar::matches(&gr, &reading.tree, &reading.angles, work, deadline) != Outcome::Same {
+            continue;
+        }
+        let tv = Instant::now();
+        if let Some((file, text, redraw)) = finish(&gr, &reading, name, work, g.noise) {
+            stats.verify_ms = ms(tv);
+            stats.rules = gr.letters.iter().filter(|l| l.rule.is_some()).count();
+            stats.rule_symbols = gr.rule_size();
+            stats.depth = gr.depth;
+            return Ok(Box::new(Inferred {
+                grammar: gr,
+                file,
+                text,
+                redraw,
+                stats: stats.clone(),
+            }));
+        }
+    }
+    Err(late())
+}
+
+/// A found grammar in the symbols of the candidates, its turns counted in
+/// the reading's δ (which may be a multiple of the graph's δ₀).
+fn to_grammar(f: &synth::Found, angles: &turtle::Angles) -> Option<Grammar> {
+    let ratio = f.delta / angles.delta;
+    let syms = |v: &[synth::Sym]| -> Option<Vec<grammar::Sym>> {
+        let mut out = Vec::new();
+        for s in v {
+            match *s {
+                synth::Sym::Letter(k) => out.push(grammar::Sym::Letter(k)),
+                synth::Sym::Unnamed => out.push(grammar::Sym::Letter(0)),
+                synth::Sym::Push => out.push(grammar::Sym::Push),
+                synth::Sym::Pop => out.push(grammar::Sym::Pop),
+                synth::Sym::Turn(t) => {
+                    let k = f64::from(t) * ratio;
+                    if (k - k.round()).abs() > 1e-6 {
+                        return None;
+                    }
+                    out.extend(grammar::turn_syms(k.round() as i32, angles));
+                }
+            }
+        }
+        Some(out)
+    };
+    const NAMES: [char; 3] = ['F', 'G', 'H'];
+    let mut letters = Vec::new();
+    for (k, r) in f.rules.iter().enumerate() {
+        letters.push(grammar::Letter {
+            name: *NAMES.get(k)?,
+            action: grammar::Action::Draw,
+            rule: Some(syms(r)?),
+        });
+    }
+    Some(Grammar {
+        letters,
+        axiom: syms(&f.axiom)?,
+        depth: f.depth,
+    })
 }
 
 /// Whether a grammar says more than the drawing itself: at most half its
@@ -334,6 +446,7 @@ fn finish(
     r: &Reading,
     name: &str,
     work: u64,
+    noise: f64,
 ) -> Option<(crate::ast::File, String, verify::Redraw)> {
     let angle = if r.angles.period.is_some() {
         nice(r.angles.delta, 1e-6)
@@ -384,8 +497,12 @@ fn finish(
     };
     let check = |settings: &emit::Settings| {
         let draft = crate::fmt::format_file(&emit::program(g, settings));
-        verify::redraw(&draft, &r.segments, r.step)
-            .filter(|d| d.drawn == d.steps && d.relative() <= 1e-3)
+        verify::redraw(&draft, &r.segments, r.step).filter(|d| {
+            // Within 10⁻³ of the diagonal, or of the drawing's own noise
+            // (its points' spread about their vertices) when larger.
+            let limit = (1e-3f64).max(2.0 * noise * r.step / d.diagonal.max(1e-300));
+            d.drawn == d.steps && d.relative() <= limit
+        })
     };
     let mut best = settings(precise);
     let mut redraw = check(&best);

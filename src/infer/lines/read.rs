@@ -489,6 +489,12 @@ fn find_delta(b: &Builder, edge_of: &[u32]) -> Result<Angles, NotLines> {
         })
         .map(|i| b.turn_radians(i).to_degrees().abs())
         .collect();
+    delta_from_turns(&turns)
+}
+
+/// δ roughly from turns (degrees, any sign): see `find_delta`.
+pub(super) fn delta_from_turns(turns: &[f64]) -> Result<Angles, NotLines> {
+    let turns: Vec<f64> = turns.iter().map(|t| t.abs()).collect();
     // A histogram of quarter degrees, smoothed over a degree each way; its
     // lumps (runs of bins that are not empty) are the clusters, as wide as
     // the drawing's noise. The lump from 0 is the straight turns; lumps of

@@ -69,16 +69,25 @@ fn steps(segments: &[(DVec2, DVec2)], step: f64) -> Vec<(DVec2, DVec2)> {
 /// (world coordinates, steps of `step`). `None` if the program does not run
 /// (which would be a bug of the emitter).
 pub fn redraw(text: &str, segments: &[(DVec2, DVec2)], step: f64) -> Option<Redraw> {
+    let drawn = steps(&drawn(text, 0)?, step);
+    let input = steps(segments, step);
+    Some(compare(&input, &drawn, step))
+}
+
+/// The segments (x–y plane) the program `text` draws when derived `more`
+/// steps beyond its own `derive`, as `lsyc run` derives and draws it (seed
+/// 0). `None` if the program does not run.
+pub fn drawn(text: &str, more: u32) -> Option<Vec<(DVec2, DVec2)>> {
     let fe = crate::frontend::run(text, Vec::new(), &[]);
     if fe.has_errors() {
         return None;
     }
     let checked = fe.checked.as_ref()?;
-    // As `lsyc run` derives and draws (`run::derive`, one layer up).
     let prog = crate::compile::compile(&fe.file, checked, None).ok()?;
     let limits = crate::derive::Limits::default();
     let axiom = crate::derive::axiom(&prog, &vec![0.0; prog.params.len()], 0).ok()?;
-    let string = crate::derive::derive(&prog, axiom, prog.derive, 0, limits, &|_, _| {}).ok()?;
+    let steps = prog.derive.checked_add(more)?;
+    let string = crate::derive::derive(&prog, axiom, steps, 0, limits, &|_, _| {}).ok()?;
     let mut sink = Segments::default();
     crate::turtle::interpret_limited(
         &prog,
@@ -89,9 +98,7 @@ pub fn redraw(text: &str, segments: &[(DVec2, DVec2)], step: f64) -> Option<Redr
         &mut sink,
     )
     .ok()?;
-    let drawn = steps(&sink.0, step);
-    let input = steps(segments, step);
-    Some(compare(&input, &drawn, step))
+    Some(sink.0)
 }
 
 /// Compares two sets of steps.

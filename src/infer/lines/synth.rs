@@ -1,0 +1,875 @@
+//! Grammar synthesis against the stroke graph: a D0L system is guessed one
+//! symbol at a time while it is derived and drawn, and every drawn step must
+//! be an unused edge of the drawing.
+//!
+//! The drawing is a set of unit edges (`graph`), so the order, direction and
+//! splitting of its paths do not matter. A search starts at a vertex, along
+//! one of its edges, for a depth n. The axiom and the successors start empty
+//! and open; the derivation runs depth first, as a turtle draws, and where it
+//! needs a symbol that is not known yet it chooses one (close the successor,
+//! a drawing letter, a turn, a bracket) and goes on. A drawing letter is
+//! first written unnamed: at the last derivation step every drawing letter
+//! draws the same step, so its name is chosen only when it must be rewritten
+//! (an existing letter or a new one). Every choice is checked by the steps it
+//! draws, so a wrong one fails within a few steps and the search backs up to
+//! the latest choice with alternatives left. A search ends when every edge
+//! is drawn exactly once: the grammar draws the drawing, whatever order its
+//! paths came in.
+//!
+//! Owns: the search and its work limits. Must not read SVG or write
+//! programs; the found grammar goes through the same checks as every other
+//! candidate (`grammar::matches`, the library's redraw).
+
+use super::graph::Graph;
+use glam::DVec2;
+use std::time::Instant;
+
+/// A symbol of a successor being guessed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sym {
+    /// Drawing letter `k`.
+    Letter(u8),
+    /// A drawing letter not named yet.
+    Unnamed,
+    /// A turn of `t` times δ₀ (left when positive).
+    Turn(i32),
+    Push,
+    Pop,
+}
+
+/// A successor (or the axiom) and whether it is complete.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Rule {
+    pub syms: Vec<Sym>,
+    pub closed: bool,
+}
+
+/// A grammar found: the axiom, each drawing letter's successor, the depth,
+/// δ₀ (degrees) the turns count, and the start.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Found {
+    pub axiom: Vec<Sym>,
+    pub rules: Vec<Vec<Sym>>,
+    pub depth: u32,
+    pub delta: f64,
+    /// The drawing's polylines in the order the grammar draws them.
+    pub walk: Vec<Vec<DVec2>>,
+}
+
+impl Found {
+    /// Symbols in the axiom and all successors.
+    pub fn size(&self) -> usize {
+        self.axiom.len() + self.rules.iter().map(Vec::len).sum::<usize>()
+    }
+}
+
+/// How far a search goes.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    /// Drawing letters at most.
+    pub letters: usize,
+    /// Symbols in a successor at most.
+    pub rule: usize,
+    /// Symbols in the axiom at most.
+    pub axiom: usize,
+    /// Derivation symbols read and choices made per start and depth.
+    pub work: u64,
+    /// Derivation symbols read and choices made over all searches: the
+    /// search ends there (a count, so the same drawing always gets the same
+    /// answer).
+    pub total: u64,
+    /// Whether successors may branch (`[`, `]`).
+    pub brackets: bool,
+    pub deadline: Option<Instant>,
+}
+
+impl Default for Limits {
+    fn default() -> Limits {
+        Limits {
+            letters: 3,
+            rule: 24,
+            axiom: 12,
+            work: 200_000,
+            total: 12_000_000,
+            brackets: false,
+            deadline: None,
+        }
+    }
+}
+
+const AXIOM: u8 = u8::MAX;
+
+#[derive(Clone, Copy, Debug)]
+struct Frame {
+    rule: u8,
+    at: u16,
+    depth: u8,
+}
+
+#[derive(Clone, Debug)]
+struct Turtle {
+    at: u32,
+    heading: i32,
+    saved: Vec<(u32, i32)>,
+}
+
+/// What a choice may be.
+#[derive(Clone, Copy, Debug)]
+enum Choice {
+    /// The successor `rule` (or the axiom) is read to its end: close it or
+    /// add a symbol.
+    End { rule: u8 },
+    /// The unnamed letter at `rule[at]` must be rewritten: name it.
+    Name { rule: u8, at: u16 },
+}
+
+/// An edit to the grammar, undone when the search backs up.
+#[derive(Clone, Copy, Debug)]
+enum Edit {
+    Added(u8),
+    Closed(u8),
+    Named(u8, u16),
+    NewLetter,
+}
+
+struct Point {
+    choice: Choice,
+    next: usize,
+    frames: Vec<Frame>,
+    turtle: Turtle,
+    h0: Option<f64>,
+    used: usize,
+    edits: usize,
+}
+
+enum Step {
+    Need(Choice),
+    Fail,
+    Done,
+}
+
+struct Search<'a> {
+    g: &'a Graph,
+    limits: Limits,
+    delta: f64,
+    turns: Vec<i32>,
+    axiom: Rule,
+    rules: Vec<Rule>,
+    frames: Vec<Frame>,
+    turtle: Turtle,
+    /// Radians of heading 0, fixed by the first drawn step.
+    h0: Option<f64>,
+    start: (u32, u32),
+    used: Vec<bool>,
+    /// Drawn edges and the vertex each was drawn from, in order.
+    trail: Vec<(u32, u32)>,
+    edits: Vec<Edit>,
+    cos_tol: f64,
+    work: u64,
+    /// Symbols in the axiom and all successors at most.
+    bound: usize,
+    /// The depth n.
+    depth: u8,
+}
+
+impl<'a> Search<'a> {
+    fn rule(&self, r: u8) -> &Rule {
+        if r == AXIOM {
+            &self.axiom
+        } else {
+            &self.rules[r as usize]
+        }
+    }
+
+    fn rule_mut(&mut self, r: u8) -> &mut Rule {
+        if r == AXIOM {
+            &mut self.axiom
+        } else {
+            &mut self.rules[r as usize]
+        }
+    }
+
+    /// Whether the axiom could still draw no more steps than the drawing
+    /// has: a lower bound of what it draws, from what is known of the
+    /// successors (an unnamed letter or an open successor draws at least
+    /// what its known part does, and at least one step).
+    fn feasible(&self) -> bool {
+        let n = self.depth;
+        let mut memo = [[None::<u64>; 16]; 4];
+        let mut total = 0u64;
+        for s in &self.axiom.syms {
+            total = total.saturating_add(self.least(*s, n, &mut memo));
+        }
+        total <= self.g.edges.len() as u64
+    }
+
+    /// The fewest steps symbol `s` at depth `d` draws.
+    fn least(&self, s: Sym, d: u8, memo: &mut [[Option<u64>; 16]; 4]) -> u64 {
+        match s {
+            Sym::Turn(_) | Sym::Push | Sym::Pop => 0,
+            _ if d == 0 => 1,
+            Sym::Letter(k) => self.least_letter(k, d, memo),
+            Sym::Unnamed => {
+                let mut m = if self.rules.len() < self.limits.letters {
+                    1
+                } else {
+                    u64::MAX
+                };
+                for j in 0..self.rules.len() as u8 {
+                    m = m.min(self.least_letter(j, d, memo));
+                }
+                m
+            }
+        }
+    }
+
+    fn least_letter(&self, k: u8, d: u8, memo: &mut [[Option<u64>; 16]; 4]) -> u64 {
+        if let Some(v) = memo
+            .get(k as usize)
+            .and_then(|r| r.get(d as usize))
+            .copied()
+            .flatten()
+        {
+            return v;
+        }
+        let Some(r) = self.rules.get(k as usize) else {
+            return 1;
+        };
+        let mut t = 0u64;
+        for s in &r.syms {
+            t = t.saturating_add(self.least(*s, d - 1, memo));
+        }
+        let t = t.max(1);
+        if let Some(cell) = memo.get_mut(k as usize).and_then(|r| r.get_mut(d as usize)) {
+            *cell = Some(t);
+        }
+        t
+    }
+
+    /// Whether more axiom letters could draw the steps left: once every
+    /// successor is known, the letters needed are at least the steps left
+    /// over the most one letter draws.
+    fn axiom_can_grow(&self, letters: usize) -> bool {
+        let depth = self.frames.first().map_or(0, |f| f.depth);
+        let mut most = 0u64;
+        for k in 0..self.rules.len() as u8 {
+            match self.count(k, depth) {
+                Some(c) => most = most.max(c),
+                None => return true,
+            }
+        }
+        let left = (self.g.edges.len() - self.trail.len()) as u64;
+        let need = left.div_ceil(most.max(1)) as usize;
+        letters + need <= self.limits.axiom
+    }
+
+    /// How many steps letter `k` draws at depth `d`, when every successor
+    /// it reaches is complete and named.
+    fn count(&self, k: u8, d: u8) -> Option<u64> {
+        let mut memo = [[None::<Option<u64>>; 16]; 4];
+        self.count_in(k, d, &mut memo)
+    }
+
+    fn count_in(&self, k: u8, d: u8, memo: &mut [[Option<Option<u64>>; 16]; 4]) -> Option<u64> {
+        if d == 0 {
+            return Some(1);
+        }
+        if let Some(m) = memo
+            .get(k as usize)
+            .and_then(|row| row.get(d as usize))
+            .copied()
+            .flatten()
+        {
+            return m;
+        }
+        let r = self.rules.get(k as usize)?;
+        let mut total: Option<u64> = if r.closed { Some(0) } else { None };
+        for s in &r.syms {
+            let c = match *s {
+                Sym::Letter(j) => self.count_in(j, d - 1, memo),
+                Sym::Unnamed if d == 1 => Some(1),
+                Sym::Unnamed => None,
+                _ => Some(0),
+            };
+            total = match (total, c) {
+                (Some(t), Some(c)) => Some(t.saturating_add(c)),
+                _ => None,
+            };
+            if total.is_none() {
+                break;
+            }
+        }
+        if let Some(cell) = memo
+            .get_mut(k as usize)
+            .and_then(|row| row.get_mut(d as usize))
+        {
+            *cell = Some(total);
+        }
+        total
+    }
+
+    /// Draws one step from the turtle's vertex along its heading.
+    fn draw(&mut self) -> bool {
+        let at = self.turtle.at;
+        let h0 = match self.h0 {
+            Some(h) => h,
+            None => {
+                // The first step: along the start edge.
+                let (v, e) = self.start;
+                if at != v || self.used[e as usize] {
+                    return false;
+                }
+                let dir = self.g.direction(e, v);
+                self.h0 = Some(dir - f64::from(self.turtle.heading) * self.delta.to_radians());
+                return self.take(e, v);
+            }
+        };
+        let a = h0 + f64::from(self.turtle.heading) * self.delta.to_radians();
+        let u = DVec2::new(a.cos(), a.sin());
+        let p = self.g.points[at as usize];
+        let mut best: Option<(f64, u32)> = None;
+        for &(nb, e) in &self.g.adj[at as usize] {
+            if self.used[e as usize] {
+                continue;
+            }
+            let d = self.g.points[nb as usize] - p;
+            let c = d.dot(u) / d.length();
+            if c >= self.cos_tol && best.is_none_or(|(bc, _)| c > bc) {
+                best = Some((c, e));
+            }
+        }
+        match best {
+            Some((_, e)) => self.take(e, at),
+            None => false,
+        }
+    }
+
+    fn take(&mut self, e: u32, from: u32) -> bool {
+        let [a, b] = self.g.edges[e as usize];
+        self.used[e as usize] = true;
+        self.trail.push((e, from));
+        self.turtle.at = if a == from { b } else { a };
+        true
+    }
+
+    /// Reads the derivation on to the next choice, failure or end.
+    fn advance(&mut self) -> Step {
+        loop {
+            self.work += 1;
+            if self.work > self.limits.work {
+                return Step::Fail;
+            }
+            let Some(top) = self.frames.last().copied() else {
+                return Step::Done;
+            };
+            let rule = self.rule(top.rule);
+            if top.at as usize >= rule.syms.len() {
+                if !rule.closed {
+                    return Step::Need(Choice::End { rule: top.rule });
+                }
+                self.frames.pop();
+                continue;
+            }
+            let sym = rule.syms[top.at as usize];
+            match sym {
+                Sym::Turn(t) => self.turtle.heading += t,
+                Sym::Push => {
+                    let s = (self.turtle.at, self.turtle.heading);
+                    self.turtle.saved.push(s);
+                }
+                Sym::Pop => match self.turtle.saved.pop() {
+                    Some((at, h)) => {
+                        self.turtle.at = at;
+                        self.turtle.heading = h;
+                    }
+                    None => return Step::Fail,
+                },
+                Sym::Unnamed if top.depth > 0 => {
+                    return Step::Need(Choice::Name {
+                        rule: top.rule,
+                        at: top.at,
+                    });
+                }
+                Sym::Unnamed | Sym::Letter(_) if top.depth == 0 => {
+                    if !self.draw() {
+                        return Step::Fail;
+                    }
+                }
+                Sym::Letter(k) => {
+                    // A letter that would draw more steps than are left.
+                    if let Some(c) = self.count(k, top.depth)
+                        && c > (self.g.edges.len() - self.trail.len()) as u64
+                    {
+                        return Step::Fail;
+                    }
+                    if let Some(f) = self.frames.last_mut() {
+                        f.at += 1;
+                    }
+                    self.frames.push(Frame {
+                        rule: k,
+                        at: 0,
+                        depth: top.depth - 1,
+                    });
+                    continue;
+                }
+                Sym::Unnamed => return Step::Fail,
+            }
+            if let Some(f) = self.frames.last_mut() {
+                f.at += 1;
+            }
+        }
+    }
+
+    /// The alternatives of a choice, in the order they are tried.
+    fn alternatives(&self, c: Choice) -> Vec<Alt> {
+        match c {
+            Choice::Name { rule, .. } => {
+                // A successor of one letter names another letter (a letter
+                // that only becomes itself, turned, explains nothing).
+                let single = rule != AXIOM
+                    && self
+                        .rule(rule)
+                        .syms
+                        .iter()
+                        .filter(|s| matches!(s, Sym::Letter(_) | Sym::Unnamed))
+                        .count()
+                        == 1
+                    && self.rule(rule).closed;
+                let mut v: Vec<Alt> = (0..self.rules.len() as u8)
+                    .filter(|&k| !(single && k == rule))
+                    .map(Alt::Name)
+                    .collect();
+                if self.rules.len() < self.limits.letters {
+                    v.push(Alt::NewLetter);
+                }
+                v
+            }
+            Choice::End { rule } => {
+                let r = self.rule(rule);
+                let letters = r
+                    .syms
+                    .iter()
+                    .filter(|s| matches!(s, Sym::Letter(_) | Sym::Unnamed))
+                    .count();
+                let open = r.syms.iter().fold(0i32, |d, s| match s {
+                    Sym::Push => d + 1,
+                    Sym::Pop => d - 1,
+                    _ => d,
+                });
+                let last = r.syms.last().copied();
+                let limit = if rule == AXIOM {
+                    self.limits.axiom
+                } else {
+                    self.limits.rule
+                };
+                let mut v = Vec::new();
+                // A successor that only copies its letter explains nothing.
+                let identity = rule != AXIOM
+                    && r.syms.len() == 1
+                    && matches!(r.syms[0], Sym::Unnamed | Sym::Letter(_));
+                if letters > 0 && open == 0 && !identity {
+                    v.push(Alt::Close);
+                }
+                let size =
+                    self.axiom.syms.len() + self.rules.iter().map(|r| r.syms.len()).sum::<usize>();
+                if r.syms.len() >= limit || size >= self.bound {
+                    return v;
+                }
+                if rule == AXIOM && !self.axiom_can_grow(letters) {
+                    return v;
+                }
+                v.push(Alt::Add(Sym::Unnamed));
+                let turn_ok =
+                    !matches!(last, Some(Sym::Turn(_))) && !(rule == AXIOM && r.syms.is_empty());
+                if turn_ok {
+                    for &t in &self.turns {
+                        v.push(Alt::Add(Sym::Turn(t)));
+                    }
+                }
+                if self.limits.brackets && rule != AXIOM {
+                    if open < 2 {
+                        v.push(Alt::Add(Sym::Push));
+                    }
+                    if open > 0 && !matches!(last, Some(Sym::Push) | Some(Sym::Turn(_))) {
+                        v.push(Alt::Add(Sym::Pop));
+                    }
+                }
+                v
+            }
+        }
+    }
+
+    fn apply(&mut self, c: Choice, alt: Alt) {
+        match (c, alt) {
+            (Choice::Name { rule, at }, Alt::Name(k)) => {
+                self.rule_mut(rule).syms[at as usize] = Sym::Letter(k);
+                self.edits.push(Edit::Named(rule, at));
+            }
+            (Choice::Name { rule, at }, Alt::NewLetter) => {
+                self.rules.push(Rule::default());
+                self.edits.push(Edit::NewLetter);
+                let k = self.rules.len() as u8 - 1;
+                self.rule_mut(rule).syms[at as usize] = Sym::Letter(k);
+                self.edits.push(Edit::Named(rule, at));
+            }
+            (Choice::End { rule }, Alt::Close) => {
+                self.rule_mut(rule).closed = true;
+                self.edits.push(Edit::Closed(rule));
+            }
+            (Choice::End { rule }, Alt::Add(s)) => {
+                self.rule_mut(rule).syms.push(s);
+                self.edits.push(Edit::Added(rule));
+            }
+            _ => {}
+        }
+    }
+
+    fn undo_to(&mut self, p: &Point) {
+        while self.trail.len() > p.used {
+            if let Some((e, _)) = self.trail.pop() {
+                self.used[e as usize] = false;
+            }
+        }
+        while self.edits.len() > p.edits {
+            match self.edits.pop() {
+                Some(Edit::Added(r)) => {
+                    self.rule_mut(r).syms.pop();
+                }
+                Some(Edit::Closed(r)) => self.rule_mut(r).closed = false,
+                Some(Edit::Named(r, at)) => self.rule_mut(r).syms[at as usize] = Sym::Unnamed,
+                Some(Edit::NewLetter) => {
+                    self.rules.pop();
+                }
+                None => break,
+            }
+        }
+        self.frames.clone_from(&p.frames);
+        self.turtle.clone_from(&p.turtle);
+        self.h0 = p.h0;
+    }
+
+    /// Searches from the start; `true` when the grammar draws every edge.
+    fn run(&mut self) -> bool {
+        let mut points: Vec<Point> = Vec::new();
+        loop {
+            match self.advance() {
+                Step::Done if self.trail.len() == self.g.edges.len() => return true,
+                Step::Need(c) => {
+                    let p = Point {
+                        choice: c,
+                        next: 0,
+                        frames: self.frames.clone(),
+                        turtle: self.turtle.clone(),
+                        h0: self.h0,
+                        used: self.trail.len(),
+                        edits: self.edits.len(),
+                    };
+                    points.push(p);
+                    if !self.next(&mut points) {
+                        return false;
+                    }
+                }
+                Step::Done | Step::Fail => {
+                    if !self.next(&mut points) {
+                        return false;
+                    }
+                }
+            }
+            if self.work > self.limits.work {
+                return false;
+            }
+        }
+    }
+
+    /// Takes the next alternative of the latest choice that has one.
+    fn next(&mut self, points: &mut Vec<Point>) -> bool {
+        while let Some(mut p) = points.pop() {
+            self.undo_to(&p);
+            let alts = self.alternatives(p.choice);
+            if p.next < alts.len() {
+                let alt = alts[p.next];
+                p.next += 1;
+                let c = p.choice;
+                points.push(p);
+                self.apply(c, alt);
+                if !self.feasible() {
+                    self.work += 1;
+                    continue;
+                }
+                return true;
+            }
+            self.work += 1;
+            if self.work > self.limits.work {
+                return false;
+            }
+        }
+        false
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Alt {
+    Close,
+    Add(Sym),
+    Name(u8),
+    NewLetter,
+}
+
+/// Where searches start: vertices with one edge first (a curve's ends, a
+/// plant's root), far from the drawing's centre first, then the others.
+fn starts(g: &Graph) -> Vec<(u32, u32)> {
+    let n = g.points.len().max(1) as f64;
+    let centre = g.points.iter().fold(DVec2::ZERO, |s, p| s + *p) / n;
+    let mut vs: Vec<u32> = (0..g.points.len() as u32)
+        .filter(|&v| !g.adj[v as usize].is_empty())
+        .collect();
+    vs.sort_by(|&a, &b| {
+        let (da, db) = (g.adj[a as usize].len(), g.adj[b as usize].len());
+        (da != 1).cmp(&(db != 1)).then(
+            g.points[b as usize]
+                .distance_squared(centre)
+                .total_cmp(&g.points[a as usize].distance_squared(centre)),
+        )
+    });
+    vs.iter()
+        .flat_map(|&v| g.adj[v as usize].iter().map(move |&(_, e)| (v, e)))
+        .collect()
+}
+
+/// The turns tried, in δ₀: small ones first.
+fn turn_range(delta: f64) -> Vec<i32> {
+    let m = (360.0 / delta).round();
+    let span = if (360.0 / delta - m).abs() < 1e-6 && m <= 16.0 {
+        (m as i32) / 2
+    } else {
+        4
+    };
+    let mut v = Vec::new();
+    for k in 1..=span {
+        v.push(k);
+        if !(2 * k == m as i32 && (360.0 / delta - m).abs() < 1e-6) {
+            v.push(-k);
+        }
+    }
+    v
+}
+
+/// δ₀ as the search uses it: 360/m when that is within a percent.
+fn working_delta(delta: f64) -> f64 {
+    let m = (360.0 / delta).round();
+    if m >= 2.0 && (360.0 / m - delta).abs() <= 0.01 * delta {
+        360.0 / m
+    } else {
+        delta
+    }
+}
+
+/// Searches for a grammar that draws every edge of `g` exactly once.
+pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
+    if g.edges.is_empty() {
+        return None;
+    }
+    let delta = working_delta(g.delta);
+    let turns = turn_range(delta);
+    let edges = g.edges.len() as f64;
+    let n_max = (edges.log2().ceil() as u32 + 1).clamp(2, 14);
+    // Directions within a third of δ₀ (tighter when the drawing is clean).
+    let tol = (delta / 3.0).min(10.0 + (2.0 * g.noise).atan().to_degrees() * 2.0);
+    let cos_tol = tol.to_radians().cos();
+    let starts = starts(g);
+    let mut spent = 0u64;
+    // Smallest grammars first: a bound on the symbols of the axiom and the
+    // successors, raised until a grammar is found.
+    for bound in BOUNDS {
+        for &(v, e) in &starts {
+            let mut found: Vec<Found> = Vec::new();
+            for n in (2..=n_max).rev() {
+                if spent >= limits.total || limits.deadline.is_some_and(|d| Instant::now() >= d) {
+                    return None;
+                }
+                let mut s = Search {
+                    g,
+                    limits: *limits,
+                    delta,
+                    turns: turns.clone(),
+                    axiom: Rule::default(),
+                    rules: vec![Rule::default()],
+                    frames: vec![Frame {
+                        rule: AXIOM,
+                        at: 0,
+                        depth: n as u8,
+                    }],
+                    turtle: Turtle {
+                        at: v,
+                        heading: 0,
+                        saved: Vec::new(),
+                    },
+                    h0: None,
+                    start: (v, e),
+                    used: vec![false; g.edges.len()],
+                    trail: Vec::new(),
+                    edits: Vec::new(),
+                    cos_tol,
+                    work: 0,
+                    bound,
+                    depth: n as u8,
+                };
+                s.limits.work = limits.work.min(limits.total - spent);
+                let ok = s.run();
+                spent += s.work;
+                if ok {
+                    found.push(Found {
+                        axiom: s.axiom.syms.clone(),
+                        rules: s.rules.iter().map(|r| r.syms.clone()).collect(),
+                        depth: n,
+                        delta,
+                        walk: walk(g, &s.trail),
+                    });
+                }
+            }
+            // Of the grammars from one start, the smallest, with the fewest
+            // letters.
+            if let Some(best) = found
+                .into_iter()
+                .min_by_key(|f| (f.size(), f.rules.len(), std::cmp::Reverse(f.depth)))
+            {
+                return Some(best);
+            }
+        }
+    }
+    None
+}
+
+/// The bounds on a grammar's symbols, tried in turn.
+const BOUNDS: [usize; 10] = [4, 6, 8, 10, 12, 15, 18, 22, 26, 32];
+
+/// The drawn edges, in the order drawn, as polylines: a new one wherever a
+/// step does not start where the last ended.
+fn walk(g: &Graph, trail: &[(u32, u32)]) -> Vec<Vec<DVec2>> {
+    let mut out: Vec<Vec<DVec2>> = Vec::new();
+    let mut at = u32::MAX;
+    for &(e, from) in trail {
+        let [a, b] = g.edges[e as usize];
+        let to = if a == from { b } else { a };
+        if from != at {
+            out.push(vec![g.points[from as usize]]);
+        }
+        if let Some(l) = out.last_mut() {
+            l.push(g.points[to as usize]);
+        }
+        at = to;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::infer::lines::graph;
+
+    /// Draws a D0L system's string as unit segments (a turtle of this test).
+    fn draw(axiom: &str, rules: &[(char, &str)], n: usize, delta: f64) -> Vec<Vec<DVec2>> {
+        let mut s: String = axiom.into();
+        for _ in 0..n {
+            s = s
+                .chars()
+                .map(|c| {
+                    rules
+                        .iter()
+                        .find(|r| r.0 == c)
+                        .map_or(c.to_string(), |r| r.1.to_string())
+                })
+                .collect();
+        }
+        let (mut p, mut h) = (DVec2::ZERO, 90f64);
+        let mut stack = Vec::new();
+        let mut out = Vec::new();
+        for c in s.chars() {
+            match c {
+                '+' => h += delta,
+                '-' => h -= delta,
+                '[' => stack.push((p, h)),
+                ']' => (p, h) = stack.pop().expect("balanced"),
+                c if c.is_ascii_uppercase() && c != 'X' && c != 'Y' => {
+                    let q = p + DVec2::new(h.to_radians().cos(), h.to_radians().sin()) * 3.0;
+                    out.push(vec![p, q]);
+                    p = q;
+                }
+                _ => {}
+            }
+        }
+        // Shuffle and reverse every other segment.
+        let mut state = 12345u64;
+        for i in (1..out.len()).rev() {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let j = (state >> 33) as usize % (i + 1);
+            out.swap(i, j);
+        }
+        for (i, l) in out.iter_mut().enumerate() {
+            if i % 2 == 1 {
+                l.reverse();
+            }
+        }
+        out
+    }
+
+    fn found(lines: &[Vec<DVec2>], brackets: bool) -> Option<Found> {
+        let g = graph::build(lines, 1).expect("graph");
+        let limits = Limits {
+            brackets,
+            ..Limits::default()
+        };
+        search(&g, &limits)
+    }
+
+    #[test]
+    fn shuffled_curves_give_back_their_grammars() {
+        // Drawn in another order, half the segments reversed: the
+        // terdragon (δ = 120°, touching itself at every other vertex).
+        let ter = found(&draw("F", &[('F', "F+F-F")], 4, 120.0), false).expect("the terdragon");
+        assert_eq!(
+            (ter.axiom.as_slice(), ter.rules.as_slice(), ter.depth),
+            (
+                &[Sym::Letter(0)][..],
+                &[vec![
+                    Sym::Letter(0),
+                    Sym::Turn(1),
+                    Sym::Letter(0),
+                    Sym::Turn(-1),
+                    Sym::Letter(0)
+                ]][..],
+                4
+            )
+        );
+        // Its walk draws every segment once, in the grammar's order.
+        let steps: usize = ter.walk.iter().map(|l| l.len() - 1).sum();
+        assert_eq!(steps, 81);
+    }
+
+    #[test]
+    fn a_random_walk_is_not_explained_within_the_work_limit() {
+        let mut lines = Vec::new();
+        let (mut p, mut state) = (DVec2::ZERO, 7u64);
+        let mut seen = std::collections::HashSet::new();
+        for _ in 0..400 {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let d = [DVec2::X, DVec2::Y, -DVec2::X, -DVec2::Y][(state >> 33) as usize % 4];
+            let q = p + d;
+            let key = ((p + q) * 2.0).round().as_ivec2();
+            if seen.insert((key.x, key.y)) {
+                lines.push(vec![p, q]);
+            }
+            p = q;
+        }
+        let g = graph::build(&lines, 1).expect("graph");
+        let limits = Limits {
+            total: 200_000,
+            ..Limits::default()
+        };
+        assert!(search(&g, &limits).is_none());
+    }
+}
