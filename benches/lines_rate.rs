@@ -2,7 +2,7 @@
 //! the large run of `tests/it/lines_random.rs`, in release.
 //!
 //! `cargo bench --bench lines_rate -- [--per-class N] [--first SEED]
-//! [--class CLASS]… [--variant VARIANT]… [--show]`
+//! [--class CLASS]… [--variant VARIANT]… [--show] [--write DIR]`
 //!
 //! Programs of each class (seeds SEED..SEED+N, default 0..200) are drawn
 //! by the tests' independent drawer in each variant and inferred; the table
@@ -10,7 +10,9 @@
 //! the median and largest time per inference, the failures by kind, and
 //! how the programs were sampled. Each failure is one line on stdout:
 //! `FAIL class seed variant kind: detail | program | found`. `--show`
-//! prints each case's program text and the inferred one.
+//! prints each case's program text and the inferred one; `--write DIR`
+//! writes each drawing (`CLASS-SEED-VARIANT.svg`, for `lsyc infer`) and
+//! program (`CLASS-SEED.lsy`) into DIR.
 //!
 //! Classes: edge-1 edge-2 edge-3 node bracketed moves. Variants: clean
 //! rotated jittered split shuffled.
@@ -28,6 +30,7 @@ fn main() {
     let mut classes = Vec::new();
     let mut variants = Vec::new();
     let mut show = false;
+    let mut write: Option<std::path::PathBuf> = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut value = |what: &str| args.next().unwrap_or_else(|| panic!("{a} needs {what}"));
@@ -43,6 +46,7 @@ fn main() {
                 variants.push(Variant::parse(&v).unwrap_or_else(|| panic!("no variant {v}")));
             }
             "--show" => show = true,
+            "--write" => write = Some(value("a folder").into()),
             // What cargo bench passes on.
             "--bench" => {}
             other => panic!("unknown argument {other}"),
@@ -63,6 +67,12 @@ fn main() {
         budget: None,
     };
     let table = lines_gen::run(&run, &mut |case, v, o| {
+        if let Some(dir) = &write {
+            let name = format!("{}-{}-{}.svg", case.class.name(), case.seed, v.name());
+            std::fs::write(dir.join(name), case.svg(v)).expect("writes the drawing");
+            let name = format!("{}-{}.lsy", case.class.name(), case.seed);
+            std::fs::write(dir.join(name), case.program.text()).expect("writes the program");
+        }
         if show {
             println!(
                 "== {} seed {} {}: {}\n{}",

@@ -18,6 +18,8 @@ pub const PLANT_ANGLES: [f64; 6] = [20.0, 22.5, 25.0, 25.7, 30.0, 45.0];
 pub const MIN_STEPS: u64 = 100;
 /// … and no more than this.
 pub const MAX_STEPS: u64 = 3000;
+/// The string one level further has no more letters than this.
+pub const MAX_LETTERS: u64 = 400_000;
 /// Candidates drawn before `generate` gives up.
 const MAX_TRIES: usize = 100_000;
 
@@ -143,10 +145,12 @@ impl Program {
 /// Why a candidate was left out.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Reject {
-    /// No successor turns between two of its symbols (`F -> FFF`,
-    /// `F -> +FF-`), or the drawing at depth n is one straight line
-    /// (`F -> Ff-f++f-F` at 120°, whose moves come back): any `F -> F^k`
-    /// draws it.
+    /// No rule draws a bend: each rewritten letter's successor, and its
+    /// successor's successor, draws all its steps on one line (`F -> FFF`,
+    /// `F -> +FF-`, `F -> Ff--f++F` at 90° whose moves come back,
+    /// `X -> XX-X` that never draws), so that the drawing is straight runs
+    /// turning only where the axiom turns, which `F -> F^k` explains as
+    /// well; or the drawing at depth n is one straight line.
     Straight,
     /// (Edge rewriting, every letter rewritten) A conjugate program is no
     /// larger: every successor's leading turn less c·δ and its trailing
@@ -162,7 +166,9 @@ pub enum Reject {
     /// number k ≥ 2 of steps on, heading as it started: `f -> f^k` would
     /// not keep the gaps in scale with the edges.
     OffLine,
-    /// No depth n ≥ 2 draws between `MIN_STEPS` and `MAX_STEPS` steps.
+    /// No depth n ≥ 2 draws between `MIN_STEPS` and `MAX_STEPS` steps
+    /// with no more than `MAX_LETTERS` letters at depth n + 1 (node
+    /// letters that multiply without drawing).
     Size,
     /// A letter does not occur at depth n − 1, so its rule is never used
     /// to draw level n.
@@ -467,16 +473,22 @@ fn moves(rng: &mut Rng) -> Result<Program, Reject> {
 
 // ------------------------------------------------------------ filters
 
-/// Whether `w` turns between two of its symbols (leading and trailing
-/// turns do not count).
-fn bends(w: &str) -> bool {
-    let inner = w.trim_matches(|c| c == '+' || c == '-');
-    inner.contains(['+', '-'])
+/// Whether some rule draws a bend: the successor of one of the rewritten
+/// letters, or its successor, drawn from that letter alone, does not draw
+/// all its steps on one line.
+fn bends(p: &Program) -> bool {
+    p.rules.iter().any(|(l, _)| {
+        let q = Program {
+            axiom: l.to_string(),
+            ..p.clone()
+        };
+        (1..=2).any(|k| !straight(&draw::draw(&q, &draw::derive(&q, k))))
+    })
 }
 
 /// The filters, and the depth: `p` as drawn, or why it is left out.
 fn filter(mut p: Program, rng: &mut Rng) -> Result<Program, Reject> {
-    if !p.rules.iter().any(|(_, w)| bends(w)) {
+    if !bends(&p) {
         return Err(Reject::Straight);
     }
     if conjugate(&p) {
@@ -513,25 +525,30 @@ fn filter(mut p: Program, rng: &mut Rng) -> Result<Program, Reject> {
             .map(|(_, n)| *n)
             .sum()
     };
+    let total = |v: &[u64]| v.iter().fold(0u64, |a, &b| a.saturating_add(b));
     let mut levels = vec![count(&p.axiom)];
-    let mut depths = Vec::new();
-    for n in 1..=40u32 {
-        let prev = levels.last().unwrap();
+    while levels.len() <= 41 {
+        let last = levels.last().unwrap();
+        if drawn(last) > MAX_STEPS || total(last) > MAX_LETTERS {
+            break;
+        }
         let mut next = vec![0u64; letters.len()];
-        for (i, &m) in prev.iter().enumerate() {
+        for (i, &m) in last.iter().enumerate() {
             for (j, &r) in rows[i].iter().enumerate() {
                 next[j] = next[j].saturating_add(m.saturating_mul(r));
             }
         }
-        let steps = drawn(&next);
         levels.push(next);
-        if n >= 2 && (MIN_STEPS..=MAX_STEPS).contains(&steps) {
-            depths.push(n);
-        }
-        if steps > MAX_STEPS {
-            break;
-        }
     }
+    // Depths n with the right number of steps and a string one level
+    // further no longer than `MAX_LETTERS` letters.
+    let depths: Vec<u32> = (2..levels.len().saturating_sub(1))
+        .filter(|&d| {
+            (MIN_STEPS..=MAX_STEPS).contains(&drawn(&levels[d]))
+                && total(&levels[d + 1]) <= MAX_LETTERS
+        })
+        .map(|d| d as u32)
+        .collect();
     if depths.is_empty() {
         return Err(Reject::Size);
     }
