@@ -10,8 +10,12 @@ use super::draw;
 use super::rng::Rng;
 use std::collections::HashSet;
 
-/// δ of the edge-rewriting, node-rewriting and moves classes, degrees.
+/// δ of the edge-rewriting and node-rewriting classes, degrees.
 pub const EDGE_ANGLES: [f64; 8] = [90.0, 60.0, 45.0, 120.0, 72.0, 36.0, 30.0, 22.5];
+/// δ of the moves class, degrees: those at which a successor of 3–8
+/// steps and moves ends on its own line often enough (at 72°, 36° and
+/// 22.5° one in hundreds of thousands does, or none).
+pub const MOVES_ANGLES: [f64; 5] = [90.0, 60.0, 45.0, 120.0, 30.0];
 /// δ of the bracketed plants, degrees.
 pub const PLANT_ANGLES: [f64; 6] = [20.0, 22.5, 25.0, 25.7, 30.0, 45.0];
 /// The drawing at the chosen depth has this many unit steps, or more …
@@ -227,22 +231,27 @@ impl Rejections {
 }
 
 /// A random program of `class` that passes every filter; `None` if none
-/// did within `MAX_TRIES` candidates.
+/// did within `MAX_TRIES` candidates. δ (and for plants, edge or node
+/// rewriting) is drawn first, uniformly, and kept while candidates are
+/// drawn: each δ is as common among the programs as any other, however
+/// many of its candidates the filters leave out.
 pub fn generate(class: Class, rng: &mut Rng, rejections: &mut Rejections) -> Option<Program> {
+    let angles: &[f64] = match class {
+        Class::Bracketed => &PLANT_ANGLES,
+        Class::Moves => &MOVES_ANGLES,
+        _ => &EDGE_ANGLES,
+    };
+    let delta = rng.pick(angles);
+    let edge_plants = rng.chance(0.5);
     for _ in 0..MAX_TRIES {
         let candidate = match class {
-            Class::Edge1 => edge(rng, 1),
-            Class::Edge2 => edge(rng, 2),
-            Class::Edge3 => edge(rng, 3),
-            Class::Node => node(rng),
-            Class::Bracketed => {
-                if rng.chance(0.5) {
-                    edge_plant(rng)
-                } else {
-                    node_plant(rng)
-                }
-            }
-            Class::Moves => moves(rng),
+            Class::Edge1 => edge(rng, delta, 1),
+            Class::Edge2 => edge(rng, delta, 2),
+            Class::Edge3 => edge(rng, delta, 3),
+            Class::Node => node(rng, delta),
+            Class::Bracketed if edge_plants => edge_plant(rng, delta),
+            Class::Bracketed => node_plant(rng, delta),
+            Class::Moves => moves(rng, delta),
         };
         match candidate.and_then(|p| filter(p, rng)) {
             Ok(p) => {
@@ -311,8 +320,7 @@ fn one(c: char) -> String {
 }
 
 /// edge-1, edge-2, edge-3: `letters` drawing letters (F, G, H).
-fn edge(rng: &mut Rng, letters: usize) -> Result<Program, Reject> {
-    let delta = rng.pick(&EDGE_ANGLES);
+fn edge(rng: &mut Rng, delta: f64, letters: usize) -> Result<Program, Reject> {
     let alphabet = &['F', 'G', 'H'][..letters];
     let mut rules = Vec::new();
     if letters == 1 {
@@ -342,8 +350,7 @@ fn edge(rng: &mut Rng, letters: usize) -> Result<Program, Reject> {
 }
 
 /// node: X (and sometimes Y) rewritten over F, X, Y; `F -> F` or `F -> FF`.
-fn node(rng: &mut Rng) -> Result<Program, Reject> {
-    let delta = rng.pick(&EDGE_ANGLES);
+fn node(rng: &mut Rng, delta: f64) -> Result<Program, Reject> {
     let with_y = rng.chance(0.5);
     let alphabet: &[char] = if with_y {
         &['F', 'X', 'Y']
@@ -377,8 +384,7 @@ fn node(rng: &mut Rng) -> Result<Program, Reject> {
 
 /// bracketed, edge rewriting: a trunk of F's with 1–3 branches of 1–3
 /// steps (`F -> F[+F]F[-F]F`, `F -> FF-[-F+F+F]+[+F-F-F]`).
-fn edge_plant(rng: &mut Rng) -> Result<Program, Reject> {
-    let delta = rng.pick(&PLANT_ANGLES);
+fn edge_plant(rng: &mut Rng, delta: f64) -> Result<Program, Reject> {
     let mut w = "F".repeat(rng.range(1, 2) as usize);
     let branches = rng.range(1, 3);
     for b in 0..branches {
@@ -408,8 +414,7 @@ fn edge_plant(rng: &mut Rng) -> Result<Program, Reject> {
 }
 
 /// bracketed, node rewriting: `X -> F[+X]F[-X]+X`, `F -> FF`-like.
-fn node_plant(rng: &mut Rng) -> Result<Program, Reject> {
-    let delta = rng.pick(&PLANT_ANGLES);
+fn node_plant(rng: &mut Rng, delta: f64) -> Result<Program, Reject> {
     let mut w = "F".repeat(rng.range(1, 2) as usize);
     for _ in 0..rng.range(1, 3) {
         w.push('[');
@@ -437,8 +442,7 @@ fn node_plant(rng: &mut Rng) -> Result<Program, Reject> {
 
 /// moves: `F -> ` 3–8 steps and moves (at least two F, one f) ending on
 /// its own line k steps on, `f -> f^k`.
-fn moves(rng: &mut Rng) -> Result<Program, Reject> {
-    let delta = rng.pick(&EDGE_ANGLES);
+fn moves(rng: &mut Rng, delta: f64) -> Result<Program, Reject> {
     let n = rng.range(3, 8) as usize;
     let mut parts: Vec<String> = (0..n)
         .map(|_| one(if rng.chance(0.3) { 'f' } else { 'F' }))
