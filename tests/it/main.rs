@@ -15,6 +15,8 @@ mod hostile_svg;
 mod infer;
 mod layers;
 mod lines;
+mod lines_gen;
+mod lines_random;
 mod lsp;
 mod outputs;
 mod plants;
