@@ -90,7 +90,7 @@ impl Default for Limits {
             rule: 24,
             axiom: 12,
             work: 200_000,
-            total: 12_000_000,
+            total: 1_000_000,
             brackets: false,
             deadline: None,
         }
@@ -819,6 +819,7 @@ mod tests {
         let g = graph::build(lines, 1).expect("graph");
         let limits = Limits {
             brackets,
+            total: 12_000_000,
             ..Limits::default()
         };
         search(&g, &limits)
