@@ -15,6 +15,7 @@ mod hostile_svg;
 mod infer;
 mod layers;
 mod lines;
+mod lines_classic;
 mod lines_gen;
 mod lines_random;
 mod lsp;

@@ -37,6 +37,9 @@ pub struct Options {
     pub budget: Duration,
     /// Search limits.
     pub limits: search::Limits,
+    /// Limits of the search on the stroke graph (`synth`); its work is a
+    /// count, so the same drawing gets the same answer on any machine.
+    pub graph: synth::Limits,
 }
 
 impl Default for Options {
@@ -44,6 +47,7 @@ impl Default for Options {
         Options {
             budget: Duration::from_millis(DEFAULT_BUDGET_MS),
             limits: search::Limits::default(),
+            graph: synth::Limits::default(),
         }
     }
 }
@@ -212,7 +216,7 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
     // The drawing as a set of segments: a grammar that draws each once,
     // whatever the order, direction and splitting of its paths.
     let t = Instant::now();
-    let by_graph = from_graph(&lines, name, None, &mut stats);
+    let by_graph = from_graph(&lines, name, &opts.graph, &mut stats);
     stats.search_ms += ms(t);
     match by_graph {
         Ok(found) => return Lines::Found(found),
@@ -237,9 +241,10 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
 fn from_graph(
     lines: &[Vec<DVec2>],
     name: &str,
-    deadline: Option<Instant>,
+    opts: &synth::Limits,
     stats: &mut Stats,
 ) -> Result<Box<Inferred>, bool> {
+    let deadline = opts.deadline;
     let late = || deadline.is_some_and(|d| Instant::now() >= d);
     for split in [1, 2] {
         if late() {
@@ -251,9 +256,8 @@ fn from_graph(
         let branches =
             g.adj.iter().any(|a| a.len() > 2) || g.adj.iter().filter(|a| a.len() == 1).count() > 2;
         let limits = synth::Limits {
-            deadline,
             brackets: branches,
-            ..synth::Limits::default()
+            ..*opts
         };
         let Some(found) = synth::search(&g, &limits) else {
             continue;
@@ -266,6 +270,9 @@ fn from_graph(
         let Some(gr) = to_grammar(&found, &reading.angles) else {
             continue;
         };
+        if !explains(&gr, drawing_symbols(&reading)) {
+            continue;
+        }
         stats.compared += 1;
         stats.steps = reading.steps;
         stats.angle = reading.angles.delta;

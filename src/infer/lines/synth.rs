@@ -90,7 +90,7 @@ impl Default for Limits {
             rule: 24,
             axiom: 12,
             work: 200_000,
-            total: 1_000_000,
+            total: 8_000_000,
             brackets: false,
             deadline: None,
         }
@@ -465,8 +465,8 @@ impl<'a> Search<'a> {
                 let mut v = Vec::new();
                 // A successor that only copies its letter explains nothing.
                 let identity = rule != AXIOM
-                    && r.syms.len() == 1
-                    && matches!(r.syms[0], Sym::Unnamed | Sym::Letter(_));
+                    && letters == 1
+                    && (r.syms.len() == 1 || r.syms.contains(&Sym::Letter(rule)));
                 if letters > 0 && open == 0 && !identity {
                     v.push(Alt::Close);
                 }
@@ -480,7 +480,7 @@ impl<'a> Search<'a> {
                 }
                 v.push(Alt::Add(Sym::Unnamed));
                 let turn_ok =
-                    !matches!(last, Some(Sym::Turn(_))) && !(rule == AXIOM && r.syms.is_empty());
+                    !(matches!(last, Some(Sym::Turn(_))) || rule == AXIOM && r.syms.is_empty());
                 if turn_ok {
                     for &t in &self.turns {
                         v.push(Alt::Add(Sym::Turn(t)));
@@ -677,68 +677,82 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
     let tol = (delta / 3.0).min(10.0 + (2.0 * g.noise).atan().to_degrees() * 2.0);
     let cos_tol = tol.to_radians().cos();
     let starts = starts(g);
+    // A curve's ends (a plant's root among its tips) are where a drawing
+    // most likely starts: every bound is tried from each of them before
+    // the other vertices, which are tried bound by bound.
+    let ends = starts
+        .iter()
+        .take_while(|(v, _)| g.adj[*v as usize].len() == 1)
+        .take(MAX_ENDS)
+        .count();
+    let mut plan: Vec<(usize, (u32, u32))> = Vec::new();
+    for &start in &starts[..ends] {
+        plan.extend(BOUNDS.iter().map(|&b| (b, start)));
+    }
+    for b in BOUNDS {
+        plan.extend(starts[ends..].iter().map(|&start| (b, start)));
+    }
     let mut spent = 0u64;
-    // Smallest grammars first: a bound on the symbols of the axiom and the
-    // successors, raised until a grammar is found.
-    for bound in BOUNDS {
-        for &(v, e) in &starts {
-            let mut found: Vec<Found> = Vec::new();
-            for n in (2..=n_max).rev() {
-                if spent >= limits.total || limits.deadline.is_some_and(|d| Instant::now() >= d) {
-                    return None;
-                }
-                let mut s = Search {
-                    g,
-                    limits: *limits,
-                    delta,
-                    turns: turns.clone(),
-                    axiom: Rule::default(),
-                    rules: vec![Rule::default()],
-                    frames: vec![Frame {
-                        rule: AXIOM,
-                        at: 0,
-                        depth: n as u8,
-                    }],
-                    turtle: Turtle {
-                        at: v,
-                        heading: 0,
-                        saved: Vec::new(),
-                    },
-                    h0: None,
-                    start: (v, e),
-                    used: vec![false; g.edges.len()],
-                    trail: Vec::new(),
-                    edits: Vec::new(),
-                    cos_tol,
-                    work: 0,
-                    bound,
+    for (bound, (v, e)) in plan {
+        let mut found: Vec<Found> = Vec::new();
+        for n in (2..=n_max).rev() {
+            if spent >= limits.total || limits.deadline.is_some_and(|d| Instant::now() >= d) {
+                return None;
+            }
+            let mut s = Search {
+                g,
+                limits: *limits,
+                delta,
+                turns: turns.clone(),
+                axiom: Rule::default(),
+                rules: vec![Rule::default()],
+                frames: vec![Frame {
+                    rule: AXIOM,
+                    at: 0,
                     depth: n as u8,
-                };
-                s.limits.work = limits.work.min(limits.total - spent);
-                let ok = s.run();
-                spent += s.work;
-                if ok {
-                    found.push(Found {
-                        axiom: s.axiom.syms.clone(),
-                        rules: s.rules.iter().map(|r| r.syms.clone()).collect(),
-                        depth: n,
-                        delta,
-                        walk: walk(g, &s.trail),
-                    });
-                }
+                }],
+                turtle: Turtle {
+                    at: v,
+                    heading: 0,
+                    saved: Vec::new(),
+                },
+                h0: None,
+                start: (v, e),
+                used: vec![false; g.edges.len()],
+                trail: Vec::new(),
+                edits: Vec::new(),
+                cos_tol,
+                work: 0,
+                bound,
+                depth: n as u8,
+            };
+            s.limits.work = limits.work.min(limits.total - spent);
+            let ok = s.run();
+            spent += s.work;
+            if ok {
+                found.push(Found {
+                    axiom: s.axiom.syms.clone(),
+                    rules: s.rules.iter().map(|r| r.syms.clone()).collect(),
+                    depth: n,
+                    delta,
+                    walk: walk(g, &s.trail),
+                });
             }
-            // Of the grammars from one start, the smallest, with the fewest
-            // letters.
-            if let Some(best) = found
-                .into_iter()
-                .min_by_key(|f| (f.size(), f.rules.len(), std::cmp::Reverse(f.depth)))
-            {
-                return Some(best);
-            }
+        }
+        // Of the grammars from one start, the smallest, with the fewest
+        // letters.
+        if let Some(best) = found
+            .into_iter()
+            .min_by_key(|f| (f.size(), f.rules.len(), std::cmp::Reverse(f.depth)))
+        {
+            return Some(best);
         }
     }
     None
 }
+
+/// The most start edges at a curve's ends tried with every bound first.
+const MAX_ENDS: usize = 8;
 
 /// The bounds on a grammar's symbols, tried in turn.
 const BOUNDS: [usize; 10] = [4, 6, 8, 10, 12, 15, 18, 22, 26, 32];

@@ -175,13 +175,19 @@ pub enum Inference {
     NotLines(String),
 }
 
-/// The one place this module calls inference (its API is being re-cut):
-/// the library's line-drawing inference with its default options, but for
-/// the time budget when `budget` is given.
+/// The work the stroke-graph search may do when a budget is given (the
+/// debug-build property test): an eighth of its default, so that the drawings
+/// it cannot explain cost about a second each in a debug build.
+const TEST_GRAPH_WORK: u64 = 1_000_000;
+
+/// The one place this module calls inference: the library's line-drawing
+/// inference with its default options, but for the time budget (and the
+/// graph search's work, `TEST_GRAPH_WORK`) when `budget` is given.
 pub fn infer(svg: &[u8], budget: Option<Duration>) -> Inference {
     let mut opts = lines::Options::default();
     if let Some(b) = budget {
         opts.budget = b;
+        opts.graph.total = TEST_GRAPH_WORK;
     }
     match lines::from_svg(svg, "random.svg", &opts) {
         Lines::Found(f) => {
@@ -307,7 +313,7 @@ type Segs = Vec<(DVec2, DVec2)>;
 
 /// The program `text` derived and drawn by the library (as `lsyc run` and
 /// inference's own check do) at its `derive` and one step further.
-fn redraw(text: &str) -> Result<(Segs, Segs), String> {
+pub fn redraw(text: &str) -> Result<(Segs, Segs), String> {
     let fe = lsyc::frontend::run(text, Vec::new(), &[]);
     if fe.has_errors() {
         return Err("the inferred program has errors".into());
@@ -362,22 +368,45 @@ fn unit_steps(segments: &[(DVec2, DVec2)], step: f64) -> Segs {
 /// steps): steps of `truth` that `drawn` has not (within `TOLERANCE` steps
 /// at both ends), and the other way round.
 pub fn compare(truth: &[(DVec2, DVec2)], drawn: &[(DVec2, DVec2)], step: f64) -> (usize, usize) {
+    compare_within(truth, drawn, step, TOLERANCE)
+}
+
+/// [`compare`] with ends within `tolerance` steps.
+pub fn compare_within(
+    truth: &[(DVec2, DVec2)],
+    drawn: &[(DVec2, DVec2)],
+    step: f64,
+    tolerance: f64,
+) -> (usize, usize) {
     let (a, b) = (unit_steps(truth, step), unit_steps(drawn, step));
     // A wrong grammar can draw far more: no need to count exactly.
     if b.len() > 8 * a.len() + 1000 {
         return (0, b.len());
     }
-    (unmatched(&a, &b, step), unmatched(&b, &a, step))
+    let tol = tolerance * step;
+    (unmatched(&a, &b, step, tol), unmatched(&b, &a, step, tol))
 }
 
 /// Steps of `from` with no step of `to` at both ends.
-fn unmatched(from: &[(DVec2, DVec2)], to: &[(DVec2, DVec2)], step: f64) -> usize {
-    pairs(from, to, step).iter().filter(|p| p.is_none()).count()
+fn unmatched(from: &[(DVec2, DVec2)], to: &[(DVec2, DVec2)], step: f64, tol: f64) -> usize {
+    pairs_within(from, to, step, tol)
+        .iter()
+        .filter(|p| p.is_none())
+        .count()
 }
 
 /// The step of `to` at both ends of each step of `from`, if any.
 fn pairs(from: &[(DVec2, DVec2)], to: &[(DVec2, DVec2)], step: f64) -> Vec<Option<(DVec2, DVec2)>> {
-    let tol = TOLERANCE * step;
+    pairs_within(from, to, step, TOLERANCE * step)
+}
+
+/// [`pairs`] with ends within `tol` (user units).
+fn pairs_within(
+    from: &[(DVec2, DVec2)],
+    to: &[(DVec2, DVec2)],
+    step: f64,
+    tol: f64,
+) -> Vec<Option<(DVec2, DVec2)>> {
     let key = |p: DVec2| ((p.x / step).floor() as i64, (p.y / step).floor() as i64);
     let mut cells: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
     for (i, s) in to.iter().enumerate() {
