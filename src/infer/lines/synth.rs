@@ -160,7 +160,7 @@ struct Search<'a> {
     /// Radians of heading 0, fixed by the first drawn step.
     h0: Option<f64>,
     start: (u32, u32),
-    used: Vec<bool>,
+    used: &'a mut [bool],
     /// Drawn edges and the vertex each was drawn from, in order.
     trail: Vec<(u32, u32)>,
     edits: Vec<Edit>,
@@ -666,7 +666,7 @@ fn working_delta(delta: f64) -> f64 {
 
 /// Searches for a grammar that draws every edge of `g` exactly once.
 pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
-    if g.edges.is_empty() {
+    if g.edges.is_empty() || g.edges.len() > MAX_EDGES {
         return None;
     }
     let delta = working_delta(g.delta);
@@ -693,6 +693,9 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
         plan.extend(starts[ends..].iter().map(|&start| (b, start)));
     }
     let mut spent = 0u64;
+    // Which edges are drawn: one buffer for every attempt, cleared by the
+    // attempt's own trail (an attempt costs its work, not the drawing's size).
+    let mut used = vec![false; g.edges.len()];
     for (bound, (v, e)) in plan {
         let mut found: Vec<Found> = Vec::new();
         for n in (2..=n_max).rev() {
@@ -718,7 +721,7 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
                 },
                 h0: None,
                 start: (v, e),
-                used: vec![false; g.edges.len()],
+                used: &mut used,
                 trail: Vec::new(),
                 edits: Vec::new(),
                 cos_tol,
@@ -728,7 +731,7 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
             };
             s.limits.work = limits.work.min(limits.total - spent);
             let ok = s.run();
-            spent += s.work;
+            spent += s.work.max(1);
             if ok {
                 found.push(Found {
                     axiom: s.axiom.syms.clone(),
@@ -737,6 +740,9 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
                     delta,
                     walk: walk(g, &s.trail),
                 });
+            }
+            for &(e, _) in &s.trail {
+                s.used[e as usize] = false;
             }
         }
         // Of the grammars from one start, the smallest, with the fewest
@@ -750,6 +756,10 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
     }
     None
 }
+
+/// The most unit edges a drawing may have for this search (its work limit
+/// would end it long before it drew one so large).
+pub const MAX_EDGES: usize = 200_000;
 
 /// The most start edges at a curve's ends tried with every bound first.
 const MAX_ENDS: usize = 8;
