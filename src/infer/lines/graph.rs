@@ -400,60 +400,45 @@ pub fn build(lines: &[Vec<DVec2>], split: u32) -> Result<Graph, String> {
     Ok(g)
 }
 
-/// The turns the drawing shows, degrees: at a vertex of two edges, the turn
-/// a walk through it makes (180° less the angle between its rays); at other
-/// vertices, the angle between two rays folded into [0°, 90°] (either that
-/// angle or 180° less it is a turn).
-pub fn turns(g: &Graph) -> Vec<f64> {
-    let mut out = Vec::new();
+/// The turns the drawing shows, degrees: at each vertex of two edges, the
+/// turn a walk through it makes (180° less the angle between its rays); and
+/// at other vertices, the angles between two rays folded into [0°, 90°]
+/// (either that angle or 180° less it is a turn).
+pub fn turns(g: &Graph) -> (Vec<f64>, Vec<f64>) {
+    let (mut two, mut others) = (Vec::new(), Vec::new());
+    let angle = |a: f64, b: f64| {
+        let d = (a - b).rem_euclid(360.0);
+        if d > 180.0 { 360.0 - d } else { d }
+    };
     for (v, nb) in g.adj.iter().enumerate() {
         let dirs: Vec<f64> = nb
             .iter()
             .map(|&(_, e)| g.direction(e, v as u32).to_degrees())
             .collect();
-        let angle = |a: f64, b: f64| {
-            let d = (a - b).rem_euclid(360.0);
-            if d > 180.0 { 360.0 - d } else { d }
-        };
         if dirs.len() == 2 {
-            out.push(180.0 - angle(dirs[0], dirs[1]));
+            two.push(180.0 - angle(dirs[0], dirs[1]));
             continue;
         }
         for i in 0..dirs.len().min(8) {
             for j in i + 1..dirs.len().min(8) {
                 let a = angle(dirs[i], dirs[j]);
-                out.push(a.min(180.0 - a));
+                others.push(a.min(180.0 - a));
             }
         }
     }
-    out
+    (two, others)
 }
 
 /// δ₀: the turns' smallest common unit (see `read::delta_from_turns`).
+/// Turns at two-edge vertices are true turns: they are used alone when at
+/// least 8 of them bend, or all that there are bend; else every angle.
 fn smallest_turn(g: &Graph) -> f64 {
-    let t = turns(g);
-    // Turns at two-edge vertices are true turns; use them alone when there
-    // are enough that bend, else all.
-    let bends = g.adj.iter().filter(|nb| nb.len() == 2).count().min(t.len());
-    let two: Vec<f64> = g
-        .adj
-        .iter()
-        .enumerate()
-        .filter(|(_, nb)| nb.len() == 2)
-        .map(|(v, nb)| {
-            let a = g.direction(nb[0].1, v as u32).to_degrees();
-            let b = g.direction(nb[1].1, v as u32).to_degrees();
-            let d = (a - b).rem_euclid(360.0);
-            180.0 - if d > 180.0 { 360.0 - d } else { d }
-        })
-        .collect();
+    let (mut two, others) = turns(g);
     let bending = two.iter().filter(|t| t.abs() > 1.0).count();
-    let sample = if bending >= 8 || bending == bends.min(two.len()) && bending > 0 {
-        two
-    } else {
-        t
-    };
-    super::read::delta_from_turns(&sample).map_or(90.0, |a| a.delta)
+    if !(bending >= 8 || bending > 0 && bending == two.len()) {
+        two.extend(others);
+    }
+    super::read::delta_from_turns(&two).map_or(90.0, |a| a.delta)
 }
 
 #[cfg(test)]
