@@ -33,3 +33,4 @@ pub mod studio;
 pub mod trivia;
 pub mod turtle;
 pub mod vm;
+pub mod write;

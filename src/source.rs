@@ -1,4 +1,5 @@
-//! Reading a program from disk: size limit, directories, UTF-8.
+//! Reading a program from disk: size limit, directories, UTF-8 (writing is
+//! `crate::write`'s; `write_atomic` here is its short name).
 //!
 //! Owns: turning a path into text plus the diagnostics about the file itself.
 
@@ -59,77 +60,15 @@ fn cannot_read(name: &str, e: &std::io::Error) -> Diagnostic {
     Diagnostic::error(Code::ReadFile, format!("cannot read `{name}`: {why}"))
 }
 
-/// Writes `contents` to `path` atomically: a temporary file beside it, then a rename.
+/// Writes `contents` to `path` atomically (see `crate::write::replace`).
 pub fn write_atomic(path: &Path, contents: &[u8]) -> std::io::Result<()> {
-    write_atomic_with(path, |w| w.write_all(contents))
+    crate::write::replace_with_bytes(path, contents)
 }
 
-/// Streams into a temporary file beside `path` and renames it over `path` only
-/// when `fill` succeeds; on failure nothing is left behind and `path` is untouched.
-///
-/// Only a regular file (or a new one) is replaced that way. A symbolic link is
-/// followed, so the link stays and its target gets the new contents; a device,
-/// pipe or socket (`-o /dev/null`, `-o /dev/stdout`, a FIFO) is written in place,
-/// since renaming over it would replace the device with a plain file.
+/// Streams into `path` atomically (see `crate::write::replace`).
 pub fn write_atomic_with(
     path: &Path,
     fill: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let resolved;
-    let path = match std::fs::symlink_metadata(path) {
-        Ok(meta) if meta.file_type().is_symlink() => match std::fs::canonicalize(path) {
-            Ok(target) => {
-                resolved = target;
-                resolved.as_path()
-            }
-            // A dangling link: writing through it creates its target.
-            Err(_) => return write_in_place(path, fill),
-        },
-        _ => path,
-    };
-    if let Ok(meta) = std::fs::metadata(path)
-        && !meta.is_file()
-    {
-        return write_in_place(path, fill);
-    }
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    let file_name = path
-        .file_name()
-        .map(|f| f.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".to_string());
-    let tmp = dir.join(format!(".{file_name}.lsyc-{}.tmp", std::process::id()));
-    let result = (|| {
-        let f = std::fs::File::create(&tmp)?;
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
-        fill(&mut w)?;
-        let f = w.into_inner().map_err(|e| e.into_error())?;
-        f.sync_all()?;
-        if let Ok(meta) = std::fs::metadata(path) {
-            std::fs::set_permissions(&tmp, meta.permissions())?;
-        }
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
-/// Writes into `path` as it is (a device, a pipe, a dangling link), for the
-/// outputs that cannot be replaced by a rename.
-fn write_in_place(
-    path: &Path,
-    fill: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
-) -> std::io::Result<()> {
-    let f = std::fs::OpenOptions::new()
-        .write(true)
-        .create(true)
-        .truncate(true)
-        .open(path)?;
-    let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
-    fill(&mut w)?;
-    std::io::Write::flush(&mut w)
+    crate::write::replace(path, fill)
 }

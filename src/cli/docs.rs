@@ -4,7 +4,6 @@
 
 use super::{Cli, Reporter};
 use clap::CommandFactory;
-use std::io::Write;
 
 #[derive(clap::Args, Debug)]
 pub struct CompletionsArgs {
@@ -58,15 +57,8 @@ pub fn man(args: &ManArgs, reporter: &Reporter) -> u8 {
     write_stdout(&out, reporter)
 }
 
+/// The page or script on stdout: exit 1 when it could not be written (a full
+/// disk, a closed pipe), with a message where one can still be written.
 fn write_stdout(bytes: &[u8], reporter: &Reporter) -> u8 {
-    let mut stdout = std::io::stdout().lock();
-    match stdout.write_all(bytes).and_then(|()| stdout.flush()) {
-        Ok(()) => 0,
-        // A closed pipe (`lsyc man | head`) is not an error of ours.
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => 0,
-        Err(e) => {
-            reporter.error(&format!("cannot write to stdout: {e}"), None);
-            1
-        }
-    }
+    if reporter.stdout(bytes) { 0 } else { 1 }
 }

@@ -8,7 +8,6 @@ use super::Reporter;
 use clap::{Arg, ArgAction, ArgMatches, Command};
 use lsyc::edit::{self, EditError, Op};
 use lsyc::{frontend, source};
-use std::io::Write;
 use std::path::PathBuf;
 
 #[derive(Debug)]
@@ -234,7 +233,9 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         }
         reporter.info(&summary);
     } else {
-        let _ = std::io::stdout().write_all(out.as_bytes());
+        if !reporter.stdout(out.as_bytes()) {
+            return 1;
+        }
         reporter.info(&summary);
     }
     0

@@ -2,7 +2,6 @@
 
 use super::Reporter;
 use lsyc::{parser, source};
-use std::io::Write;
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -57,8 +56,8 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
                     reporter.info(&format!("{}: formatted", src.name));
                 }
             }
-        } else {
-            let _ = std::io::stdout().write_all(out.as_bytes());
+        } else if !reporter.stdout(out.as_bytes()) {
+            return 1;
         }
     }
     status

@@ -15,7 +15,7 @@ use super::Reporter;
 use lsyc::infer::elements::{self, rules::Weights};
 use lsyc::infer::{self, MAX_SVG_BYTES, Options, Outcome, lines, sketch};
 use lsyc::source;
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -203,7 +203,7 @@ fn infer_drawing(
     let (lines, elements) = match outcome {
         Outcome::Lines(found) => {
             if args.stats {
-                print_stats(args, &found.stats);
+                print_stats(args, &found.stats, reporter);
             }
             let summary = format!(
                 "{name}: a line drawing of {} steps, drawn by a D0L system of {} rule{} at derive {}",
@@ -218,7 +218,7 @@ fn infer_drawing(
     };
     if let Some(gave_way) = lines {
         if args.stats {
-            print_stats(args, &gave_way.stats);
+            print_stats(args, &gave_way.stats, reporter);
         }
         reporter.note(&gave_way.note);
     }
@@ -232,7 +232,7 @@ fn infer_drawing(
         ));
     }
     if args.stats {
-        print_stats(args, &inferred.stats);
+        print_stats(args, &inferred.stats, reporter);
     }
     let st = &inferred.stats;
     let summary = format!(
@@ -274,14 +274,14 @@ fn program_on_stdout(out: Option<&std::path::Path>) -> bool {
 /// `--stats` as one JSON object, by the rule `lsyc run` follows too: on
 /// stdout, unless stdout carries the result itself (then on stderr, where it
 /// is the same line in either error format).
-fn print_stats(args: &Args, stats: &impl serde::Serialize) {
+fn print_stats(args: &Args, stats: &impl serde::Serialize, reporter: &Reporter) {
     let Ok(json) = serde_json::to_string(stats) else {
         return;
     };
     if program_on_stdout(args.output.as_deref()) {
-        eprintln!("{json}");
+        reporter.stderr(&format!("{json}\n"));
     } else {
-        println!("{json}");
+        reporter.stdout(format!("{json}\n").as_bytes());
     }
 }
 
@@ -364,7 +364,9 @@ fn write_program(
             reporter.info(&format!("{summary}, wrote {}", out.display()));
         }
         None => {
-            let _ = std::io::stdout().write_all(text.as_bytes());
+            if !reporter.stdout(text.as_bytes()) {
+                return 1;
+            }
         }
     }
     0

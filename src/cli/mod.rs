@@ -112,9 +112,11 @@ pub enum Command {
     Studio(studio::Args),
 }
 
-/// Where diagnostics go and how they look.
+/// Where diagnostics go and how they look; remembers a failed write, so that
+/// a command whose messages or results could not be written never exits 0.
 pub struct Reporter {
     format: Format,
+    failed: std::cell::Cell<bool>,
 }
 
 impl Reporter {
@@ -131,7 +133,42 @@ impl Reporter {
                 },
             },
         };
-        Reporter { format }
+        Reporter {
+            format,
+            failed: std::cell::Cell::new(false),
+        }
+    }
+
+    /// Whether a write to stdout or stderr has failed (a full disk, a closed
+    /// pipe): the exit status is then 1 whatever the command did.
+    pub fn write_failed(&self) -> bool {
+        self.failed.get()
+    }
+
+    /// Writes `text` to stderr; a failure is remembered, never a panic.
+    pub fn stderr(&self, text: &str) {
+        let mut err = std::io::stderr().lock();
+        if err
+            .write_all(text.as_bytes())
+            .and_then(|()| err.flush())
+            .is_err()
+        {
+            self.failed.set(true);
+        }
+    }
+
+    /// Writes a result to stdout and flushes it; on failure says so on
+    /// stderr (where that still works) and returns false.
+    pub fn stdout(&self, bytes: &[u8]) -> bool {
+        let mut out = std::io::stdout().lock();
+        match out.write_all(bytes).and_then(|()| out.flush()) {
+            Ok(()) => true,
+            Err(e) => {
+                self.failed.set(true);
+                self.error(&format!("cannot write to stdout: {e}"), None);
+                false
+            }
+        }
     }
 
     /// Writes diagnostics about `source` (named `file`) to stderr.
@@ -140,7 +177,7 @@ impl Reporter {
             return;
         }
         let text = diagnostic::render(diags, file, source, self.format);
-        let _ = std::io::stderr().write_all(text.as_bytes());
+        self.stderr(&text);
     }
 
     pub fn is_json(&self) -> bool {
@@ -175,16 +212,17 @@ impl Reporter {
             if let Some(h) = help {
                 v["help"] = serde_json::Value::from(h);
             }
-            eprintln!("{v}");
+            self.stderr(&format!("{v}\n"));
             return;
         }
-        match kind {
-            Line::Info => eprintln!("{msg}"),
-            _ => eprintln!("{}: {msg}", kind.name()),
-        }
+        let mut text = match kind {
+            Line::Info => format!("{msg}\n"),
+            _ => format!("{}: {msg}\n", kind.name()),
+        };
         if let Some(h) = help {
-            eprintln!("  help: {h}");
+            text.push_str(&format!("  help: {h}\n"));
         }
+        self.stderr(&text);
     }
 }
 
@@ -229,14 +267,15 @@ pub fn main() -> ExitCode {
                     "message": message,
                     "help": rest.join(" "),
                 });
-                eprintln!("{v}");
+                let _ = writeln!(std::io::stderr(), "{v}");
                 return ExitCode::from(2);
             }
-            let _ = e.print();
-            return if shown {
-                ExitCode::SUCCESS
-            } else {
-                ExitCode::from(2)
+            // `--help > /dev/full` is a failed write, not a success.
+            let printed = e.print().and_then(|()| std::io::stdout().flush());
+            return match (shown, printed) {
+                (true, Ok(())) => ExitCode::SUCCESS,
+                (true, Err(_)) => ExitCode::from(1),
+                (false, _) => ExitCode::from(2),
             };
         }
     };
@@ -252,6 +291,9 @@ pub fn main() -> ExitCode {
         Command::Lsp(args) => lsp::run(args),
         Command::Studio(args) => studio::run(args, &reporter),
     };
+    if status == 0 && reporter.write_failed() {
+        return ExitCode::from(1);
+    }
     ExitCode::from(status)
 }
 

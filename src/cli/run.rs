@@ -171,8 +171,11 @@ fn run_inner(args: &Args, reporter: &Reporter) -> Result<(), u8> {
                 reporter.emit(&[e.diagnostic()], &src.name, &src.text);
                 1u8
             })?;
-        print!("{}", prog.disassemble());
-        return Ok(());
+        return if reporter.stdout(prog.disassemble().as_bytes()) {
+            Ok(())
+        } else {
+            Err(1)
+        };
     }
     run_system(args, reporter, &src, &fe, &opts, format, background)
 }
@@ -345,7 +348,7 @@ fn run_system(
         _ => run::measure(&derived, args.seed).map_err(fail)?.0,
     };
     let stats = Stats::new(&derived, &drawn, start.elapsed().as_secs_f64() * 1000.0);
-    let wrote = report_stats(args, &stats);
+    let wrote = report_stats(args, &stats, reporter)?;
     reporter.info(&format!(
         "{}: {}, {}, {}, {} after {} (derive {:.0} ms, draw {:.0} ms){wrote}",
         stats.system,
@@ -357,7 +360,6 @@ fn run_system(
         stats.derive_ms,
         stats.interpret_ms
     ));
-    let _ = std::io::stdout().flush();
     Ok(())
 }
 
@@ -413,19 +415,23 @@ fn write_file<T>(
 
 /// Prints `--stats` as one JSON object: on stdout, or on stderr when stdout
 /// carries the drawing (`-o -`). Returns the end of the summary line: where
-/// the output went, or how to write one.
-fn report_stats(args: &Args, stats: &impl serde::Serialize) -> String {
+/// the output went, or how to write one; exit status 1 if stdout failed.
+fn report_stats(
+    args: &Args,
+    stats: &impl serde::Serialize,
+    reporter: &Reporter,
+) -> Result<String, u8> {
     let on_stdout = args.output.as_deref().is_some_and(is_stdout);
     if args.stats
         && let Ok(s) = serde_json::to_string(stats)
     {
         if on_stdout {
-            eprintln!("{s}");
-        } else {
-            println!("{s}");
+            reporter.stderr(&format!("{s}\n"));
+        } else if !reporter.stdout(format!("{s}\n").as_bytes()) {
+            return Err(1);
         }
     }
-    match &args.output {
+    Ok(match &args.output {
         Some(_) if args.frames => ", wrote its frames".to_string(),
         Some(p) if is_stdout(p) => ", wrote it to stdout".to_string(),
         Some(p) => format!(", wrote {}", p.display()),
@@ -436,7 +442,7 @@ fn report_stats(args: &Args, stats: &impl serde::Serialize) -> String {
                 .map_or("out".into(), |s| s.to_string_lossy());
             format!("; no output written, add -o {stem}.svg to draw it")
         }
-    }
+    })
 }
 
 /// "1 polygon", "2 polygons", "3 queries".
@@ -508,7 +514,7 @@ fn run_scene(
     );
     if args.explain {
         match lsyc::env::explain::explain(&r.scene, &r.outcome, cfg) {
-            Ok(rep) => eprint!("{}", lsyc::env::explain::render(&r.scene, &rep)),
+            Ok(rep) => reporter.stderr(&lsyc::env::explain::render(&r.scene, &rep)),
             Err(d) => reporter.emit(&[d], &src.name, &src.text),
         }
     }
@@ -536,7 +542,10 @@ fn run_scene(
             }
         },
     };
-    let wrote = report_stats(args, &stats);
+    let wrote = match report_stats(args, &stats, reporter) {
+        Ok(w) => w,
+        Err(status) => return status,
+    };
     reporter.info(&format!(
         "scene {}: {}, {}, {}, {}, {}, {}, {} after {}{wrote}",
         stats.scene,

@@ -25,6 +25,7 @@ mod roundtrip;
 mod run;
 mod scene;
 mod sketch;
+mod stress_files;
 mod studio;
 mod support;
 mod turtle_queries;

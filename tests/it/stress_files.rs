@@ -1,0 +1,257 @@
+//! Files under stress, for real: fifty writers of one file at once (threads
+//! of one process, and processes), read-only files, a full disk (`/dev/full`)
+//! on stdout and stderr, and an interrupt during a long write. Whatever
+//! happens, a file holds one whole version (the old one or a new one), no
+//! temporary file is left behind, and a failed write exits 1, never 0, never
+//! a panic (101).
+
+use crate::support::root;
+use std::fs::{self, File};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+fn lsyc() -> Command {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_lsyc"));
+    cmd.env("NO_COLOR", "1").stdin(Stdio::null());
+    cmd
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// The temporary files lsyc left in `dir` (hidden, ending `.tmp`).
+fn leftovers(dir: &Path) -> Vec<String> {
+    fs::read_dir(dir)
+        .expect("reads the folder")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect()
+}
+
+#[cfg(unix)]
+fn mode(path: &Path) -> u32 {
+    use std::os::unix::fs::PermissionsExt;
+    fs::metadata(path).expect("metadata").permissions().mode() & 0o777
+}
+
+#[cfg(unix)]
+fn set_mode(path: &Path, mode: u32) {
+    use std::os::unix::fs::PermissionsExt;
+    fs::set_permissions(path, fs::Permissions::from_mode(mode)).expect("chmod");
+}
+
+/// Version `k` of a file: large enough that a mix of two would show.
+fn version(k: usize) -> Vec<u8> {
+    let line = format!("// version {k:02} {}\n", "x".repeat(70));
+    line.repeat(4000).into_bytes()
+}
+
+#[test]
+fn fifty_threads_saving_one_file_leave_one_whole_version() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("plant.lsy");
+    fs::write(&path, b"// the original\n").expect("writes");
+    let results: Vec<std::io::Result<()>> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..50)
+            .map(|k| {
+                let path = &path;
+                s.spawn(move || lsyc::source::write_atomic(path, &version(k)))
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("no panic"))
+            .collect()
+    });
+    for (k, r) in results.iter().enumerate() {
+        assert!(r.is_ok(), "save {k} failed: {r:?}");
+    }
+    let now = fs::read(&path).expect("reads");
+    let matches = (0..50).filter(|&k| now == version(k)).count();
+    assert_eq!(
+        matches,
+        1,
+        "the file is not one of the saved versions ({} bytes)",
+        now.len()
+    );
+    assert_eq!(leftovers(dir.path()), Vec::<String>::new());
+}
+
+#[test]
+fn fifty_processes_writing_one_output_leave_one_whole_version() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // Fifty programs whose derived strings differ in length.
+    let expected: Vec<String> = (0..50).map(|k| "F+".repeat(2000 + k * 50)).collect();
+    for (k, axiom) in expected.iter().enumerate() {
+        let program = format!("lsystem P{k} {{ derive 0; axiom {axiom}; }}\n");
+        fs::write(dir.path().join(format!("p{k}.lsy")), program).expect("writes");
+    }
+    let children: Vec<_> = (0..50)
+        .map(|k| {
+            lsyc()
+                .current_dir(dir.path())
+                .args(["run", &format!("p{k}.lsy"), "-o", "out.txt"])
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("starts lsyc")
+        })
+        .collect();
+    for (k, child) in children.into_iter().enumerate() {
+        let out = child.wait_with_output().expect("waits");
+        assert_eq!(out.status.code(), Some(0), "run {k}: {}", text(&out.stderr));
+    }
+    let now = fs::read_to_string(dir.path().join("out.txt")).expect("reads");
+    let matches = expected
+        .iter()
+        .filter(|e| now.trim_end() == e.as_str())
+        .count();
+    assert_eq!(matches, 1, "out.txt is not one whole output");
+    assert_eq!(leftovers(dir.path()), Vec::<String>::new());
+}
+
+/// A scene to edit, copied into `dir`.
+fn palm(dir: &Path) -> PathBuf {
+    let path = dir.join("palm.lsy");
+    fs::copy(root().join("lang-examples/palm.lsy"), &path).expect("copies");
+    path
+}
+
+#[cfg(unix)]
+#[test]
+fn read_only_files_are_never_replaced() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let messy = dir.path().join("messy.lsy");
+    fs::write(&messy, "lsystem A{axiom F;F->F+F;}").expect("writes");
+    let scene = palm(dir.path());
+    for path in [&messy, &scene] {
+        set_mode(path, 0o444);
+    }
+    let before: Vec<Vec<u8>> = [&messy, &scene]
+        .iter()
+        .map(|p| fs::read(p).expect("reads"))
+        .collect();
+    let runs: [(&Path, Vec<&str>); 2] = [
+        (&messy, vec!["fmt", "--write", "messy.lsy"]),
+        (
+            &scene,
+            vec![
+                "edit",
+                "palm.lsy",
+                "--by",
+                "trunk3.v2=30,-5",
+                "--pin",
+                "trunk2",
+                "--write",
+            ],
+        ),
+    ];
+    for (k, (path, args)) in runs.iter().enumerate() {
+        let out = lsyc()
+            .current_dir(dir.path())
+            .args(args)
+            .output()
+            .expect("runs");
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        let name = path.file_name().unwrap().to_string_lossy();
+        assert!(
+            err.contains(&format!("cannot write `{name}`")) && err.contains("read-only"),
+            "{args:?}: {err}"
+        );
+        assert_eq!(fs::read(path).expect("reads"), before[k], "{args:?}");
+        assert_eq!(mode(path), 0o444, "{args:?}");
+    }
+    assert_eq!(leftovers(dir.path()), Vec::<String>::new());
+}
+
+#[cfg(unix)]
+#[test]
+fn a_replaced_file_keeps_its_permissions() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("messy.lsy");
+    fs::write(&path, "lsystem A{axiom F;F->F+F;}").expect("writes");
+    set_mode(&path, 0o640);
+    let out = lsyc()
+        .current_dir(dir.path())
+        .args(["fmt", "--write", "messy.lsy"])
+        .output()
+        .expect("runs");
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(
+        fs::read_to_string(&path)
+            .expect("reads")
+            .contains("F -> F+F;")
+    );
+    assert_eq!(mode(&path), 0o640);
+}
+
+/// Runs lsyc in `dir` with stdout and/or stderr on `/dev/full`.
+fn on_full_disk(dir: &Path, args: &[&str], stdout_full: bool, stderr_full: bool) -> Output {
+    let full = || Stdio::from(File::create("/dev/full").expect("opens /dev/full"));
+    let mut cmd = lsyc();
+    cmd.current_dir(dir).args(args);
+    cmd.stdout(if stdout_full { full() } else { Stdio::piped() });
+    cmd.stderr(if stderr_full { full() } else { Stdio::piped() });
+    cmd.output().expect("runs")
+}
+
+#[test]
+fn a_full_disk_is_an_error_never_success_or_a_panic() {
+    if !Path::new("/dev/full").exists() {
+        eprintln!("no /dev/full on this system");
+        return;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    fs::copy(
+        root().join("lang-examples/koch-island.lsy"),
+        dir.path().join("koch.lsy"),
+    )
+    .expect("copies");
+    fs::write(dir.path().join("broken.lsy"), "lsystem B { axiom F(; }\n").expect("writes");
+    palm(dir.path());
+    fs::write(
+        dir.path().join("art.svg"),
+        r#"<svg xmlns="http://www.w3.org/2000/svg"><path d="M0 0h10v10h-10z"/><path d="M20 0h10v10h-10z"/></svg>"#,
+    )
+    .expect("writes");
+    let edit = [
+        "edit",
+        "palm.lsy",
+        "--by",
+        "trunk3.v2=30,-5",
+        "--pin",
+        "trunk2",
+    ];
+    // (arguments, stdout full, stderr full)
+    let cases: [(&[&str], bool, bool); 11] = [
+        (&["fmt", "koch.lsy"], true, false),
+        (&["infer", "art.svg"], true, false),
+        (&edit, true, false),
+        (&["run", "koch.lsy", "--stats"], true, false),
+        (&["run", "koch.lsy", "--stats"], false, true),
+        (&["run", "koch.lsy", "--disasm"], true, false),
+        (&["run", "koch.lsy", "-o", "-"], true, false),
+        (&["run", "koch.lsy"], false, true),
+        (&["check", "broken.lsy"], false, true),
+        (&["check", "koch.lsy"], false, true),
+        (&["man"], true, false),
+    ];
+    for (args, out_full, err_full) in cases {
+        let out = on_full_disk(dir.path(), args, out_full, err_full);
+        let err = text(&out.stderr);
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{args:?} (stdout full: {out_full}, stderr full: {err_full}): {err}"
+        );
+        if !err_full {
+            assert!(
+                err.contains("cannot write") && !err.contains("panicked"),
+                "{args:?}: {err}"
+            );
+        }
+    }
+}
