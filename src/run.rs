@@ -459,9 +459,7 @@ pub fn write_animation(
             let Some(out) = out.take() else {
                 return Err(std::io::Error::other("the output is gone").into());
             };
-            let mut e = png::Encoder::new(out, width, height);
-            e.set_color(png::ColorType::Rgba);
-            e.set_depth(png::BitDepth::Eight);
+            let mut e = render::png::png_encoder(out, width, height);
             e.set_animated(frames, 0).map_err(png_error)?;
             encoder = Some(e.write_header().map_err(png_error)?);
         }

@@ -11,7 +11,7 @@
 //! the drawing) and the exit statuses. Must not choose what a drawing is:
 //! `lsyc::infer` does.
 
-use super::Reporter;
+use super::{Reporter, overwrite};
 use lsyc::infer::elements::{self, rules::Weights};
 use lsyc::infer::{self, MAX_SVG_BYTES, Options, Outcome, lines, sketch};
 use lsyc::source;
@@ -314,18 +314,12 @@ fn same_as_input(
     reporter: &Reporter,
 ) -> Option<u8> {
     let out = out.filter(|p| !program_on_stdout(Some(p)))?;
-    let same = match (std::fs::canonicalize(out), std::fs::canonicalize(input)) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    };
-    if same {
-        reporter.error(
-            &format!("the output `{}` is the {what}", out.display()),
-            Some("choose another file: lsyc never writes over its input"),
-        );
-        return Some(2);
-    }
-    None
+    let mut inputs = overwrite::Inputs::default();
+    inputs.add(input, format!("the {what}"));
+    let clash =
+        overwrite::check(out, "the output", overwrite::Made::Named, &inputs, false).err()?;
+    reporter.error(&clash.to_string(), Some(clash.help()));
+    Some(2)
 }
 
 fn read_input(path: &std::path::Path, name: &str, reporter: &Reporter) -> Result<Vec<u8>, u8> {

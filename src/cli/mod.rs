@@ -9,6 +9,7 @@ mod edit;
 mod fmt;
 mod infer;
 mod lsp;
+mod overwrite;
 mod run;
 mod studio;
 

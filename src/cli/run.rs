@@ -1,5 +1,6 @@
 //! `lsyc run FILE`: derive, draw, and write SVG, PNG, OBJ or text.
 
+use super::overwrite::{self, Clash, Inputs, Made};
 use super::{Reporter, check::overrides};
 
 mod outputs;
@@ -99,6 +100,13 @@ pub struct Args {
     /// to the element's size, in the drawing's colours); repeatable.
     #[arg(long = "element", value_name = "NAME=FILE.svg")]
     pub elements: Vec<String>,
+
+    /// Replace a file beside the output that lsyc did not write (an OBJ's
+    /// .mtl, a frame of --frames): without it that is a usage error. Never
+    /// allows writing over a file the command reads (the program, an
+    /// --element drawing).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `-n STEPS`: a whole number within derive's own limit, with derive's message.
@@ -127,6 +135,7 @@ fn run_inner(args: &Args, reporter: &Reporter) -> Result<(), u8> {
         2
     })?;
     let format = output_format(args, reporter)?;
+    check_outputs(args, format, reporter)?;
     let background = background(args, reporter)?;
     if let Some(n) = args.threads {
         // Only the first call in a process can set the global pool; later calls are harmless.
@@ -278,15 +287,6 @@ fn load(
     reporter: &Reporter,
 ) -> Result<(source::Source, frontend::Frontend), u8> {
     let src = super::read_program(&args.file, reporter).ok_or(1u8)?;
-    if let Some(out) = &args.output
-        && same_file(out, &args.file)
-    {
-        reporter.error(
-            &format!("the output `{}` is the input program", out.display()),
-            Some("choose another file: lsyc never writes over its input"),
-        );
-        return Err(2);
-    }
     let mut fe = frontend::run_seeded(&src.text, src.diagnostics.clone(), ovr, args.seed);
     reporter.emit(&fe.diagnostics, &src.name, &src.text);
     if fe.has_errors() {
@@ -464,11 +464,46 @@ fn output_name(p: &std::path::Path) -> String {
     }
 }
 
-fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
-    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => false,
+/// The files this run reads: the program and the `--element` drawings.
+fn inputs(args: &Args) -> Inputs {
+    let mut inputs = Inputs::default();
+    inputs.add(&args.file, "the program");
+    for spec in &args.elements {
+        if let Some((name, file)) = spec.split_once('=') {
+            inputs.add(
+                std::path::Path::new(file),
+                format!("the drawing of `--element {name}`"),
+            );
+        }
     }
+    inputs
+}
+
+/// Checks the output and its `.mtl` before anything is derived (frames are
+/// checked once their number is known, `outputs::check_frames`).
+fn check_outputs(args: &Args, format: Option<Format>, reporter: &Reporter) -> Result<(), u8> {
+    let Some(path) = args.output.as_deref().filter(|p| !is_stdout(p)) else {
+        return Ok(());
+    };
+    if args.frames && format != Some(Format::Apng) {
+        return Ok(());
+    }
+    let inputs = inputs(args);
+    let mut checks = vec![(path.to_path_buf(), "the output".to_string(), Made::Named)];
+    if format == Some(Format::Obj) {
+        let role = format!("the materials of `{}`", path.display());
+        checks.push((outputs::mtl_path(path), role, Made::Beside));
+    }
+    for (p, role, made) in checks {
+        overwrite::check(&p, &role, made, &inputs, args.force).map_err(|c| refuse(&c, reporter))?;
+    }
+    Ok(())
+}
+
+/// Reports a file this run may not write: a usage error.
+fn refuse(clash: &Clash, reporter: &Reporter) -> u8 {
+    reporter.error(&clash.to_string(), Some(clash.help()));
+    2
 }
 
 fn progress_bar(steps: Option<u32>) -> Option<indicatif::ProgressBar> {

@@ -176,7 +176,7 @@ impl GlbMesh {
     fn document(&self) -> (json::Root, Vec<u8>) {
         let mut root = json::Root {
             asset: json::Asset {
-                generator: Some("lsyc".to_string()),
+                generator: Some(super::mark::GLTF_GENERATOR.to_string()),
                 ..Default::default()
             },
             ..Default::default()

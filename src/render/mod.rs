@@ -6,6 +6,7 @@
 //! writer of the module string; none of them derives.
 
 pub mod glb;
+pub mod mark;
 pub mod obj;
 pub mod png;
 pub mod svg;

@@ -232,9 +232,15 @@ impl PngWriter {
     }
 
     /// Finishes drawing and encodes the image.
-    pub fn finish(mut self) -> Result<Vec<u8>, String> {
-        self.flush();
-        self.pixmap.encode_png().map_err(|e| e.to_string())
+    pub fn finish(self) -> Result<Vec<u8>, String> {
+        let (width, height, rgba) = self.finish_rgba();
+        let mut data = Vec::new();
+        let mut encoder = encoder(&mut data, width, height).map_err(|e| e.to_string())?;
+        encoder
+            .write_image_data(&rgba)
+            .and_then(|()| encoder.finish())
+            .map_err(|e| e.to_string())?;
+        Ok(data)
     }
 
     /// The picture's width, height and RGBA pixels (not premultiplied), for
@@ -244,6 +250,28 @@ impl PngWriter {
         let (w, h) = (self.pixmap.width(), self.pixmap.height());
         (w, h, self.pixmap.take_demultiplied())
     }
+}
+
+/// A PNG encoder for 8-bit RGBA pixels (not premultiplied) whose header
+/// carries lsyc's mark (`mark::PNG_SOFTWARE`); animations set their frames
+/// before writing the header.
+pub fn png_encoder<W: std::io::Write>(out: W, width: u32, height: u32) -> png::Encoder<'static, W> {
+    let mut e = png::Encoder::new(out, width, height);
+    e.set_color(png::ColorType::Rgba);
+    e.set_depth(png::BitDepth::Eight);
+    let (keyword, text) = super::mark::PNG_SOFTWARE;
+    // A Latin-1 keyword of 1 to 79 characters: never refused.
+    let _ = e.add_text_chunk(keyword.to_string(), text.to_string());
+    e
+}
+
+/// `png_encoder` with its header written.
+fn encoder<W: std::io::Write>(
+    out: W,
+    width: u32,
+    height: u32,
+) -> Result<png::Writer<W>, png::EncodingError> {
+    png_encoder(out, width, height).write_header()
 }
 
 impl Sink for PngWriter {

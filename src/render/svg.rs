@@ -68,9 +68,9 @@ impl<W: Write> SvgWriter<W> {
             String::from_utf8(b).unwrap_or_default()
         };
         let mut head = String::new();
-        head.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+        head.push_str(super::mark::SVG_HEAD);
         head.push_str(&format!(
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:xlink=\"http://www.w3.org/1999/xlink\" viewBox=\"{} {} {} {}\" width=\"{:.0}\" height=\"{:.0}\">\n",
+            "{} {} {} {}\" width=\"{:.0}\" height=\"{:.0}\">\n",
             num(min.x),
             num(-max.y),
             num(size.x),

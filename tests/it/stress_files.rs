@@ -255,3 +255,96 @@ fn a_full_disk_is_an_error_never_success_or_a_panic() {
         }
     }
 }
+
+/// Runs lsyc in `dir`; (exit status, stderr).
+fn run_in(dir: &Path, args: &[&str]) -> (i32, String) {
+    let out = lsyc().current_dir(dir).args(args).output().expect("runs");
+    (out.status.code().unwrap_or(-1), text(&out.stderr))
+}
+
+#[test]
+fn outputs_never_replace_inputs_or_files_lsyc_did_not_write() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let program = "lsystem T { derive 2; axiom F; F -> F[+F]F; }\n";
+    let leaf = r#"<svg xmlns="http://www.w3.org/2000/svg"><path d="M0 0 C6 4 7 14 1 20 Z"/></svg>"#;
+    for (name, body) in [
+        ("tree-000.txt", program),
+        ("plant.mtl", program),
+        ("tree.lsy", program),
+        ("tree.mtl", "newmtl bark\nKd 0.4 0.3 0.2\n"),
+        ("leaf-001.svg", leaf),
+        ("grow-001.svg", leaf),
+        (
+            "el.lsy",
+            "element Leaf { path \"M0 0 L1 1 L0 2 Z\"; }\nlsystem E { derive 1; axiom A; A -> F Leaf A; }\n",
+        ),
+    ] {
+        fs::write(d.join(name), body).expect("writes");
+    }
+    let before = |name: &str| fs::read(d.join(name)).expect("reads");
+    let kept: Vec<(&str, Vec<u8>)> = [
+        "tree-000.txt",
+        "plant.mtl",
+        "tree.mtl",
+        "leaf-001.svg",
+        "grow-001.svg",
+    ]
+    .iter()
+    .map(|n| (*n, before(n)))
+    .collect();
+    let refused: [&[&str]; 6] = [
+        &["run", "tree-000.txt", "--frames", "-o", "tree.txt"],
+        &[
+            "run",
+            "el.lsy",
+            "--element",
+            "Leaf=leaf-001.svg",
+            "--frames",
+            "-o",
+            "leaf.svg",
+        ],
+        &["run", "tree.lsy", "-o", "tree.obj"],
+        &["run", "plant.mtl", "-o", "plant.obj"],
+        &["run", "el.lsy", "--frames", "-o", "grow.svg"],
+        // --force never allows writing over an input.
+        &["run", "plant.mtl", "-o", "plant.obj", "--force"],
+    ];
+    let mut messages = String::new();
+    for args in refused {
+        let (status, err) = run_in(d, args);
+        assert_eq!(status, 2, "{args:?}: {err}");
+        messages.push_str(&format!("$ lsyc {}\n{err}\n", args.join(" ")));
+    }
+    for (name, bytes) in &kept {
+        assert_eq!(&before(name), bytes, "{name} was changed");
+    }
+    assert!(!d.join("plant.obj").exists() && !d.join("tree.obj").exists());
+    insta::assert_snapshot!("stress_outputs_refused", messages);
+    // Outputs of earlier runs are replaced: users run commands again.
+    let again: [&[&str]; 6] = [
+        &["run", "tree.lsy", "-o", "tree.svg"],
+        &["run", "tree.lsy", "-o", "tree.svg"],
+        &["run", "tree.lsy", "-o", "tree.png"],
+        &["run", "tree.lsy", "-o", "tree.png"],
+        &["run", "el.lsy", "--frames", "-o", "again.glb"],
+        &["run", "el.lsy", "--frames", "-o", "again.glb"],
+    ];
+    for args in again {
+        let (status, err) = run_in(d, args);
+        assert_eq!(status, 0, "{args:?}: {err}");
+    }
+    // A hard link to the program is the program.
+    fs::hard_link(d.join("tree.lsy"), d.join("linked.svg")).expect("links");
+    let (status, err) = run_in(d, &["run", "tree.lsy", "-o", "linked.svg"]);
+    assert_eq!(status, 2, "{err}");
+    // --force replaces somebody else's sidecar, and says nothing about it.
+    let (status, err) = run_in(d, &["run", "tree.lsy", "-o", "tree.obj", "--force"]);
+    assert_eq!(status, 0, "{err}");
+    assert!(before("tree.mtl").starts_with(b"# lsyc MTL"));
+    let (status, err) = run_in(d, &["run", "tree.lsy", "-o", "tree.obj"]);
+    assert_eq!(status, 0, "an .mtl lsyc wrote is replaced: {err}");
+    let (status, err) = run_in(d, &["infer", "leaf-001.svg", "-o", "leaf-001.svg"]);
+    assert_eq!(status, 2, "{err}");
+    assert_eq!(before("leaf-001.svg"), leaf.as_bytes());
+}

@@ -7,6 +7,7 @@
 //! (`lsyc::run`).
 
 use super::{Args, Reporter, write_file};
+use crate::cli::overwrite::{self, Made};
 use lsyc::run::{self, Derived, Format, OutputError, Picture, SceneRun, SceneStats, Written};
 use lsyc::source;
 use lsyc::turtle::Drawn;
@@ -58,7 +59,7 @@ pub fn picture(args: &Args, background: [u8; 4]) -> Picture {
 }
 
 /// `X.mtl` beside `X.obj`.
-fn mtl_path(obj: &Path) -> PathBuf {
+pub fn mtl_path(obj: &Path) -> PathBuf {
     obj.with_extension("mtl")
 }
 
@@ -163,6 +164,7 @@ pub fn write(
         return written.map(|w| w.drawn);
     }
     let last = derived.steps;
+    check_frames(args, format, path, last, reporter)?;
     let bar = frames_bar(last + 1);
     let mut failed = false;
     let mut drawn = Drawn::default();
@@ -210,6 +212,30 @@ pub fn write(
             Err(1)
         }
     }
+}
+
+/// Checks every frame's file (and `.mtl`) before the first is written: none
+/// is an input, none is somebody else's file (unless `--force`).
+fn check_frames(
+    args: &Args,
+    format: Format,
+    path: &Path,
+    last: u32,
+    reporter: &Reporter,
+) -> Result<(), u8> {
+    let inputs = super::inputs(args);
+    for k in 0..=last {
+        let frame = frame_path(path, k, last);
+        let role = format!("frame {k} of `-o {}`", path.display());
+        overwrite::check(&frame, &role, Made::Beside, &inputs, args.force)
+            .map_err(|c| super::refuse(&c, reporter))?;
+        if format == Format::Obj {
+            let role = format!("the materials of frame {k} of `-o {}`", path.display());
+            overwrite::check(&mtl_path(&frame), &role, Made::Beside, &inputs, args.force)
+                .map_err(|c| super::refuse(&c, reporter))?;
+        }
+    }
+    Ok(())
 }
 
 /// One output file (and its `.mtl` for an OBJ).

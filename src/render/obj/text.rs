@@ -149,7 +149,8 @@ pub fn write_mtl_with(
     palette: &crate::render::Palette,
 ) -> io::Result<()> {
     let mut buf = Vec::new();
-    buf.extend_from_slice(b"# lsyc MTL: one material per palette colour\n");
+    buf.extend_from_slice(crate::render::mark::MTL_COMMENT.as_bytes());
+    buf.extend_from_slice(b": one material per palette colour\n");
     for &c in colors {
         let [r, g, b] = palette.linear(c);
         buf.extend_from_slice(format!("\nnewmtl {}\n", palette.material(c)).as_bytes());
