@@ -380,6 +380,9 @@ fn quiet_branches(prog: &Program, s: &ModString) -> Vec<(u32, u32, u32)> {
     out
 }
 
+/// How many modules the turtle interprets between looks at `Limits::cancel`.
+const CANCEL_EVERY: usize = 1 << 14;
+
 fn run(
     prog: &Program,
     s: &ModString,
@@ -428,6 +431,13 @@ fn run(
             p = params_end as usize;
             next += 1;
             continue;
+        }
+        if i.is_multiple_of(CANCEL_EVERY)
+            && limits
+                .cancel
+                .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
+        {
+            return Err(DeriveError::Cancelled { step: u32::MAX });
         }
         let sym = s.syms[i];
         let n = prog.symbols.arity(sym);

@@ -50,8 +50,8 @@ impl ModString {
 pub struct Limits {
     pub max_modules: usize,
     pub max_bytes: usize,
-    /// When set (by another thread), the next derivation step stops with
-    /// `DeriveError::Cancelled`: `lsyc studio` stops a run that a newer edit
+    /// When set (by another thread), the next derivation step (or the
+    /// turtle, every few thousand modules) stops with `DeriveError::Cancelled`: `lsyc studio` stops a run that a newer edit
     /// replaced. `None` everywhere else.
     pub cancel: Option<&'static std::sync::atomic::AtomicBool>,
 }
@@ -110,8 +110,9 @@ pub enum DeriveError {
         depth: usize,
         span: crate::span::Span,
     },
-    /// The run was stopped from outside before step `step` (`Limits::cancel`).
-    #[error("the run was stopped before step {step}: a newer request replaced it")]
+    /// The run was stopped from outside before step `step` (`Limits::cancel`;
+    /// `u32::MAX`: while drawing).
+    #[error("the run was stopped {}: a newer request replaced it", stopped_at(*.step))]
     Cancelled { step: u32 },
     /// More steps were asked for than `MAX_STEPS`.
     #[error("{steps} derivation steps were asked for; the most is {limit}")]
@@ -139,6 +140,13 @@ fn chain_text(chain: &[String]) -> String {
         chain.iter().map(|m| format!("`{m}`")).collect()
     };
     shown.join(" → ")
+}
+
+fn stopped_at(step: u32) -> String {
+    match step {
+        u32::MAX => "while drawing".to_string(),
+        s => format!("before step {s}"),
+    }
 }
 
 fn when(step: u32) -> String {
