@@ -7,9 +7,9 @@ pub struct Args {}
 
 /// Serves one client; exits 0 after `shutdown` and `exit`, 1 otherwise.
 pub fn run(_args: &Args) -> u8 {
-    let stdin = std::io::stdin();
     let stdout = std::io::stdout();
-    match lsyc::lsp::serve(BufReader::new(stdin.lock()), BufWriter::new(stdout.lock())) {
+    let input = BufReader::new(std::io::stdin());
+    match lsyc::lsp::serve_threaded(input, BufWriter::new(stdout.lock())) {
         Ok(lsyc::lsp::End::Clean) => 0,
         Ok(lsyc::lsp::End::Abrupt) => 1,
         Err(e) => {

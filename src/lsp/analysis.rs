@@ -12,9 +12,30 @@ use crate::ast::File;
 use crate::check::Checked;
 use crate::diagnostic::{Code, Diagnostic, Severity};
 use crate::frontend;
-use crate::source::MAX_SOURCE_BYTES;
 use crate::span::Span;
 use lsp_types as lsp;
+
+/// The largest document analysed (the language server and the studio alike).
+/// Analysis holds about 40 to 170 bytes per byte of text (a long axiom is the
+/// dense end: every module a token and a node), so a document of this size
+/// peaks near 350 MB; a larger one gets one E0002 diagnostic instead (see
+/// docs/lsp.md).
+pub const MAX_DOCUMENT_BYTES: usize = 2 << 20;
+
+/// The diagnostic of a document over [`MAX_DOCUMENT_BYTES`], or `None`.
+pub fn too_large(text: &str) -> Option<Diagnostic> {
+    (text.len() > MAX_DOCUMENT_BYTES).then(|| {
+        Diagnostic::error(
+            Code::FileTooLarge,
+            format!(
+                "the document is {:.1} MiB; lsyc analyses documents up to {} MiB as you edit (`lsyc check` reads up to 64 MiB)",
+                text.len() as f64 / f64::from(1 << 20),
+                MAX_DOCUMENT_BYTES >> 20
+            ),
+        )
+        .primary(Span::new(0, 0), "too large to analyse")
+    })
+}
 
 pub struct Analysis {
     pub text: String,
@@ -29,16 +50,7 @@ pub struct Analysis {
 impl Analysis {
     pub fn new(text: String) -> Analysis {
         let lines = LineIndex::new(&text);
-        if text.len() as u64 > MAX_SOURCE_BYTES {
-            let d = Diagnostic::error(
-                Code::FileTooLarge,
-                format!(
-                    "the document is {} MiB; lsyc reads programs up to {} MiB",
-                    text.len() / (1024 * 1024),
-                    MAX_SOURCE_BYTES / (1024 * 1024)
-                ),
-            )
-            .primary(Span::new(0, 0), "too large to check");
+        if let Some(d) = too_large(&text) {
             return Analysis {
                 text,
                 lines,

@@ -25,4 +25,4 @@ pub mod transport;
 pub mod words;
 
 pub use analysis::Analysis;
-pub use server::{End, serve};
+pub use server::{End, serve, serve_threaded};

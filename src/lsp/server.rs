@@ -1,4 +1,6 @@
-//! The server's main loop: one thread, one message at a time.
+//! The server's main loop: one thread, one message at a time (`lsyc lsp`
+//! reads its input on a second thread, a few messages ahead, so that a
+//! `$/cancelRequest` stops a request still waiting).
 //!
 //! Owns: the protocol's life cycle (initialize, shutdown, exit), the open
 //! documents, and dispatching requests by type to the features. Every request
@@ -14,7 +16,7 @@ use lsp_server::{ErrorCode, Message, Notification, Request, Response, ResponseEr
 use lsp_types as lsp;
 use lsp_types::notification::{self as note, Notification as _};
 use lsp_types::request::{self as req, Request as _};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet, VecDeque};
 use std::io::{self, BufRead, Write};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -44,22 +46,146 @@ pub enum End {
     Abrupt,
 }
 
+/// Where messages come from: `next` waits for one; `ready` gives one only if
+/// it has already arrived (so that the loop can see a `$/cancelRequest` for
+/// a request it has not answered yet).
+trait Source {
+    fn next(&mut self) -> io::Result<Incoming>;
+    fn ready(&mut self) -> Option<io::Result<Incoming>>;
+}
+
+/// Messages read on the loop's own thread: nothing is ever ready early.
+struct Direct<R>(R);
+
+impl<R: BufRead> Source for Direct<R> {
+    fn next(&mut self) -> io::Result<Incoming> {
+        transport::read(&mut self.0)
+    }
+
+    fn ready(&mut self) -> Option<io::Result<Incoming>> {
+        None
+    }
+}
+
+/// Messages read by a thread of their own, a few ahead of the loop.
+struct Reader(std::sync::mpsc::Receiver<io::Result<Incoming>>);
+
+impl Source for Reader {
+    fn next(&mut self) -> io::Result<Incoming> {
+        self.0.recv().unwrap_or(Ok(Incoming::Eof))
+    }
+
+    fn ready(&mut self) -> Option<io::Result<Incoming>> {
+        self.0.try_recv().ok()
+    }
+}
+
+/// The most messages read ahead of the one being answered (a client that
+/// sends more waits: memory stays bounded however many it sends).
+const READ_AHEAD: usize = 64;
+
 /// Serves one client over `input` and `output` until `exit` or the end of
-/// the input.
-pub fn serve(mut input: impl BufRead, output: impl Write) -> io::Result<End> {
+/// the input, reading on the calling thread (a `$/cancelRequest` is seen
+/// only once the requests before it are answered).
+pub fn serve(input: impl BufRead, output: impl Write) -> io::Result<End> {
+    run(&mut Direct(input), output)
+}
+
+/// As [`serve`], with the input read by a thread of its own, so that a
+/// `$/cancelRequest` that arrives while earlier requests are answered stops
+/// its request before it starts (answered `RequestCanceled`).
+pub fn serve_threaded(input: impl BufRead + Send + 'static, output: impl Write) -> io::Result<End> {
+    let (tx, rx) = std::sync::mpsc::sync_channel(READ_AHEAD);
+    std::thread::spawn(move || {
+        let mut input = input;
+        loop {
+            let m = transport::read(&mut input);
+            let end = matches!(m, Ok(Incoming::Eof) | Err(_));
+            if tx.send(m).is_err() || end {
+                return;
+            }
+        }
+    });
+    run(&mut Reader(rx), output)
+}
+
+/// The id a `$/cancelRequest` names, if `m` is one.
+fn cancelled_id(m: &Incoming) -> Option<lsp_server::RequestId> {
+    let Incoming::Message(Message::Notification(n)) = m else {
+        return None;
+    };
+    if n.method != note::Cancel::METHOD {
+        return None;
+    }
+    let p: lsp::CancelParams = serde_json::from_value(n.params.clone()).ok()?;
+    Some(match p.id {
+        lsp::NumberOrString::Number(i) => i.into(),
+        lsp::NumberOrString::String(s) => s.into(),
+    })
+}
+
+/// The messages read but not yet handled, and the requests among them that
+/// the client cancelled.
+#[derive(Default)]
+struct Queue {
+    waiting: VecDeque<Incoming>,
+    cancelled: HashSet<lsp_server::RequestId>,
+}
+
+impl Queue {
+    /// Reads what has already arrived (up to [`READ_AHEAD`] messages),
+    /// noting cancellations of the requests waiting.
+    fn look_ahead(&mut self, source: &mut dyn Source) -> io::Result<()> {
+        while self.waiting.len() < READ_AHEAD {
+            let Some(m) = source.ready() else {
+                return Ok(());
+            };
+            let m = m?;
+            if let Some(id) = cancelled_id(&m) {
+                let waiting = self
+                    .waiting
+                    .iter()
+                    .any(|w| matches!(w, Incoming::Message(Message::Request(r)) if r.id == id));
+                if waiting {
+                    self.cancelled.insert(id);
+                }
+            }
+            self.waiting.push_back(m);
+        }
+        Ok(())
+    }
+}
+
+fn run(source: &mut dyn Source, output: impl Write) -> io::Result<End> {
     let mut s = Server {
         out: output,
         state: State::Uninitialized,
         docs: HashMap::new(),
     };
+    let mut queue = Queue::default();
     loop {
-        match transport::read(&mut input)? {
+        let m = match queue.waiting.pop_front() {
+            Some(m) => m,
+            None => source.next()?,
+        };
+        match m {
             Incoming::Eof => return Ok(End::Abrupt),
             Incoming::Invalid { id, code, message } => {
                 transport::write_error(&mut s.out, id, code, &message)?;
             }
             Incoming::Message(Message::Request(r)) => {
-                let resp = s.request(r);
+                queue.look_ahead(source)?;
+                let resp = if queue.cancelled.remove(&r.id) {
+                    Response {
+                        id: r.id,
+                        response_result: Err(error(
+                            ErrorCode::RequestCanceled,
+                            format!("`{}` was cancelled", r.method),
+                        )),
+                    }
+                } else {
+                    s.request(r)
+                };
                 transport::write(&mut s.out, resp.into())?;
             }
             Incoming::Message(Message::Notification(n)) => {

@@ -19,6 +19,7 @@ mod lines_classic;
 mod lines_gen;
 mod lines_random;
 mod lsp;
+mod lsp_stress;
 mod outputs;
 mod plants;
 mod roundtrip;
