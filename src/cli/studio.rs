@@ -65,6 +65,11 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
             .stderr(std::process::Stdio::null())
             .spawn();
     }
-    studio.serve();
-    0
+    match studio.serve() {
+        Ok(()) => 0,
+        Err(e) => {
+            reporter.error(&e, None);
+            1
+        }
+    }
 }

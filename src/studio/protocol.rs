@@ -13,6 +13,7 @@ use crate::ast::{ExprKind, File, Item};
 use crate::check::{Checked, Override, Value};
 use crate::diagnostic::{self, Diagnostic, Format};
 use crate::env::{self, Runner};
+use crate::lsp::analysis::Analysis;
 use crate::run::{self, Options, OutputError, Picture, SceneRun};
 use crate::{edit, fmt, frontend};
 use serde::{Deserialize, Serialize};
@@ -98,7 +99,15 @@ impl Program {
         }
     }
 
+    /// Parses and checks the source, unless it is too large to run here.
     fn frontend(&self) -> frontend::Frontend {
+        if let Some(d) = crate::lsp::analysis::too_large(&self.source) {
+            return frontend::Frontend {
+                file: File::default(),
+                diagnostics: vec![d],
+                checked: None,
+            };
+        }
         frontend::run_seeded(&self.source, Vec::new(), &self.overrides(), self.seed)
     }
 }
@@ -404,6 +413,9 @@ fn scene_svg(r: &SceneRun, p: &Program) -> Result<(String, Json), Diagnostic> {
 /// formatter (comments kept). `None` if the source does not check or has no
 /// such constant.
 pub fn set_constant(source: &str, name: &str, value: f64) -> Option<String> {
+    if crate::lsp::analysis::too_large(source).is_some() {
+        return None;
+    }
     let fe = frontend::run(source, Vec::new(), &[]);
     if fe.has_errors() || !value.is_finite() {
         return None;
@@ -518,6 +530,8 @@ impl DragSession {
     /// Moves the vertex, relaxes the guides, reruns what changed and draws.
     pub fn drag(&mut self, d: &Drag, name: &str) -> Result<RunReply, String> {
         let start = Instant::now();
+        // This move's stop flag (the worker running it), not the first move's.
+        self.runner.cfg.limits.cancel = d.program.cancel.0;
         let mut ops = vec![edit::Op::Move(
             edit::parse_vertex(&d.vertex)?,
             glam::DVec2::new(d.x, d.y),
@@ -686,8 +700,14 @@ pub fn byte_offset(text: &str, at: usize) -> usize {
 /// The language server's hover at UTF-16 offset `at` (`lsyc lsp`'s own
 /// answer): its Markdown text and the span it is about, in UTF-16 units.
 pub fn hover(source: &str, at: usize) -> Option<Json> {
-    let a = crate::lsp::analysis::Analysis::new(source.to_string());
-    let h = crate::lsp::hover::hover(&a, byte_offset(source, at))?;
+    hover_in(&Analysis::new(source.to_string()), at)
+}
+
+/// [`hover`] in an analysis already made (the server shares one between the
+/// questions about one text).
+pub fn hover_in(a: &Analysis, at: usize) -> Option<Json> {
+    let source = a.text.as_str();
+    let h = crate::lsp::hover::hover(a, byte_offset(source, at))?;
     let text = match h.contents {
         lsp_types::HoverContents::Markup(m) => m.value,
         lsp_types::HoverContents::Scalar(lsp_types::MarkedString::String(s)) => s,
@@ -707,8 +727,13 @@ pub fn hover(source: &str, at: usize) -> Option<Json> {
 /// own list): label, kind, detail, documentation, the text to insert and
 /// the span it replaces (UTF-16 units).
 pub fn complete(source: &str, at: usize) -> Vec<Json> {
-    let a = crate::lsp::analysis::Analysis::new(source.to_string());
-    crate::lsp::complete::complete(&a, byte_offset(source, at))
+    complete_in(&Analysis::new(source.to_string()), at)
+}
+
+/// [`complete`] in an analysis already made.
+pub fn complete_in(a: &Analysis, at: usize) -> Vec<Json> {
+    let source = a.text.as_str();
+    crate::lsp::complete::complete(a, byte_offset(source, at))
         .into_iter()
         .map(|c| {
             let (insert, from, to) = match &c.text_edit {

@@ -209,11 +209,26 @@ async function gallery(browser, errors, timings) {
     await page.waitForFunction((t) => window.lsycStudio.getSource() === t, other);
     check(true, "a change on disk reloads a page without unsaved edits");
 
+    // A second tab and a reloaded page draw (each page has its own session).
+    const tab = await openPage(browser, url, errors);
+    check(await tab.$("[data-role=drawing] svg path"), "a second tab draws");
+    await tab.close();
+    await page.reload();
+    await page.waitForSelector("[data-role=drawing] svg path", { state: "attached" });
+    await idle(page);
+    check(true, "a reloaded page draws");
+
     // With unsaved edits, it asks instead.
     await page.evaluate(() => window.lsycStudio.setSource(window.lsycStudio.getSource() + "\n// mine"));
     writeFileSync(file, other + "\n// theirs");
     await page.waitForSelector("[data-role=disk-changed]:not([hidden])");
     check((await source(page)).endsWith("// mine"), "unsaved edits are kept and the page asks");
+    // Saving now would write over the other editor's change: refused, and said.
+    await page.click("[data-role=save]");
+    await page.waitForFunction(() => document.querySelector("[data-role=status]").textContent.startsWith("not saved"));
+    const message = await page.$eval("[data-role=disk-message]", (e) => e.textContent);
+    check(message.startsWith("Not saved"), `the bar says the save was refused (${message})`);
+    check(readFileSync(file, "utf8") === other + "\n// theirs", "the file changed on disk is not overwritten");
     await page.screenshot({ path: join(work, "gallery.png") });
     await page.close();
   } finally {

@@ -28,5 +28,6 @@ mod scene;
 mod sketch;
 mod stress_files;
 mod studio;
+mod studio_stress;
 mod support;
 mod turtle_queries;

@@ -28,6 +28,7 @@ const ui = {
   exportLsy: $("[data-role=export-lsy]"),
   fit: $("[data-role=fit]"),
   banner: $("[data-role=disk-changed]"),
+  diskMessage: $("[data-role=disk-message]"),
   reload: $("[data-role=reload]"),
   keep: $("[data-role=keep]"),
   editor: $("[data-role=editor]"),
@@ -80,11 +81,18 @@ const state = {
 
 // ---- the server ----
 
+/// This page's session: the server keeps sequence numbers per session, so
+/// that a reloaded page or a second tab starts its own.
+const SESSION =
+  globalThis.crypto && crypto.randomUUID
+    ? crypto.randomUUID()
+    : `${Date.now().toString(36)}-${Math.random().toString(36).slice(2)}`;
+
 async function post(path, body) {
   const r = await fetch(path, {
     method: "POST",
     headers: { "Content-Type": "application/json" },
-    body: JSON.stringify(body),
+    body: JSON.stringify({ ...body, session: SESSION }),
   });
   return r.json();
 }
@@ -834,16 +842,29 @@ async function showString() {
 
 async function save() {
   const text = getSource();
-  const reply = await post("/api/save", { text });
+  // The version the text started from: the server refuses to write over a
+  // file that changed on disk since.
+  const reply = await post("/api/save", { text, base: state.diskVersion });
   if (reply.ok) {
     state.savedText = text;
     state.diskVersion = reply.version;
     ui.banner.hidden = true;
     markDirty();
     setStatus(`saved ${ui.file.textContent}`, false);
+  } else if (reply.conflict && reply.disk && reply.disk.ok) {
+    askAboutDisk(reply.disk, "Not saved: the file changed on disk since it was loaded.");
+    setStatus(reply.error, true);
   } else {
     setStatus(reply.error, true);
   }
+}
+
+/// Shows the bar that asks whether to load the file as it is on disk or
+/// keep the page's text (a later save then writes over that version).
+function askAboutDisk(f, message) {
+  ui.diskMessage.textContent = message;
+  ui.banner.hidden = false;
+  state.pendingDisk = f;
 }
 
 async function load() {
@@ -866,8 +887,7 @@ async function pollDisk() {
       setStatus("reloaded: the file changed on disk", false);
     } else {
       // Unsaved edits here and a change there: ask, never drop either silently.
-      ui.banner.hidden = false;
-      state.pendingDisk = f;
+      askAboutDisk(f, "The file changed on disk.");
     }
   } catch {
     // The server is gone; the page keeps what was typed.
@@ -879,7 +899,7 @@ async function exportAs(ext) {
   const r = await fetch("/api/export", {
     method: "POST",
     headers: { "Content-Type": "application/json" },
-    body: JSON.stringify({ ...program(), format: ext }),
+    body: JSON.stringify({ ...program(), format: ext, session: SESSION }),
   });
   if (!r.ok) {
     const e = await r.json().catch(() => ({}));
@@ -933,7 +953,12 @@ async function main() {
   });
   ui.keep.addEventListener("click", () => {
     const d = state.pendingDisk;
-    if (d) state.ignoredVersion = d.version;
+    if (d) {
+      // The page's text now stands against that version: the next save
+      // writes over it, knowingly.
+      state.ignoredVersion = d.version;
+      state.diskVersion = d.version;
+    }
     ui.banner.hidden = true;
   });
   window.addEventListener("beforeunload", (e) => {
