@@ -21,6 +21,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("trivia", 4),
     ("resolve", 4),
     ("dump", 4),
+    ("write", 0),
     ("source", 6),
     ("fmt", 5),
     ("builtins", 5),
