@@ -100,6 +100,7 @@ codes! {
     GuideIncomplete = "E0803", "a guide without a polygon or without a system";
     SeedArguments = "E0804", "a seed passing a different number of arguments than its lsystem takes";
     LinkSetting = "E0805", "a link setting lsyc does not know, or a value it does not take";
+    SceneNeverSettles = "E0806", "a scene still growing when it has run the most steps a scene runs";
     DivisionByZero = "E0901", "a division by zero while running";
     NotFinite = "E0902", "an expression whose value is not a finite number while running";
     TooManyModules = "E0903", "a derivation step that would exceed the module limit";

@@ -74,8 +74,9 @@ pub struct Args {
     #[arg(long, value_name = "MIB", default_value_t = Limits::default().max_bytes >> 20)]
     pub max_memory: usize,
 
-    /// Worker threads for derivation (default: all cores). Output does not depend on it.
-    #[arg(long)]
+    /// Worker threads for derivation, from 1 to four times the cores (default:
+    /// all cores); more is a usage error. Output does not depend on it.
+    #[arg(long, value_name = "N", value_parser = parse_threads)]
     pub threads: Option<usize>,
 
     /// Print the compiled bytecode of every rule and exit.
@@ -121,6 +122,20 @@ fn parse_steps(text: &str) -> Result<u32, String> {
         })
 }
 
+/// `--threads N`: 1 to four times the cores (a thread pool of 100,000 would
+/// exhaust the system before deriving anything).
+fn parse_threads(text: &str) -> Result<usize, String> {
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+    let max = cores * 4;
+    text.trim()
+        .parse::<usize>()
+        .ok()
+        .filter(|n| (1..=max).contains(n))
+        .ok_or_else(|| {
+            format!("the number of threads must be a whole number from 1 to {max} (four times the {cores} cores)")
+        })
+}
+
 pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     match run_inner(args, reporter) {
         Ok(()) => 0,
@@ -138,10 +153,17 @@ fn run_inner(args: &Args, reporter: &Reporter) -> Result<(), u8> {
     check_outputs(args, format, reporter)?;
     let background = background(args, reporter)?;
     if let Some(n) = args.threads {
-        // Only the first call in a process can set the global pool; later calls are harmless.
-        let _ = rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
-            .build_global();
+        // Only the first call in a process can set the global pool; later
+        // calls are harmless. A pool the system cannot start is said, and
+        // the default pool does the work.
+        if let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+        {
+            reporter.warning(&format!(
+                "cannot start {n} threads ({e}); using the default"
+            ));
+        }
     }
     let (src, fe) = load(args, &ovr, reporter)?;
     let checked = fe.checked.as_ref().ok_or(1u8)?;
@@ -300,16 +322,32 @@ fn load(
             );
             return Err(2);
         };
-        let data = std::fs::read(file).map_err(|e| {
-            reporter.error(&format!("cannot read `{file}`: {e}"), None);
-            1u8
-        })?;
+        let data = read_element(file, reporter)?;
         if let Err(why) = lsyc::infer::elements::replace_element(&mut fe.file, name, &data) {
             reporter.error(&format!("--element {spec}: {why}"), None);
             return Err(1);
         }
     }
     Ok((src, fe))
+}
+
+/// Reads an `--element` drawing, up to the size inference reads.
+fn read_element(file: &str, reporter: &Reporter) -> Result<Vec<u8>, u8> {
+    let limit = lsyc::infer::MAX_SVG_BYTES;
+    if std::fs::metadata(file).is_ok_and(|m| m.len() > limit as u64) {
+        reporter.error(
+            &format!(
+                "`{file}` is larger than {} MiB; lsyc reads drawings of up to that",
+                limit >> 20
+            ),
+            None,
+        );
+        return Err(1);
+    }
+    std::fs::read(file).map_err(|e| {
+        reporter.error(&format!("cannot read `{file}`: {e}"), None);
+        1u8
+    })
 }
 
 /// Derives one lsystem, draws it (to a file with `-o`) and reports the summary.

@@ -509,6 +509,9 @@ fn run_unit(
         answer(scene, cfg, &mut live, &used, t)?;
         t += 1;
     }
+    if t > MAX_SCENE_STEPS && (growing(scene, &live).is_some() || next < inbox.len()) {
+        return Err(never_settles(scene, unit, &live));
+    }
     release_all(&mut live, t.min(cfg.cap));
     Ok(live
         .into_iter()
@@ -581,6 +584,70 @@ fn arriving(
     );
     arriving.sort_by_key(|m| (m.from_guide, m.seq));
     arriving
+}
+
+/// The first guide of a unit with a system that still derives and still
+/// changes (not settled), or `None`.
+fn growing(scene: &Scene, live: &[Live]) -> Option<usize> {
+    live.iter()
+        .find(|l| {
+            let prog = &scene.programs[scene.guides[l.guide].program];
+            l.run
+                .instances
+                .iter()
+                .zip(&l.settled)
+                .any(|(inst, settled)| inst.steps < prog.derive && !settled)
+        })
+        .map(|l| l.guide)
+}
+
+/// The error of a unit still growing (or with messages still to deliver)
+/// when the scene has run `MAX_SCENE_STEPS`: it names the guide, and a link
+/// that feeds the unit's messages back into it, where there is one (a
+/// guide linked to itself, or guides linked in a circle).
+fn never_settles(scene: &Scene, unit: &[usize], live: &[Live]) -> Diagnostic {
+    let g = growing(scene, live).unwrap_or(unit[0]);
+    let guide = &scene.guides[g];
+    let within = |x: usize| unit.binary_search(&x).is_ok();
+    let sent = |i: usize| {
+        live.iter()
+            .flat_map(|l| &l.run.sent)
+            .filter(|m| m.link == i)
+            .count()
+    };
+    // The link inside the unit that carried the most messages back into it.
+    let circle = (0..scene.links.len())
+        .filter(|&i| within(scene.links[i].from.0) && within(scene.links[i].to.0))
+        .map(|i| (sent(i), i))
+        .filter(|&(n, _)| n > 0)
+        .max()
+        .map(|(n, i)| (n, &scene.links[i]));
+    let mut d = Diagnostic::error(
+        crate::diagnostic::Code::SceneNeverSettles,
+        format!(
+            "guide `{}` is still growing after {MAX_SCENE_STEPS} steps, the most a scene runs",
+            guide.name
+        ),
+    )
+    .primary(guide.span, "still growing here");
+    if let Some((sent, l)) = circle {
+        let name = |(g, e): (usize, usize)| format!("{}.edge({e})", scene.guides[g].name);
+        let what = if l.from.0 == l.to.0 {
+            "links the guide to itself"
+        } else {
+            "closes a circle of links"
+        };
+        d = d.secondary(
+            l.span,
+            format!(
+                "`{} -> {}` {what}: each crossing seeds the growth again ({sent} message{} so far)",
+                name(l.from),
+                name(l.to),
+                if sent == 1 { "" } else { "s" }
+            ),
+        );
+    }
+    d.help("let the systems end within the scene (a smaller `derive`, a rule that stops growing), give the links fewer tokens, or run fewer steps with -n")
 }
 
 /// Reservations nobody will settle: the tokens are free again at `step`.

@@ -5,7 +5,10 @@
 //!
 //! Owns: refusing what would make usvg (or lsyc after it) run out of memory,
 //! stack or time on a hostile file: compressed data (usvg inflates it without
-//! a bound), too many XML nodes, elements nested too deep, `<use>` elements
+//! a bound), a file over 64 MiB, entities that expand without bound, too many
+//! attributes on one element (the XML parser compares each with all before
+//! it), numbers beyond 32-bit floats (the raw text's pass, `scan`, before any
+//! parser), too many XML nodes, elements nested too deep, `<use>` elements
 //! that draw themselves or expand to too many elements (a "billion laughs"
 //! of `<use>`s), and images (never loaded: an `href` may name any file, even
 //! a device). The checks are one pass over the XML, iterative and linear in
@@ -13,6 +16,8 @@
 //! what lsyc draws lies on the input), turning the SVG's y-down user space
 //! into the language's y-up world (x, −y), subpaths as segments (`Seg`) and
 //! flattening them into points. Must not decide what an element means.
+
+mod scan;
 
 use glam::DVec2;
 use std::collections::HashMap;
@@ -65,6 +70,38 @@ pub enum Refusal {
     /// A limit of the reader: `what` is counted while reading.
     #[error("it has more than {limit} {what}; lsyc infers from drawings of up to {limit} {what}")]
     TooMany { what: &'static str, limit: usize },
+    #[error("it is larger than {limit_mib} MiB; lsyc reads drawings of up to {limit_mib} MiB")]
+    TooLarge { limit_mib: usize },
+    #[error(
+        "{at}: its DOCTYPE's entities expand to more than {limit_mib} MiB of text, or refer to each other too deeply; lsyc reads drawings whose entities stay within that (write the text out, or drop the entities)"
+    )]
+    EntityExpansion { at: Place, limit_mib: u64 },
+    #[error(
+        "{at}: `<{tag}>` has more than {limit} attributes; lsyc reads elements with up to {limit}"
+    )]
+    TooManyAttributes {
+        at: Place,
+        tag: String,
+        limit: usize,
+    },
+    /// `number`: the number as written, and where (`` 1e308 in `d` of `<path>` ``).
+    #[error(
+        "{at}: the number {number} is beyond ±3.4e38, the largest coordinate lsyc reads (scale the drawing down)"
+    )]
+    NumberTooLarge { at: Place, number: String },
+}
+
+/// A place in a drawing's text, for messages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Place {
+    pub line: usize,
+    pub column: usize,
+}
+
+impl std::fmt::Display for Place {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "line {}, column {}", self.line, self.column)
+    }
 }
 
 fn target_note(id: &str) -> String {
@@ -99,9 +136,15 @@ pub fn check(data: &[u8]) -> Result<(), Refusal> {
     if data.starts_with(&[0x1f, 0x8b]) {
         return Err(Refusal::Compressed);
     }
+    if data.len() > scan::MAX_BYTES {
+        return Err(Refusal::TooLarge {
+            limit_mib: scan::MAX_BYTES >> 20,
+        });
+    }
     let Ok(text) = std::str::from_utf8(data) else {
         return Ok(());
     };
+    scan::scan(text)?;
     let opts = roxmltree::ParsingOptions {
         allow_dtd: true,
         nodes_limit: MAX_XML_NODES,

@@ -81,11 +81,17 @@ fn small_hostile_files() {
         ("empty.svg", Error(not_svg), Error(not_svg)),
         ("png.svg", Error(not_svg), Error(not_svg)),
         ("random-bytes.svg", Error(not_svg), Error(not_svg)),
-        // usvg drops points it cannot hold in 32-bit floats.
+        // Numbers usvg cannot hold in 32-bit floats would vanish: refused,
+        // with the place, even beside drawable paths.
         (
             "huge-coordinates.svg",
-            Error("has nothing to infer from"),
-            Error("has no strokes"),
+            Error("line 2, column 18: the number 1e308 in `d` of `<path>`"),
+            Error("line 2, column 18: the number 1e308 in `d` of `<path>`"),
+        ),
+        (
+            "huge-among-lines.svg",
+            Error("line 4, column 18: the number 1e308"),
+            Error("line 4, column 18: the number 1e308"),
         ),
         ("use-cycle.svg", Error(cycle), Error(cycle)),
         ("use-self.svg", Error(cycle), Error(cycle)),
@@ -96,8 +102,13 @@ fn small_hostile_files() {
         ),
         (
             "entity-bomb.svg",
-            Error("entity reference loop"),
-            Error("entity reference loop"),
+            Error("entities expand to more than 4 MiB"),
+            Error("entities expand to more than 4 MiB"),
+        ),
+        (
+            "entity-quadratic.svg",
+            Error("line 6, column 73: its DOCTYPE's entities expand to more than 4 MiB"),
+            Error("line 6, column 73: its DOCTYPE's entities expand to more than 4 MiB"),
         ),
         (
             "compressed.svg",
@@ -193,4 +204,47 @@ fn a_long_chain_of_strokes() {
     // Within the limits, a chain is a tree, however deep.
     let chain = generated(dir.path(), "chain-3000.svg", &chained_strokes(3000));
     check(&chain, true, Program);
+}
+
+#[test]
+fn two_hundred_thousand_attributes_on_one_element() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let attrs: String = (0..200_000).map(|i| format!(" a{i}=\"1\"")).collect();
+    let file = generated(
+        dir.path(),
+        "attributes.svg",
+        &format!("{HEAD}\n<path d=\"M0 0L5 5\" stroke=\"black\"{attrs}/></svg>"),
+    );
+    let says = Error("line 2, column 1: `<path>` has more than 1024 attributes");
+    both(&file, says, says);
+}
+
+/// The entity bombs under a memory limit of 512 MiB of address space (the
+/// quadratic one grew to 2.47 GB before it was refused): each is refused
+/// quickly, never killed.
+#[cfg(unix)]
+#[test]
+fn entity_bombs_under_a_memory_limit() {
+    for name in ["entity-quadratic.svg", "entity-bomb.svg"] {
+        for mode in [&["infer"][..], &["infer", "--skeleton"][..]] {
+            let start = Instant::now();
+            let out = Command::new("sh")
+                .arg("-c")
+                .arg("ulimit -v 524288 && exec \"$@\"")
+                .arg("sh")
+                .arg(env!("CARGO_BIN_EXE_lsyc"))
+                .args(mode)
+                .arg(hostile(name))
+                .stdin(Stdio::null())
+                .output()
+                .expect("runs sh");
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(1), "{name} {mode:?}: {err}");
+            assert!(
+                err.contains("entities expand to more than"),
+                "{name}: {err}"
+            );
+            assert!(start.elapsed() < TIME, "{name}: {:?}", start.elapsed());
+        }
+    }
 }

@@ -320,8 +320,14 @@ fn bad_drawings_are_clear_errors() {
         ("truncated.svg", "is not an SVG drawing lsyc can read"),
         ("empty.svg", "is not an SVG drawing lsyc can read"),
         ("no-drawable.svg", "has nothing to infer from"),
-        ("nan.svg", "has nothing to infer from"),
-        ("huge.svg", "has coordinates as large as"),
+        (
+            "nan.svg",
+            "line 10, column 13: the number 1e999 in `d` of `<path>` is beyond",
+        ),
+        (
+            "huge.svg",
+            "line 7, column 13: the number 1e300 in `d` of `<path>` is beyond",
+        ),
     ] {
         let out = Command::new(env!("CARGO_BIN_EXE_lsyc"))
             .arg("infer")

@@ -27,6 +27,7 @@ mod run;
 mod scene;
 mod sketch;
 mod stress_files;
+mod stress_limits;
 mod studio;
 mod studio_stress;
 mod support;
