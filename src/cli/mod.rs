@@ -281,6 +281,12 @@ pub fn main() -> ExitCode {
         }
     };
     let reporter = Reporter::new(&cli);
+    if matches!(
+        cli.command,
+        Command::Run(_) | Command::Fmt(_) | Command::Infer(_) | Command::Edit(_)
+    ) {
+        remove_temp_files_on_interrupt();
+    }
     let status = match &cli.command {
         Command::Check(args) => check::run(args, &reporter),
         Command::Fmt(args) => fmt::run(args, &reporter),
@@ -296,6 +302,17 @@ pub fn main() -> ExitCode {
         return ExitCode::from(1);
     }
     ExitCode::from(status)
+}
+
+/// Ctrl-C (and SIGTERM, SIGHUP) during a write: the temporary files of the
+/// writes under way are removed and lsyc exits with status 130, so that an
+/// interrupted `-o` leaves the old file and nothing else. (The studio and the
+/// language server handle their own ending.)
+fn remove_temp_files_on_interrupt() {
+    let _ = ctrlc::set_handler(|| {
+        lsyc::write::remove_temp_files();
+        std::process::exit(130);
+    });
 }
 
 /// Whether the raw arguments ask for JSON messages (read before clap has

@@ -348,3 +348,59 @@ fn outputs_never_replace_inputs_or_files_lsyc_did_not_write() {
     assert_eq!(status, 2, "{err}");
     assert_eq!(before("leaf-001.svg"), leaf.as_bytes());
 }
+
+/// The temporary files in `dir` (polled while a child writes).
+fn wait_for_temp(dir: &Path, child: &mut std::process::Child) -> bool {
+    let start = std::time::Instant::now();
+    while start.elapsed() < std::time::Duration::from_secs(240) {
+        if !leftovers(dir).is_empty() {
+            return true;
+        }
+        if child.try_wait().ok().flatten().is_some() {
+            return false;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    false
+}
+
+#[cfg(unix)]
+#[test]
+fn an_interrupt_during_a_long_write_leaves_no_temporary_file() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    fs::copy(
+        root().join("lang-examples/koch-island.lsy"),
+        dir.path().join("koch.lsy"),
+    )
+    .expect("copies");
+    fs::write(dir.path().join("koch.svg"), "the old drawing").expect("writes");
+    // Tries again if the child finished its write before it was caught in it.
+    for _ in 0..3 {
+        let mut child = lsyc()
+            .current_dir(dir.path())
+            .args(["run", "koch.lsy", "-n", "6", "-o", "koch.svg"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("starts lsyc");
+        if !wait_for_temp(dir.path(), &mut child) {
+            let _ = child.wait();
+            fs::write(dir.path().join("koch.svg"), "the old drawing").expect("writes");
+            continue;
+        }
+        let killed = Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status()
+            .expect("runs kill");
+        assert!(killed.success());
+        let status = child.wait().expect("waits");
+        assert_eq!(status.code(), Some(130), "{status:?}");
+        assert_eq!(leftovers(dir.path()), Vec::<String>::new());
+        assert_eq!(
+            fs::read_to_string(dir.path().join("koch.svg")).expect("reads"),
+            "the old drawing"
+        );
+        return;
+    }
+    panic!("lsyc wrote koch.svg too fast to be interrupted three times");
+}
