@@ -31,6 +31,8 @@ const CLI_ONLY: &[Code] = &[
     Code::MeshFile,
     // Only `lsyc run` needs an lsystem: tests/it/hostile.rs.
     Code::NoLsystem,
+    // A scene still growing at its step limit: tests/data/hostile/self-linked-guide.lsy.
+    Code::SceneNeverSettles,
     // Warnings of a scene's run: tests/it/guided.rs.
     Code::NeverSeeded,
     Code::DeriveRanOut,
