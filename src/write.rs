@@ -213,10 +213,27 @@ fn create_temp(target: &Path) -> io::Result<(NamedTempFile, Registered)> {
     if temps.closed {
         return Err(Refused::Interrupted.into());
     }
-    let file = builder.tempfile_in(folder(target))?;
+    let file = builder
+        .tempfile_in(folder(target))
+        .map_err(|e| plain(e, target))?;
     temps.paths.insert(file.path().to_path_buf());
     let registered = Registered(file.path().to_path_buf());
     Ok((file, registered))
+}
+
+/// Why no temporary file could be made beside `target`, in the target's
+/// terms (the tempfile crate's message names the temporary file, which the
+/// user never saw).
+fn plain(e: io::Error, target: &Path) -> io::Error {
+    let dir = folder(target);
+    let why = match e.kind() {
+        io::ErrorKind::NotFound => format!("the folder `{}` does not exist", dir.display()),
+        io::ErrorKind::PermissionDenied => {
+            format!("the folder `{}` may not be written", dir.display())
+        }
+        _ => return e,
+    };
+    io::Error::new(e.kind(), why)
 }
 
 /// Renames the temporary file over `target`, under the registry's lock, so
