@@ -23,7 +23,7 @@ use lsyc::infer::lines::{self, Lines};
 const FLOORS: [(&str, usize); 5] = [
     ("clean", 6),
     ("rotated", 6),
-    ("jittered", 0),
+    ("jittered", 1),
     ("split", 6),
     ("shuffled", 1),
 ];

@@ -44,6 +44,10 @@ pub struct Graph {
     pub delta: f64,
     /// How near (user units) a point must be to a vertex to be it.
     pub tol: f64,
+    /// Every unit step as the drawing's paths draw it, in their order and
+    /// direction (a step drawn twice is here twice): what a search follows
+    /// when the paths come in the order a turtle drew them.
+    pub order: Vec<(u32, u32)>,
     grid: PointGrid,
     edge_of: HashMap<(u32, u32), u32>,
 }
@@ -206,7 +210,9 @@ fn unit_length_of(lengths: &[f64]) -> f64 {
 /// The step length of pieces of `lengths`: every piece a whole number of
 /// steps. First from `unit` (one step as the short pieces show it), then
 /// from ever longer pieces (a long piece pins the step down better once its
-/// count of steps is known).
+/// count of steps is known), then the step near that which puts the pieces
+/// nearest whole numbers of steps when the drawing is noisy (its short
+/// pieces are poor witnesses, its long ones good ones).
 pub fn step_of(lengths: &[f64], split: u32, unit: f64) -> f64 {
     let longest = lengths.iter().copied().fold(0.0, f64::max);
     let mut step = unit / f64::from(split.max(1));
@@ -228,7 +234,81 @@ pub fn step_of(lengths: &[f64], split: u32, unit: f64) -> f64 {
         }
         limit *= 4.0;
     }
-    step
+    if noisy(lengths, step) {
+        best_fit(lengths, step)
+    } else {
+        step
+    }
+}
+
+/// How far pieces are from whole numbers of `step`: the sum of squares, in
+/// steps.
+fn misfit(lengths: &[f64], step: f64) -> f64 {
+    lengths
+        .iter()
+        .map(|&len| {
+            let u = len / step;
+            (u - u.round().max(1.0)).powi(2)
+        })
+        .sum()
+}
+
+/// The step within 10 % of `step` that fits the pieces best (a sample of
+/// them: the longest and an even spread of the rest), then refined by least
+/// squares with each piece's count of steps fixed.
+fn best_fit(lengths: &[f64], step: f64) -> f64 {
+    if !(step.is_finite() && step > 0.0) || lengths.is_empty() {
+        return step;
+    }
+    let mut sorted = lengths.to_vec();
+    sorted.sort_by(|a, b| b.total_cmp(a));
+    let mut sample: Vec<f64> = sorted.iter().copied().take(200).collect();
+    let rest = &sorted[sample.len()..];
+    let stride = (rest.len() / 200).max(1);
+    sample.extend(rest.iter().step_by(stride).copied());
+    let mut best = (misfit(&sample, step), step);
+    let mut s = 0.9 * step;
+    while s <= 1.1 * step {
+        let m = misfit(&sample, s);
+        if m < best.0 {
+            best = (m, s);
+        }
+        s *= 1.0 + 2e-4;
+    }
+    let (mut num, mut den) = (0.0, 0.0);
+    for &len in lengths {
+        let k = (len / best.1).round().max(1.0);
+        num += len * k;
+        den += k * k;
+    }
+    let refined = if den > 0.0 { num / den } else { best.1 };
+    if refined.is_finite() && misfit(&sample, refined) <= misfit(&sample, step) {
+        refined
+    } else {
+        step
+    }
+}
+
+/// How far a piece may be from a whole number of steps: `WHOLE`, or any
+/// distance in a noisy drawing (whose long pieces may be off by half a
+/// step; they are rounded, and the grammar's redraw judges the result).
+fn whole_tolerance(lengths: &[f64], step: f64) -> f64 {
+    if noisy(lengths, step) { 0.5 } else { WHOLE }
+}
+
+/// Whether the pieces about one step long spread by more than 5 % about it
+/// (a jittered or hand-traced drawing).
+fn noisy(lengths: &[f64], step: f64) -> bool {
+    let ones: Vec<f64> = lengths
+        .iter()
+        .map(|&l| l / step)
+        .filter(|u| (0.75..1.25).contains(u))
+        .collect();
+    if ones.len() < 8 {
+        return false;
+    }
+    let spread = (ones.iter().map(|u| (u - 1.0).powi(2)).sum::<f64>() / ones.len() as f64).sqrt();
+    spread > 0.05
 }
 
 /// Pieces of segments, each split where a vertex lies on it.
@@ -325,10 +405,11 @@ pub fn build(lines: &[Vec<DVec2>], split: u32) -> Result<Graph, String> {
     let mut all = points.clone();
     let mut chains: Vec<Vec<u32>> = Vec::with_capacity(parts.len());
     let mut total = 0usize;
+    let whole = whole_tolerance(&lengths, step);
     for (&(a, b), &len) in parts.iter().zip(&lengths) {
         let u = len / step;
         let r = u.round();
-        if r < 1.0 || (u - r).abs() > WHOLE {
+        if r < 1.0 || (u - r).abs() > whole {
             return Err(format!(
                 "a segment of {:.4} is not a whole number of steps of {:.4}",
                 len, step
@@ -351,12 +432,14 @@ pub fn build(lines: &[Vec<DVec2>], split: u32) -> Result<Graph, String> {
     let mut edge_of: HashMap<(u32, u32), u32> = HashMap::new();
     let mut edges: Vec<[u32; 2]> = Vec::new();
     let mut adj: Vec<Vec<(u32, u32)>> = vec![Vec::new(); vertices.len()];
+    let mut order = Vec::with_capacity(total);
     for chain in &chains {
         for w in chain.windows(2) {
             let (a, b) = (of2[w[0] as usize], of2[w[1] as usize]);
             if a == b {
                 continue;
             }
+            order.push((a, b));
             let key = (a.min(b), a.max(b));
             if edge_of.contains_key(&key) {
                 continue;
@@ -393,6 +476,7 @@ pub fn build(lines: &[Vec<DVec2>], split: u32) -> Result<Graph, String> {
         noise,
         delta: 0.0,
         tol: tol.min(0.3 * step),
+        order,
         grid,
         edge_of,
     };

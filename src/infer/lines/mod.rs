@@ -259,7 +259,7 @@ fn from_graph(
             brackets: branches,
             ..*opts
         };
-        let Some(found) = synth::search(&g, &limits) else {
+        let Some(found) = synth::search(&g, &limits).map(synth::Found::squared) else {
             continue;
         };
         stats.candidates += 1;

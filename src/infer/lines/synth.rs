@@ -61,6 +61,69 @@ impl Found {
     pub fn size(&self) -> usize {
         self.axiom.len() + self.rules.iter().map(Vec::len).sum::<usize>()
     }
+
+    /// Two letters that are each rewritten only to the other (`F -> G--G`,
+    /// `G -> F+F`), derived an even number of times from an axiom of one of
+    /// them, are one letter's grammar twice over: written as that
+    /// (`F -> F+F--F+F`) at half the depth, which draws the same and has
+    /// one letter, as a person writes it.
+    pub fn squared(self) -> Found {
+        if self.rules.len() != 2 || !self.depth.is_multiple_of(2) {
+            return self;
+        }
+        let only = |r: &[Sym], k: u8| {
+            r.iter()
+                .all(|s| !matches!(s, Sym::Unnamed) && !matches!(s, Sym::Letter(j) if *j != k))
+        };
+        let Some(k) = (0..2u8).find(|&k| only(&self.axiom, k)) else {
+            return self;
+        };
+        if !(only(&self.rules[0], 1) && only(&self.rules[1], 0)) {
+            return self;
+        }
+        let other = &self.rules[1 - k as usize];
+        let mut rule: Vec<Sym> = Vec::new();
+        for s in &self.rules[k as usize] {
+            let part: &[Sym] = if matches!(s, Sym::Letter(_)) {
+                other
+            } else {
+                std::slice::from_ref(s)
+            };
+            for &t in part {
+                let t = if matches!(t, Sym::Letter(_)) {
+                    Sym::Letter(0)
+                } else {
+                    t
+                };
+                match (rule.last_mut(), t) {
+                    (Some(Sym::Turn(a)), Sym::Turn(b)) => {
+                        *a += b;
+                        if *a == 0 {
+                            rule.pop();
+                        }
+                    }
+                    _ => rule.push(t),
+                }
+            }
+        }
+        let axiom = self
+            .axiom
+            .iter()
+            .map(|s| {
+                if matches!(s, Sym::Letter(_)) {
+                    Sym::Letter(0)
+                } else {
+                    *s
+                }
+            })
+            .collect();
+        Found {
+            axiom,
+            rules: vec![rule],
+            depth: self.depth / 2,
+            ..self
+        }
+    }
 }
 
 /// How far a search goes.
@@ -165,11 +228,18 @@ struct Search<'a> {
     trail: Vec<(u32, u32)>,
     edits: Vec<Edit>,
     cos_tol: f64,
+    /// The drawing's orientation (radians) when δ₀ divides the turn: every
+    /// step's direction is the phase plus a multiple of δ₀, so the first
+    /// step's heading is snapped to it rather than taken as drawn.
+    phase: Option<f64>,
     work: u64,
     /// Symbols in the axiom and all successors at most.
     bound: usize,
     /// The depth n.
     depth: u8,
+    /// The steps in the order the drawing's paths draw them, when the
+    /// search must follow it.
+    order: Option<&'a [(u32, u32)]>,
 }
 
 impl<'a> Search<'a> {
@@ -200,7 +270,58 @@ impl<'a> Search<'a> {
         for s in &self.axiom.syms {
             total = total.saturating_add(self.least(*s, n, &mut memo));
         }
-        total <= self.g.edges.len() as u64
+        total <= self.all() as u64 && self.most() >= self.all() as u64
+    }
+
+    /// The most steps the axiom could draw at depth n: every symbol the
+    /// bound leaves (in any open successor, or the axiom) a letter, every
+    /// unnamed letter the one that draws most.
+    fn most(&self) -> u64 {
+        let size = self.axiom.syms.len() + self.rules.iter().map(|r| r.syms.len()).sum::<usize>();
+        let spare = self.bound.saturating_sub(size) as u64;
+        let new_letters = self.rules.len() < self.limits.letters;
+        // most[k] and any (the most of any letter) at the depth below.
+        let mut below = [1u64; 4];
+        let mut any_below = 1u64;
+        for _ in 1..=self.depth {
+            let mut here = [0u64; 4];
+            let mut any = if new_letters {
+                spare.saturating_mul(any_below).max(1)
+            } else {
+                0
+            };
+            for (k, r) in self.rules.iter().enumerate().take(4) {
+                let mut t = 0u64;
+                for s in &r.syms {
+                    let c = match *s {
+                        Sym::Letter(j) => below.get(j as usize).copied().unwrap_or(any_below),
+                        Sym::Unnamed => any_below,
+                        _ => 0,
+                    };
+                    t = t.saturating_add(c);
+                }
+                if !r.closed {
+                    t = t.saturating_add(spare.saturating_mul(any_below));
+                }
+                here[k] = t.max(1);
+                any = any.max(here[k]);
+            }
+            below = here;
+            any_below = any;
+        }
+        let mut total = 0u64;
+        for s in &self.axiom.syms {
+            let c = match *s {
+                Sym::Letter(j) => below.get(j as usize).copied().unwrap_or(any_below),
+                Sym::Unnamed => any_below,
+                _ => 0,
+            };
+            total = total.saturating_add(c);
+        }
+        if !self.axiom.closed {
+            total = total.saturating_add(spare.saturating_mul(any_below));
+        }
+        total
     }
 
     /// The fewest steps symbol `s` at depth `d` draws.
@@ -258,7 +379,7 @@ impl<'a> Search<'a> {
                 None => return true,
             }
         }
-        let left = (self.g.edges.len() - self.trail.len()) as u64;
+        let left = self.left();
         let need = left.div_ceil(most.max(1)) as usize;
         letters + need <= self.limits.axiom
     }
@@ -308,8 +429,69 @@ impl<'a> Search<'a> {
         total
     }
 
+    /// The letters some successor or the axiom names, as bits.
+    fn named(&self) -> u32 {
+        let mut bits = 0u32;
+        for r in std::iter::once(&self.axiom).chain(&self.rules) {
+            for s in &r.syms {
+                if let Sym::Letter(k) = s {
+                    bits |= 1 << k;
+                }
+            }
+        }
+        bits
+    }
+
+    /// Steps the grammar must draw.
+    fn all(&self) -> usize {
+        self.order.map_or(self.g.edges.len(), <[_]>::len)
+    }
+
+    /// Steps the drawing has that are not drawn yet.
+    fn left(&self) -> u64 {
+        self.all().saturating_sub(self.trail.len()) as u64
+    }
+
+    /// Draws the drawing's next step, which must leave the turtle's vertex
+    /// along its heading (the search follows the paths' order).
+    fn draw_next(&mut self, order: &[(u32, u32)]) -> bool {
+        let Some(&(from, to)) = order.get(self.trail.len()) else {
+            return false;
+        };
+        let Some(e) = self.g.edge(from, to) else {
+            return false;
+        };
+        if from != self.turtle.at {
+            return false;
+        }
+        let dir = self.g.direction(e, from);
+        let turned = f64::from(self.turtle.heading) * self.delta.to_radians();
+        match self.h0 {
+            None => self.h0 = Some(self.snapped(dir) - turned),
+            Some(h0) => {
+                if (dir - h0 - turned).cos() < self.cos_tol {
+                    return false;
+                }
+            }
+        }
+        self.take(e, from)
+    }
+
+    /// A direction (radians) moved to the nearest the drawing's phase
+    /// allows.
+    fn snapped(&self, dir: f64) -> f64 {
+        let Some(phase) = self.phase else {
+            return dir;
+        };
+        let d = self.delta.to_radians();
+        phase + ((dir - phase) / d).round() * d
+    }
+
     /// Draws one step from the turtle's vertex along its heading.
     fn draw(&mut self) -> bool {
+        if let Some(order) = self.order {
+            return self.draw_next(order);
+        }
         let at = self.turtle.at;
         let h0 = match self.h0 {
             Some(h) => h,
@@ -320,7 +502,8 @@ impl<'a> Search<'a> {
                     return false;
                 }
                 let dir = self.g.direction(e, v);
-                self.h0 = Some(dir - f64::from(self.turtle.heading) * self.delta.to_radians());
+                let turned = f64::from(self.turtle.heading) * self.delta.to_radians();
+                self.h0 = Some(self.snapped(dir) - turned);
                 return self.take(e, v);
             }
         };
@@ -348,6 +531,7 @@ impl<'a> Search<'a> {
         let [a, b] = self.g.edges[e as usize];
         self.used[e as usize] = true;
         self.trail.push((e, from));
+
         self.turtle.at = if a == from { b } else { a };
         true
     }
@@ -398,7 +582,7 @@ impl<'a> Search<'a> {
                 Sym::Letter(k) => {
                     // A letter that would draw more steps than are left.
                     if let Some(c) = self.count(k, top.depth)
-                        && c > (self.g.edges.len() - self.trail.len()) as u64
+                        && c > self.left()
                     {
                         return Step::Fail;
                     }
@@ -435,11 +619,17 @@ impl<'a> Search<'a> {
                         .count()
                         == 1
                     && self.rule(rule).closed;
+                // Letters are interchangeable: a letter nothing names yet is
+                // any new letter, so only the first such is offered (and a
+                // new one when every letter is named somewhere).
+                let named = self.named();
+                let fresh = (0..self.rules.len() as u8).find(|&k| named & (1 << k) == 0);
                 let mut v: Vec<Alt> = (0..self.rules.len() as u8)
                     .filter(|&k| !(single && k == rule))
+                    .filter(|&k| named & (1 << k) != 0 || Some(k) == fresh)
                     .map(Alt::Name)
                     .collect();
-                if self.rules.len() < self.limits.letters {
+                if fresh.is_none() && self.rules.len() < self.limits.letters {
                     v.push(Alt::NewLetter);
                 }
                 v
@@ -553,7 +743,7 @@ impl<'a> Search<'a> {
         let mut points: Vec<Point> = Vec::new();
         loop {
             match self.advance() {
-                Step::Done if self.trail.len() == self.g.edges.len() => return true,
+                Step::Done if self.left() == 0 => return true,
                 Step::Need(c) => {
                     let p = Point {
                         choice: c,
@@ -654,6 +844,22 @@ fn turn_range(delta: f64) -> Vec<i32> {
     v
 }
 
+/// The drawing's orientation when δ₀ is 360/m: the mean of its unit edges'
+/// directions, each taken m times round (so every multiple of δ₀ counts
+/// alike), radians.
+fn phase(g: &Graph, delta: f64) -> Option<f64> {
+    let m = 360.0 / delta;
+    if (m - m.round()).abs() > 1e-9 || m < 2.0 {
+        return None;
+    }
+    let mut z = DVec2::ZERO;
+    for (e, [a, _]) in g.edges.iter().enumerate() {
+        let t = g.direction(e as u32, *a) * m.round();
+        z += DVec2::new(t.cos(), t.sin());
+    }
+    (z.length() > 1e-9 * g.edges.len() as f64).then(|| z.y.atan2(z.x) / m.round())
+}
+
 /// δ₀ as the search uses it: 360/m when that is within a percent.
 fn working_delta(delta: f64) -> f64 {
     let m = (360.0 / delta).round();
@@ -664,18 +870,146 @@ fn working_delta(delta: f64) -> f64 {
     }
 }
 
-/// Searches for a grammar that draws every edge of `g` exactly once.
+/// One search: from a start edge, for a bound on the grammar's size and a
+/// depth n, following the paths' order or not.
+struct Attempt<'a> {
+    start: (u32, u32),
+    bound: usize,
+    depth: u32,
+    order: Option<&'a [(u32, u32)]>,
+}
+
+/// What the searches share: the graph, δ₀ and its turns, the tolerance of
+/// directions, the work spent and the drawn-edges buffer.
+struct Shared<'a> {
+    g: &'a Graph,
+    limits: Limits,
+    delta: f64,
+    turns: Vec<i32>,
+    cos_tol: f64,
+    phase: Option<f64>,
+    spent: u64,
+    /// Which edges are drawn: one buffer for every attempt, cleared by the
+    /// attempt's own trail (an attempt costs its work, not the drawing's
+    /// size).
+    used: Vec<bool>,
+}
+
+impl Shared<'_> {
+    fn exhausted(&self) -> bool {
+        self.spent >= self.limits.total || self.limits.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+
+    fn attempt(&mut self, a: &Attempt) -> Option<Found> {
+        let (v, e) = a.start;
+        let mut s = Search {
+            g: self.g,
+            limits: self.limits,
+            delta: self.delta,
+            turns: self.turns.clone(),
+            axiom: Rule::default(),
+            rules: vec![Rule::default()],
+            frames: vec![Frame {
+                rule: AXIOM,
+                at: 0,
+                depth: a.depth as u8,
+            }],
+            turtle: Turtle {
+                at: v,
+                heading: 0,
+                saved: Vec::new(),
+            },
+            h0: None,
+            start: (v, e),
+            used: &mut self.used,
+            trail: Vec::new(),
+            edits: Vec::new(),
+            cos_tol: if a.order.is_some() && self.phase.is_some() {
+                // Following the paths' order, a step only has to say which
+                // multiple of δ₀ it turns (a noisy drawing's steps stray).
+                (0.45 * self.delta).to_radians().cos()
+            } else {
+                self.cos_tol
+            },
+            phase: self.phase,
+            work: 0,
+            bound: a.bound,
+            depth: a.depth as u8,
+            order: a.order,
+        };
+        s.limits.work = self.limits.work.min(self.limits.total - self.spent);
+        let ok = s.run();
+        self.spent += s.work.max(1);
+        let found = ok.then(|| Found {
+            axiom: s.axiom.syms.clone(),
+            rules: s.rules.iter().map(|r| r.syms.clone()).collect(),
+            depth: a.depth,
+            delta: self.delta,
+            walk: walk(self.g, &s.trail),
+        });
+        for &(e, _) in &s.trail {
+            s.used[e as usize] = false;
+        }
+        found
+    }
+
+    /// The smallest grammar, with the fewest letters, that a start and a
+    /// bound give at any depth from `n_max` down.
+    fn best_of(
+        &mut self,
+        start: (u32, u32),
+        bound: usize,
+        n_max: u32,
+        order: Option<&[(u32, u32)]>,
+    ) -> Option<Found> {
+        let mut found: Vec<Found> = Vec::new();
+        for depth in (2..=n_max).rev() {
+            if self.exhausted() {
+                break;
+            }
+            let a = Attempt {
+                start,
+                bound,
+                depth,
+                order,
+            };
+            found.extend(self.attempt(&a));
+        }
+        found
+            .into_iter()
+            .min_by_key(|f| (f.size(), f.rules.len(), std::cmp::Reverse(f.depth)))
+    }
+}
+
+/// Searches for a grammar that draws every edge of `g` exactly once: first
+/// following the paths' order (forwards, then backwards), which a drawing
+/// saved in the order a turtle drew it allows, then over the graph alone.
 pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
-    if g.edges.is_empty() || g.edges.len() > MAX_EDGES {
+    if g.edges.is_empty() || g.edges.len() > MAX_EDGES || g.order.len() > MAX_EDGES {
         return None;
     }
     let delta = working_delta(g.delta);
-    let turns = turn_range(delta);
-    let edges = g.edges.len() as f64;
-    let n_max = (edges.log2().ceil() as u32 + 1).clamp(2, 14);
     // Directions within a third of δ₀ (tighter when the drawing is clean).
     let tol = (delta / 3.0).min(10.0 + (2.0 * g.noise).atan().to_degrees() * 2.0);
-    let cos_tol = tol.to_radians().cos();
+    let mut shared = Shared {
+        g,
+        limits: *limits,
+        delta,
+        turns: turn_range(delta),
+        cos_tol: tol.to_radians().cos(),
+        phase: phase(g, delta),
+        spent: 0,
+        used: vec![false; g.edges.len()],
+    };
+    let n_of = |steps: usize| ((steps as f64).log2().ceil() as u32 + 1).clamp(2, 14);
+    if let Some(found) = in_order(&mut shared, n_of(g.order.len())) {
+        return Some(found);
+    }
+    // The search over the graph alone has a total of its own: a drawing
+    // whose paths come in another order fails the first quickly, and one
+    // that came in order but is not explained should not take the second's.
+    shared.spent = 0;
+    let n_max = n_of(g.edges.len());
     let starts = starts(g);
     // A curve's ends (a plant's root among its tips) are where a drawing
     // most likely starts: every bound is tried from each of them before
@@ -692,66 +1026,43 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
     for b in BOUNDS {
         plan.extend(starts[ends..].iter().map(|&start| (b, start)));
     }
-    let mut spent = 0u64;
-    // Which edges are drawn: one buffer for every attempt, cleared by the
-    // attempt's own trail (an attempt costs its work, not the drawing's size).
-    let mut used = vec![false; g.edges.len()];
-    for (bound, (v, e)) in plan {
-        let mut found: Vec<Found> = Vec::new();
-        for n in (2..=n_max).rev() {
-            if spent >= limits.total || limits.deadline.is_some_and(|d| Instant::now() >= d) {
+    for (bound, start) in plan {
+        if shared.exhausted() {
+            return None;
+        }
+        if let Some(best) = shared.best_of(start, bound, n_max, None) {
+            return Some(best);
+        }
+    }
+    None
+}
+
+/// The search that follows the paths' order, forwards and backwards, bound
+/// by bound.
+fn in_order(shared: &mut Shared, n_max: u32) -> Option<Found> {
+    let g = shared.g;
+    // A drawing in one stroke needs no branches.
+    let saved = shared.limits.brackets;
+    shared.limits.brackets &= g.order.windows(2).any(|w| w[0].1 != w[1].0);
+    let found = in_order_from(shared, n_max);
+    shared.limits.brackets = saved;
+    found
+}
+
+fn in_order_from(shared: &mut Shared, n_max: u32) -> Option<Found> {
+    let g = shared.g;
+    let forwards = g.order.clone();
+    let backwards: Vec<(u32, u32)> = g.order.iter().rev().map(|&(a, b)| (b, a)).collect();
+    for bound in BOUNDS {
+        for order in [&forwards, &backwards] {
+            let &(from, to) = order.first()?;
+            let e = g.edge(from, to)?;
+            if shared.exhausted() {
                 return None;
             }
-            let mut s = Search {
-                g,
-                limits: *limits,
-                delta,
-                turns: turns.clone(),
-                axiom: Rule::default(),
-                rules: vec![Rule::default()],
-                frames: vec![Frame {
-                    rule: AXIOM,
-                    at: 0,
-                    depth: n as u8,
-                }],
-                turtle: Turtle {
-                    at: v,
-                    heading: 0,
-                    saved: Vec::new(),
-                },
-                h0: None,
-                start: (v, e),
-                used: &mut used,
-                trail: Vec::new(),
-                edits: Vec::new(),
-                cos_tol,
-                work: 0,
-                bound,
-                depth: n as u8,
-            };
-            s.limits.work = limits.work.min(limits.total - spent);
-            let ok = s.run();
-            spent += s.work.max(1);
-            if ok {
-                found.push(Found {
-                    axiom: s.axiom.syms.clone(),
-                    rules: s.rules.iter().map(|r| r.syms.clone()).collect(),
-                    depth: n,
-                    delta,
-                    walk: walk(g, &s.trail),
-                });
+            if let Some(best) = shared.best_of((from, e), bound, n_max, Some(order)) {
+                return Some(best);
             }
-            for &(e, _) in &s.trail {
-                s.used[e as usize] = false;
-            }
-        }
-        // Of the grammars from one start, the smallest, with the fewest
-        // letters.
-        if let Some(best) = found
-            .into_iter()
-            .min_by_key(|f| (f.size(), f.rules.len(), std::cmp::Reverse(f.depth)))
-        {
-            return Some(best);
         }
     }
     None

@@ -182,10 +182,15 @@ pub enum Reject {
     Overlap,
     /// The same at depth n + 1 (the next level, which inference predicts).
     OverlapNext,
+    /// (Edge rewriting) Two letters each rewritten only to the other
+    /// (`F -> G+G`, `G -> F-F`), drawn an even number of times from one of
+    /// them: one letter's program at half the depth (`F -> F-F+F-F`) draws
+    /// the same level n, and inference writes that one (fewer letters).
+    Square,
 }
 
 impl Reject {
-    pub const ALL: [Reject; 8] = [
+    pub const ALL: [Reject; 9] = [
         Reject::Straight,
         Reject::Conjugate,
         Reject::Twins,
@@ -194,6 +199,7 @@ impl Reject {
         Reject::Unused,
         Reject::Overlap,
         Reject::OverlapNext,
+        Reject::Square,
     ];
 
     pub fn name(self) -> &'static str {
@@ -206,6 +212,7 @@ impl Reject {
             Reject::Unused => "unused",
             Reject::Overlap => "overlap",
             Reject::OverlapNext => "overlap-next",
+            Reject::Square => "square",
         }
     }
 }
@@ -560,6 +567,9 @@ fn filter(mut p: Program, rng: &mut Rng) -> Result<Program, Reject> {
     if levels[p.depth as usize - 1].contains(&0) {
         return Err(Reject::Unused);
     }
+    if p.depth.is_multiple_of(2) && square(&p) {
+        return Err(Reject::Square);
+    }
     for (depth, why) in [
         (p.depth, Reject::Overlap),
         (p.depth + 1, Reject::OverlapNext),
@@ -576,6 +586,20 @@ fn filter(mut p: Program, rng: &mut Rng) -> Result<Program, Reject> {
         }
     }
     Ok(p)
+}
+
+/// Whether `p` has two drawing letters, each rewritten only to the other,
+/// and an axiom of one of them (see `Reject::Square`).
+fn square(p: &Program) -> bool {
+    let letters = |w: &str| -> Vec<char> { w.chars().filter(|c| c.is_alphabetic()).collect() };
+    let [(a, wa), (b, wb)] = p.rules.as_slice() else {
+        return false;
+    };
+    let drawn = p.draws.contains(a) && p.draws.contains(b);
+    let crossed = letters(wa).iter().all(|c| c == b) && letters(wb).iter().all(|c| c == a);
+    let axiom = letters(&p.axiom);
+    let one = axiom.iter().all(|c| c == a) || axiom.iter().all(|c| c == b);
+    drawn && crossed && one
 }
 
 /// Whether every step of `d` is on one line.
