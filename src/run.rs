@@ -81,6 +81,25 @@ pub fn derive(
     })
 }
 
+/// The largest mesh file read.
+const MAX_MESH_BYTES: usize = 64 << 20;
+
+/// A mesh file's bytes, at most one more than [`MAX_MESH_BYTES`]: a device
+/// or a FIFO (`mesh "/dev/zero"`) is refused before it is read, and a file
+/// that grows while it is read is not read to its end.
+fn read_mesh(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    // Asked before opening: opening a FIFO waits for a writer.
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(std::io::Error::other("it is not a regular file"));
+    }
+    let file = std::fs::File::open(path)?;
+    let mut text = Vec::new();
+    file.take(MAX_MESH_BYTES as u64 + 1)
+        .read_to_end(&mut text)?;
+    Ok(text)
+}
+
 /// Reads the OBJ file of every `mesh` element the program uses; an error
 /// points at the file's name in the source.
 pub fn load_meshes(prog: &mut Program, base: Option<&std::path::Path>) -> Result<(), Diagnostic> {
@@ -94,8 +113,8 @@ pub fn load_meshes(prog: &mut Program, base: Option<&std::path::Path>) -> Result
                 .primary(span, "this mesh file")
                 .note("a mesh is Wavefront OBJ text (`v`, `vn` and `f` lines), found relative to the program's directory")
         };
-        let text = std::fs::read(&path).map_err(|err| fail(format!("cannot be read: {err}")))?;
-        if text.len() > 64 << 20 {
+        let text = read_mesh(&path).map_err(|err| fail(format!("cannot be read: {err}")))?;
+        if text.len() > MAX_MESH_BYTES {
             return Err(fail("is larger than 64 MiB".to_string()));
         }
         let text = String::from_utf8(text).map_err(|_| fail("is not UTF-8 text".to_string()))?;
