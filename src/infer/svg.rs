@@ -17,7 +17,7 @@
 //! into the language's y-up world (x, −y), subpaths as segments (`Seg`) and
 //! flattening them into points. Must not decide what an element means.
 
-mod scan;
+pub mod scan;
 
 use glam::DVec2;
 use std::collections::HashMap;

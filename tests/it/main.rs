@@ -8,6 +8,7 @@ mod diagnostics;
 mod docs;
 mod edit;
 mod evaluator;
+mod fuzz_smoke;
 mod geometry;
 mod guided;
 mod hostile;
