@@ -90,6 +90,58 @@ impl Graph {
         d.y.atan2(d.x)
     }
 
+    /// The one walk that draws every edge once, when the drawing is one
+    /// curve (every vertex on at most two edges, all of them connected): from
+    /// one of its ends, or round it when it is closed (`true`), from the
+    /// lowest vertex. A drawing whose steps came in any order and direction
+    /// is read back as the curve it is.
+    pub fn chain(&self) -> Option<(Vec<(u32, u32)>, bool)> {
+        if self.adj.iter().any(|a| a.len() > 2) || self.edges.is_empty() {
+            return None;
+        }
+        let ends = self.adj.iter().filter(|a| a.len() == 1).count();
+        let first = self
+            .adj
+            .iter()
+            .position(|a| a.len() == 1)
+            .or_else(|| self.adj.iter().position(|a| !a.is_empty()))?;
+        let mut used = vec![false; self.edges.len()];
+        let mut walk = Vec::with_capacity(self.edges.len());
+        let mut at = first as u32;
+        while let Some(&(to, e)) = self.adj[at as usize]
+            .iter()
+            .find(|(_, e)| !used[*e as usize])
+        {
+            used[e as usize] = true;
+            walk.push((at, to));
+            at = to;
+        }
+        (walk.len() == self.edges.len()).then_some((walk, ends == 0))
+    }
+
+    /// Whether one stroke can draw every edge once (an Euler trail): the
+    /// edges are connected and at most two vertices have an odd number.
+    pub fn one_stroke(&self) -> bool {
+        let odd = self.adj.iter().filter(|a| a.len() % 2 == 1).count();
+        let Some(first) = self.adj.iter().position(|a| !a.is_empty()) else {
+            return false;
+        };
+        let mut seen = vec![false; self.points.len()];
+        let mut stack = vec![first];
+        seen[first] = true;
+        let mut reached = 0;
+        while let Some(v) = stack.pop() {
+            reached += self.adj[v].len();
+            for &(nb, _) in &self.adj[v] {
+                if !seen[nb as usize] {
+                    seen[nb as usize] = true;
+                    stack.push(nb as usize);
+                }
+            }
+        }
+        odd <= 2 && reached == 2 * self.edges.len()
+    }
+
     /// The drawing's diagonal, user units.
     pub fn diagonal(&self) -> f64 {
         let (lo, hi) = self.points.iter().fold(
@@ -173,7 +225,7 @@ fn snap_tolerance(ends: &[DVec2], unit: f64) -> f64 {
     if near.is_empty() {
         return 0.05 * unit;
     }
-    let floor = 1e-9 * unit;
+    let floor = 1e-4 * unit;
     let mut best: Option<(f64, f64)> = None;
     for w in near.windows(2) {
         let ratio = w[1].max(floor) / w[0].max(floor);
@@ -335,6 +387,17 @@ fn pieces(segs: &[(u32, u32)], points: &[DVec2], tol: f64, unit: f64) -> Vec<(u3
                 let p = points[v as usize];
                 let t = (p - pa).dot(d) / len2;
                 if t * len <= tol || (1.0 - t) * len <= tol {
+                    continue;
+                }
+                // A stroke that starts or touches mid-segment does so a
+                // whole number of steps along it (a vertex merely near a
+                // segment, as turns by small angles bring them, does not).
+                let along = t * len / unit;
+                let rest = len / unit - along;
+                if along.round() < 1.0
+                    || rest.round() < 1.0
+                    || (along - along.round()).abs() > WHOLE
+                {
                     continue;
                 }
                 if (pa + d * t).distance(p) <= tol {

@@ -14,6 +14,7 @@
 //! drawing, or a line drawing no grammar explains within the budget). Must
 //! not print or write files (the CLI does), and must not panic on any input.
 
+pub mod blocks;
 pub mod emit;
 pub mod grammar;
 pub mod graph;

@@ -21,7 +21,9 @@
 //! candidate (`grammar::matches`, the library's redraw).
 
 use super::graph::Graph;
+use super::{blocks, turtle};
 use glam::DVec2;
+use std::ops::RangeInclusive;
 use std::time::Instant;
 
 /// A symbol of a successor being guessed.
@@ -954,16 +956,16 @@ impl Shared<'_> {
     }
 
     /// The smallest grammar, with the fewest letters, that a start and a
-    /// bound give at any depth from `n_max` down.
+    /// bound give at any of the depths, the deepest first.
     fn best_of(
         &mut self,
         start: (u32, u32),
         bound: usize,
-        n_max: u32,
+        depths: RangeInclusive<u32>,
         order: Option<&[(u32, u32)]>,
     ) -> Option<Found> {
         let mut found: Vec<Found> = Vec::new();
-        for depth in (2..=n_max).rev() {
+        for depth in depths.rev() {
             if self.exhausted() {
                 break;
             }
@@ -1010,6 +1012,16 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
     // that came in order but is not explained should not take the second's.
     shared.spent = 0;
     let n_max = n_of(g.edges.len());
+    if let Some((chain, closed)) = g.chain() {
+        // One curve: its steps in order, from where its turns' blocks say
+        // it starts.
+        if let Some(found) = along_chain(&mut shared, &chain, closed, n_max) {
+            return Some(found);
+        }
+        if shared.exhausted() {
+            return None;
+        }
+    }
     let starts = starts(g);
     // A curve's ends (a plant's root among its tips) are where a drawing
     // most likely starts: every bound is tried from each of them before
@@ -1026,11 +1038,28 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
     for b in BOUNDS {
         plan.extend(starts[ends..].iter().map(|&start| (b, start)));
     }
-    for (bound, start) in plan {
+    // A drawing one stroke can draw is tried as one first (brackets
+    // multiply the choices); then, with its own count of work, with
+    // brackets when the drawing branches.
+    let bracketed = shared.limits.brackets;
+    if bracketed && g.one_stroke() {
+        shared.limits.brackets = false;
+        if let Some(found) = over_graph(&mut shared, &plan, n_max) {
+            return Some(found);
+        }
+        shared.limits.brackets = true;
+        shared.spent = 0;
+    }
+    over_graph(&mut shared, &plan, n_max)
+}
+
+/// The search over the graph alone, start by start and bound by bound.
+fn over_graph(shared: &mut Shared, plan: &[(usize, (u32, u32))], n_max: u32) -> Option<Found> {
+    for &(bound, start) in plan {
         if shared.exhausted() {
             return None;
         }
-        if let Some(best) = shared.best_of(start, bound, n_max, None) {
+        if let Some(best) = shared.best_of(start, bound, 2..=n_max, None) {
             return Some(best);
         }
     }
@@ -1050,9 +1079,15 @@ fn in_order(shared: &mut Shared, n_max: u32) -> Option<Found> {
 }
 
 fn in_order_from(shared: &mut Shared, n_max: u32) -> Option<Found> {
+    let order = shared.g.order.clone();
+    along(shared, 2..=n_max, &order)
+}
+
+/// The search that follows `order`, forwards and backwards, bound by bound.
+fn along(shared: &mut Shared, depths: RangeInclusive<u32>, order: &[(u32, u32)]) -> Option<Found> {
     let g = shared.g;
-    let forwards = g.order.clone();
-    let backwards: Vec<(u32, u32)> = g.order.iter().rev().map(|&(a, b)| (b, a)).collect();
+    let forwards = order.to_vec();
+    let backwards: Vec<(u32, u32)> = order.iter().rev().map(|&(a, b)| (b, a)).collect();
     for bound in BOUNDS {
         for order in [&forwards, &backwards] {
             let &(from, to) = order.first()?;
@@ -1060,12 +1095,60 @@ fn in_order_from(shared: &mut Shared, n_max: u32) -> Option<Found> {
             if shared.exhausted() {
                 return None;
             }
-            if let Some(best) = shared.best_of((from, e), bound, n_max, Some(order)) {
+            if let Some(best) = shared.best_of((from, e), bound, depths.clone(), Some(order)) {
                 return Some(best);
             }
         }
     }
     None
+}
+
+/// The search along a curve (every vertex on at most two edges) whose
+/// steps came in any order: from the starts and at the depths its turns'
+/// blocks give (`blocks`), each read forwards and backwards, with one
+/// letter; an open curve is then read from each end at every depth, with
+/// every letter the limits allow.
+fn along_chain(
+    shared: &mut Shared,
+    chain: &[(u32, u32)],
+    closed: bool,
+    n_max: u32,
+) -> Option<Found> {
+    let g = shared.g;
+    let delta = shared.delta;
+    let dir = |&(a, b): &(u32, u32)| g.edge(a, b).map_or(0.0, |e| g.direction(e, a));
+    let turns: Vec<i32> = (0..chain.len())
+        .map(|i| {
+            if i == 0 && !closed {
+                return 0;
+            }
+            let prev = chain[(i + chain.len() - 1) % chain.len()];
+            let d = (dir(&chain[i]) - dir(&prev)).to_degrees();
+            (turtle::wrap_degrees(d) / delta).round() as i32
+        })
+        .collect();
+    let max_block = shared.limits.rule;
+    let starts = blocks::starts(&turns, closed, max_block, shared.limits.axiom);
+    for s in &starts {
+        if shared.exhausted() {
+            return None;
+        }
+        let mut order = chain[s.at..].to_vec();
+        order.extend_from_slice(&chain[..s.at]);
+        let depth = s.depth.max(2);
+        // Blocks that turn alike are one letter's successor.
+        let letters = shared.limits.letters;
+        shared.limits.letters = 1;
+        let f = along(shared, depth..=depth, &order);
+        shared.limits.letters = letters;
+        if f.is_some() {
+            return f;
+        }
+    }
+    if closed {
+        return None;
+    }
+    along(shared, 2..=n_max, chain)
 }
 
 /// The most unit edges a drawing may have for this search (its work limit

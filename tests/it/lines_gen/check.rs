@@ -266,7 +266,12 @@ pub fn check(case: &Case, variant: Variant, budget: Option<Duration>) -> Outcome
         };
     }
     let (missing, extra) = compare(next, &drawn.1, step);
-    if missing + extra > 0 {
+    // A drawing whose steps came in any order and direction no longer says
+    // where it starts: a grammar that reads it from another end or corner
+    // predicts the next level up to where that is drawn (a rigid motion,
+    // or a mirror image, of it).
+    let lost_start = variant == Variant::Shuffled;
+    if missing + extra > 0 && !(lost_start && congruent(next, &drawn.1, step)) {
         // The next level, placed as the program's level n best fits the
         // drawing's.
         let (truth, ours) = (unit_steps(level, step), unit_steps(&drawn.0, step));
@@ -289,6 +294,49 @@ pub fn check(case: &Case, variant: Variant, budget: Option<Duration>) -> Outcome
         found: Some(found.describe),
         text: Some(found.text),
     }
+}
+
+/// Whether a rigid motion, or one with a mirror, puts `drawn` onto `truth`
+/// as sets of steps: `drawn`'s first step onto any step of `truth`, either
+/// way round, tried on a sample of steps first.
+fn congruent(truth: &[(DVec2, DVec2)], drawn: &[(DVec2, DVec2)], step: f64) -> bool {
+    let (a, b) = (unit_steps(truth, step), unit_steps(drawn, step));
+    let Some(&(p, q)) = b.first() else {
+        return false;
+    };
+    if a.len() != b.len() {
+        return false;
+    }
+    let sample: Segs = b.iter().step_by((b.len() / 16).max(1)).copied().collect();
+    let tol = TOLERANCE * step;
+    let fits = |moved: &Segs| {
+        pairs_within(moved, &a, step, tol)
+            .iter()
+            .all(Option::is_some)
+    };
+    let u = (q - p).normalize_or_zero();
+    for &(s, t) in &a {
+        for (s, t) in [(s, t), (t, s)] {
+            let v = (t - s).normalize_or_zero();
+            for mirror in [false, true] {
+                // z ↦ s + R(z − p), R turning u onto v (after a mirror
+                // about u's line).
+                let motion = |z: DVec2| {
+                    let d = z - p;
+                    let d = if mirror { 2.0 * d.dot(u) * u - d } else { d };
+                    let (c, sn) = (u.dot(v), u.perp_dot(v));
+                    s + DVec2::new(c * d.x - sn * d.y, sn * d.x + c * d.y)
+                };
+                let apply = |segs: &Segs| -> Segs {
+                    segs.iter().map(|&(x, y)| (motion(x), motion(y))).collect()
+                };
+                if fits(&apply(&sample)) && fits(&apply(&b)) {
+                    return true;
+                }
+            }
+        }
+    }
+    false
 }
 
 fn segments(lines: &[Vec<DVec2>]) -> Vec<(DVec2, DVec2)> {
