@@ -123,6 +123,11 @@ impl Graph {
     /// edges are connected and at most two vertices have an odd number.
     pub fn one_stroke(&self) -> bool {
         let odd = self.adj.iter().filter(|a| a.len() % 2 == 1).count();
+        odd <= 2 && self.connected()
+    }
+
+    /// Whether every edge can be reached from every other.
+    pub fn connected(&self) -> bool {
         let Some(first) = self.adj.iter().position(|a| !a.is_empty()) else {
             return false;
         };
@@ -139,7 +144,7 @@ impl Graph {
                 }
             }
         }
-        odd <= 2 && reached == 2 * self.edges.len()
+        reached == 2 * self.edges.len()
     }
 
     /// The drawing's diagonal, user units.

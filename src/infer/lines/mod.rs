@@ -23,6 +23,7 @@ pub mod search;
 pub mod synth;
 pub mod turtle;
 pub mod verify;
+pub mod walk;
 
 use crate::ast::{Expr, Module};
 use crate::infer::program::{nice, sym};
@@ -133,87 +134,43 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
         }
     };
     let read_ms = ms(start);
-    let mut why = String::new();
-    let mut steps = 0;
-    // The size of the drawing's own turtle string (at the first reading).
-    let mut drawing_size = 0;
-    let mut timed_out = false;
-    let mut stats = Stats {
-        read_ms,
-        ..Stats::default()
+    let mut tried = Tried {
+        stats: Stats {
+            read_ms,
+            ..Stats::default()
+        },
+        ..Tried::default()
     };
-    // Steps as long as the shortest segment, or half as long (a drawing
-    // whose steps all come in pairs, such as F -> FF plants).
-    for split in [1, 2] {
-        if late() {
-            timed_out = true;
-            break;
-        }
-        let reading = match read::reading(&lines, split) {
-            Ok(r) => r,
-            Err(e) => {
-                if why.is_empty() {
-                    why = match e {
-                        NotLines::Steps(w) => w,
-                        NotLines::Shapes(w) => w.to_string(),
-                    };
-                }
-                continue;
-            }
-        };
-        if steps == 0 {
-            steps = reading.steps;
-            drawing_size = drawing_symbols(&reading);
-        }
-        stats.steps = reading.steps;
-        stats.angle = reading.angles.delta;
-        let t = Instant::now();
-        let limits = search::Limits {
-            deadline,
-            ..opts.limits
-        };
-        let proposals = search::propose(&reading.tree, &reading.angles, &limits);
-        timed_out |= proposals.timed_out;
-        stats.candidates += proposals.grammars.len();
-        let work = 64 * reading.tree.nodes.len() as u64 + 100_000;
-        let mut verified = 0;
-        for g in proposals.grammars {
-            if late() {
-                timed_out = true;
-                break;
-            }
-            if !explains(&g, drawing_size) {
-                continue;
-            }
-            stats.compared += 1;
-            if grammar::matches(&g, &reading.tree, &reading.angles, work, deadline) != Outcome::Same
-            {
-                continue;
-            }
-            // The library's redraw is the costly check: a few per reading.
-            verified += 1;
-            if verified > MAX_REDRAWS {
-                break;
-            }
-            stats.search_ms += ms(t);
-            let tv = Instant::now();
-            if let Some(found) = finish(&g, &reading, name, work, 0.0) {
-                stats.verify_ms = ms(tv);
-                stats.rules = g.letters.iter().filter(|l| l.rule.is_some()).count();
-                stats.rule_symbols = g.rule_size();
-                stats.depth = g.depth;
-                let (file, text, redraw) = found;
-                return Lines::Found(Box::new(Inferred {
-                    grammar: g,
-                    file,
-                    text,
-                    redraw,
-                    stats,
-                }));
-            }
-        }
-        stats.search_ms += ms(t);
+    if let Some(found) = by_reading(&lines, name, opts, deadline, &mut tried) {
+        return Lines::Found(found);
     }
+    // A branching drawing whose steps came in any order: read again as the
+    // walks a turtle could have drawn it in, from its likeliest roots.
+    if !late()
+        && let Ok(g) = graph::build(&lines, 1)
+    {
+        for walk in walk::trees(&g) {
+            if late() {
+                tried.timed_out = true;
+                break;
+            }
+            let mut again = Tried {
+                stats: tried.stats.clone(),
+                ..Tried::default()
+            };
+            if let Some(found) = by_reading(&walk, name, opts, deadline, &mut again) {
+                return Lines::Found(found);
+            }
+            tried.stats = again.stats;
+            tried.timed_out |= again.timed_out;
+        }
+    }
+    let Tried {
+        mut why,
+        steps,
+        mut timed_out,
+        mut stats,
+    } = tried;
     // The drawing as a set of segments: a grammar that draws each once,
     // whatever the order, direction and splitting of its paths.
     let t = Instant::now();
@@ -233,6 +190,104 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
         timed_out,
         stats,
     }
+}
+
+/// What the readings of a drawing came to when no grammar explained it.
+#[derive(Default)]
+struct Tried {
+    why: String,
+    /// Drawn steps at the first reading (0: no reading).
+    steps: usize,
+    timed_out: bool,
+    stats: Stats,
+}
+
+/// The drawing read as turtle steps in its paths' order (steps as long as
+/// the shortest segment, then half as long) and the grammars the search
+/// proposes for it, each matched step by step and redrawn.
+fn by_reading(
+    lines: &[Vec<DVec2>],
+    name: &str,
+    opts: &Options,
+    deadline: Option<Instant>,
+    tried: &mut Tried,
+) -> Option<Box<Inferred>> {
+    let late = || deadline.is_some_and(|d| Instant::now() >= d);
+    // The size of the drawing's own turtle string (at the first reading).
+    let mut drawing_size = 0;
+    // Steps as long as the shortest segment, or half as long (a drawing
+    // whose steps all come in pairs, such as F -> FF plants).
+    for split in [1, 2] {
+        if late() {
+            tried.timed_out = true;
+            break;
+        }
+        let reading = match read::reading(lines, split) {
+            Ok(r) => r,
+            Err(e) => {
+                if tried.why.is_empty() {
+                    tried.why = match e {
+                        NotLines::Steps(w) => w,
+                        NotLines::Shapes(w) => w.to_string(),
+                    };
+                }
+                continue;
+            }
+        };
+        if tried.steps == 0 {
+            tried.steps = reading.steps;
+            drawing_size = drawing_symbols(&reading);
+        }
+        tried.stats.steps = reading.steps;
+        tried.stats.angle = reading.angles.delta;
+        let t = Instant::now();
+        let limits = search::Limits {
+            deadline,
+            ..opts.limits
+        };
+        let proposals = search::propose(&reading.tree, &reading.angles, &limits);
+        tried.timed_out |= proposals.timed_out;
+        tried.stats.candidates += proposals.grammars.len();
+        let work = 64 * reading.tree.nodes.len() as u64 + 100_000;
+        let mut verified = 0;
+        for g in proposals.grammars {
+            if late() {
+                tried.timed_out = true;
+                break;
+            }
+            if !explains(&g, drawing_size) {
+                continue;
+            }
+            tried.stats.compared += 1;
+            if grammar::matches(&g, &reading.tree, &reading.angles, work, deadline) != Outcome::Same
+            {
+                continue;
+            }
+            // The library's redraw is the costly check: a few per reading.
+            verified += 1;
+            if verified > MAX_REDRAWS {
+                break;
+            }
+            tried.stats.search_ms += ms(t);
+            let tv = Instant::now();
+            if let Some(found) = finish(&g, &reading, name, work, 0.0) {
+                tried.stats.verify_ms = ms(tv);
+                tried.stats.rules = g.letters.iter().filter(|l| l.rule.is_some()).count();
+                tried.stats.rule_symbols = g.rule_size();
+                tried.stats.depth = g.depth;
+                let (file, text, redraw) = found;
+                return Some(Box::new(Inferred {
+                    grammar: g,
+                    file,
+                    text,
+                    redraw,
+                    stats: tried.stats.clone(),
+                }));
+            }
+        }
+        tried.stats.search_ms += ms(t);
+    }
+    None
 }
 
 /// A grammar that draws every segment of the drawing's stroke graph once
