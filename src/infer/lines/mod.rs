@@ -315,7 +315,7 @@ fn from_graph(
             brackets: branches,
             ..*opts
         };
-        let Some(found) = synth::search(&g, &limits).map(synth::Found::squared) else {
+        let Some(found) = synth::search(&g, &limits).map(|f| f.squared().unfolded()) else {
             continue;
         };
         stats.candidates += 1;
@@ -561,9 +561,12 @@ fn finish(
     let check = |settings: &emit::Settings| {
         let draft = crate::fmt::format_file(&emit::program(g, settings));
         verify::redraw(&draft, &r.segments, r.step).filter(|d| {
-            // Within 10⁻³ of the diagonal, or of the drawing's own noise
-            // (its points' spread about their vertices) when larger.
-            let limit = (1e-3f64).max(2.0 * noise * r.step / d.diagonal.max(1e-300));
+            // Within 10⁻³ of the diagonal, or of four times the drawing's
+            // own noise (its points' spread about their vertices, its
+            // steps' about their length) when larger: the grammar has
+            // matched the drawing step by step already, this checks where
+            // the program puts it.
+            let limit = (1e-3f64).max(4.0 * noise * r.step / d.diagonal.max(1e-300));
             d.drawn == d.steps && d.relative() <= limit
         })
     };

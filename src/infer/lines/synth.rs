@@ -128,6 +128,57 @@ impl Found {
     }
 }
 
+impl Found {
+    /// A letter that only the axiom names (`F -> G+` with axiom `FFFF`)
+    /// is rewritten there once: the axiom becomes its first derivation
+    /// (`G+G+G+G+`) at one step less, which draws the same with one letter
+    /// less, as a person writes it.
+    pub fn unfolded(mut self) -> Found {
+        let named_in_rules =
+            |rules: &[Vec<Sym>], k: u8| rules.iter().flatten().any(|s| *s == Sym::Letter(k));
+        while self.depth > 1 && self.rules.len() > 1 {
+            let axiom_only = (0..self.rules.len() as u8)
+                .find(|&k| self.axiom.contains(&Sym::Letter(k)) && !named_in_rules(&self.rules, k));
+            let Some(k) = axiom_only else {
+                break;
+            };
+            if self.axiom.contains(&Sym::Unnamed)
+                || self.rules.iter().flatten().any(|s| *s == Sym::Unnamed)
+            {
+                break;
+            }
+            let mut axiom = Vec::new();
+            for s in &self.axiom {
+                match s {
+                    Sym::Letter(j) => axiom.extend_from_slice(&self.rules[*j as usize]),
+                    other => axiom.push(*other),
+                }
+            }
+            if axiom.contains(&Sym::Letter(k)) {
+                break;
+            }
+            // Letter k is gone: the letters after it move down one.
+            let down = |s: &Sym| match *s {
+                Sym::Letter(j) if j > k => Sym::Letter(j - 1),
+                other => other,
+            };
+            // Turns after the axiom's last letter draw nothing.
+            while matches!(axiom.last(), Some(Sym::Turn(_))) {
+                axiom.pop();
+            }
+            self.axiom = axiom.iter().map(down).collect();
+            self.rules.remove(k as usize);
+            self.rules = self
+                .rules
+                .iter()
+                .map(|r| r.iter().map(down).collect())
+                .collect();
+            self.depth -= 1;
+        }
+        self
+    }
+}
+
 /// How far a search goes.
 #[derive(Clone, Copy, Debug)]
 pub struct Limits {
@@ -1241,6 +1292,22 @@ mod tests {
             ..Limits::default()
         };
         search(&g, &limits)
+    }
+
+    #[test]
+    fn a_letter_only_the_axiom_names_is_unfolded() {
+        use Sym::{Letter as L, Turn as T};
+        let f = Found {
+            axiom: vec![L(0), L(0), L(0), L(0)],
+            rules: vec![vec![L(1), T(1)], vec![L(1), T(-1), L(1), L(1), T(1), L(1)]],
+            depth: 4,
+            delta: 90.0,
+            walk: Vec::new(),
+        }
+        .unfolded();
+        assert_eq!(f.depth, 3);
+        assert_eq!(f.axiom, vec![L(0), T(1), L(0), T(1), L(0), T(1), L(0)]);
+        assert_eq!(f.rules, vec![vec![L(0), T(-1), L(0), L(0), T(1), L(0)]]);
     }
 
     #[test]
