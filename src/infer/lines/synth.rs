@@ -1121,6 +1121,13 @@ fn over_graph(shared: &mut Shared, plan: &[(usize, (u32, u32))], n_max: u32) -> 
 /// by bound.
 fn in_order(shared: &mut Shared, n_max: u32) -> Option<Found> {
     let g = shared.g;
+    // Steps that do not start where the last ended: a turtle's order has
+    // one per branch at most (a plant's are fewer than half its steps);
+    // more say that the paths came in another order.
+    let jumps = g.order.windows(2).filter(|w| w[0].1 != w[1].0).count();
+    if 2 * jumps > g.order.len() {
+        return None;
+    }
     // A drawing in one stroke needs no branches.
     let saved = shared.limits.brackets;
     shared.limits.brackets &= g.order.windows(2).any(|w| w[0].1 != w[1].0);
