@@ -56,7 +56,11 @@ fn exact(dir: &std::path::Path, file: &str, step: f64, tolerance: f64) -> Result
         return Err(format!("at n: {at_n:?} (missing, extra)\n{text}"));
     }
     let at_next = check::compare_within(&segments(&next), &more, step, tolerance);
-    if at_next != (0, 0) {
+    // Steps in any order and direction no longer say where the drawing
+    // starts: the next level counts up to where it is drawn (see
+    // docs/inference.md, "Variants").
+    let lost_start = file.ends_with("-shuffled");
+    if at_next != (0, 0) && !(lost_start && check::congruent(&segments(&next), &more, step)) {
         return Err(format!("next level: {at_next:?} (missing, extra)\n{text}"));
     }
     Ok(())

@@ -299,7 +299,7 @@ pub fn check(case: &Case, variant: Variant, budget: Option<Duration>) -> Outcome
 /// Whether a rigid motion, or one with a mirror, puts `drawn` onto `truth`
 /// as sets of steps: `drawn`'s first step onto any step of `truth`, either
 /// way round, tried on a sample of steps first.
-fn congruent(truth: &[(DVec2, DVec2)], drawn: &[(DVec2, DVec2)], step: f64) -> bool {
+pub fn congruent(truth: &[(DVec2, DVec2)], drawn: &[(DVec2, DVec2)], step: f64) -> bool {
     let (a, b) = (unit_steps(truth, step), unit_steps(drawn, step));
     let Some(&(p, q)) = b.first() else {
         return false;
@@ -307,30 +307,44 @@ fn congruent(truth: &[(DVec2, DVec2)], drawn: &[(DVec2, DVec2)], step: f64) -> b
     if a.len() != b.len() {
         return false;
     }
-    let sample: Segs = b.iter().step_by((b.len() / 16).max(1)).copied().collect();
+    // Steps of `a` by the cell of their midpoint.
+    let key = |m: DVec2| ((m.x / step).floor() as i64, (m.y / step).floor() as i64);
+    let mut cells: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    for (i, s) in a.iter().enumerate() {
+        cells.entry(key((s.0 + s.1) / 2.0)).or_default().push(i);
+    }
     let tol = TOLERANCE * step;
-    let fits = |moved: &Segs| {
-        pairs_within(moved, &a, step, tol)
-            .iter()
-            .all(Option::is_some)
+    let has = |x: DVec2, y: DVec2| {
+        let (cx, cy) = key((x + y) / 2.0);
+        (-1..=1).any(|dx| {
+            (-1..=1).any(|dy| {
+                cells.get(&(cx + dx, cy + dy)).is_some_and(|v| {
+                    v.iter().any(|&i| {
+                        let t = a[i];
+                        (t.0.distance(x) <= tol && t.1.distance(y) <= tol)
+                            || (t.0.distance(y) <= tol && t.1.distance(x) <= tol)
+                    })
+                })
+            })
+        })
     };
+    let sample: Segs = b.iter().step_by((b.len() / 16).max(1)).copied().collect();
     let u = (q - p).normalize_or_zero();
     for &(s, t) in &a {
         for (s, t) in [(s, t), (t, s)] {
             let v = (t - s).normalize_or_zero();
+            let (c, sn) = (u.dot(v), u.perp_dot(v));
             for mirror in [false, true] {
                 // z ↦ s + R(z − p), R turning u onto v (after a mirror
                 // about u's line).
                 let motion = |z: DVec2| {
                     let d = z - p;
                     let d = if mirror { 2.0 * d.dot(u) * u - d } else { d };
-                    let (c, sn) = (u.dot(v), u.perp_dot(v));
                     s + DVec2::new(c * d.x - sn * d.y, sn * d.x + c * d.y)
                 };
-                let apply = |segs: &Segs| -> Segs {
-                    segs.iter().map(|&(x, y)| (motion(x), motion(y))).collect()
-                };
-                if fits(&apply(&sample)) && fits(&apply(&b)) {
+                let fits =
+                    |segs: &[(DVec2, DVec2)]| segs.iter().all(|&(x, y)| has(motion(x), motion(y)));
+                if fits(&sample) && fits(&b) {
                     return true;
                 }
             }
