@@ -18,6 +18,7 @@ pub mod blocks;
 pub mod emit;
 pub mod grammar;
 pub mod graph;
+pub mod ideal;
 pub mod read;
 pub mod search;
 pub mod synth;
@@ -141,29 +142,37 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
         },
         ..Tried::default()
     };
-    if let Some(found) = by_reading(&lines, name, opts, deadline, &mut tried) {
+    if let Some(found) = by_reading(&lines, name, opts, deadline, None, &mut tried) {
         return Lines::Found(found);
     }
+    let graph = graph::build(&lines, 1).ok();
     // A branching drawing whose steps came in any order: read again as the
-    // walks a turtle could have drawn it in, from its likeliest roots.
-    if !late()
-        && let Ok(g) = graph::build(&lines, 1)
-    {
-        for walk in walk::trees(&g) {
-            if late() {
-                tried.timed_out = true;
-                break;
-            }
-            let mut again = Tried {
-                stats: tried.stats.clone(),
-                ..Tried::default()
-            };
-            if let Some(found) = by_reading(&walk, name, opts, deadline, &mut again) {
-                return Lines::Found(found);
-            }
-            tried.stats = again.stats;
-            tried.timed_out |= again.timed_out;
+    // walks a turtle could have drawn it in, from its likeliest roots; a
+    // noisy one as the turtle meant it, checked against it as it is.
+    let mut again: Vec<(Vec<Vec<DVec2>>, Option<f64>)> = Vec::new();
+    if let Some(g) = &graph {
+        again.extend(walk::trees(g).into_iter().map(|w| (w, None)));
+        again.extend(ideal::redrawn(g).map(|w| (w, Some(g.noise))));
+    }
+    let as_drawn: Vec<(DVec2, DVec2)> = lines
+        .iter()
+        .flat_map(|l| l.windows(2).map(|w| (w[0], w[1])))
+        .collect();
+    for (walk, noise) in again {
+        if late() {
+            tried.timed_out = true;
+            break;
         }
+        let mut more = Tried {
+            stats: tried.stats.clone(),
+            ..Tried::default()
+        };
+        let truth = noise.map(|n| (&as_drawn[..], n));
+        if let Some(found) = by_reading(&walk, name, opts, deadline, truth, &mut more) {
+            return Lines::Found(found);
+        }
+        tried.stats = more.stats;
+        tried.timed_out |= more.timed_out;
     }
     let Tried {
         mut why,
@@ -204,12 +213,15 @@ struct Tried {
 
 /// The drawing read as turtle steps in its paths' order (steps as long as
 /// the shortest segment, then half as long) and the grammars the search
-/// proposes for it, each matched step by step and redrawn.
+/// proposes for it, each matched step by step and redrawn: against `lines`,
+/// or against `truth` (the drawing as it is, and its noise in steps) when
+/// `lines` is its redrawing.
 fn by_reading(
     lines: &[Vec<DVec2>],
     name: &str,
     opts: &Options,
     deadline: Option<Instant>,
+    truth: Option<(&[(DVec2, DVec2)], f64)>,
     tried: &mut Tried,
 ) -> Option<Box<Inferred>> {
     let late = || deadline.is_some_and(|d| Instant::now() >= d);
@@ -222,7 +234,7 @@ fn by_reading(
             tried.timed_out = true;
             break;
         }
-        let reading = match read::reading(lines, split) {
+        let mut reading = match read::reading(lines, split) {
             Ok(r) => r,
             Err(e) => {
                 if tried.why.is_empty() {
@@ -238,6 +250,10 @@ fn by_reading(
             tried.steps = reading.steps;
             drawing_size = drawing_symbols(&reading);
         }
+        let noise = truth.map_or(0.0, |(segments, noise)| {
+            reading.segments = segments.to_vec();
+            noise
+        });
         tried.stats.steps = reading.steps;
         tried.stats.angle = reading.angles.delta;
         let t = Instant::now();
@@ -270,7 +286,7 @@ fn by_reading(
             }
             tried.stats.search_ms += ms(t);
             let tv = Instant::now();
-            if let Some(found) = finish(&g, &reading, name, work, 0.0) {
+            if let Some(found) = finish(&g, &reading, name, work, noise) {
                 tried.stats.verify_ms = ms(tv);
                 tried.stats.rules = g.letters.iter().filter(|l| l.rule.is_some()).count();
                 tried.stats.rule_symbols = g.rule_size();

@@ -900,7 +900,7 @@ fn turn_range(delta: f64) -> Vec<i32> {
 /// The drawing's orientation when δ₀ is 360/m: the mean of its unit edges'
 /// directions, each taken m times round (so every multiple of δ₀ counts
 /// alike), radians.
-fn phase(g: &Graph, delta: f64) -> Option<f64> {
+pub(super) fn phase(g: &Graph, delta: f64) -> Option<f64> {
     let m = 360.0 / delta;
     if (m - m.round()).abs() > 1e-9 || m < 2.0 {
         return None;
@@ -914,7 +914,7 @@ fn phase(g: &Graph, delta: f64) -> Option<f64> {
 }
 
 /// δ₀ as the search uses it: 360/m when that is within a percent.
-fn working_delta(delta: f64) -> f64 {
+pub(super) fn working_delta(delta: f64) -> f64 {
     let m = (360.0 / delta).round();
     if m >= 2.0 && (360.0 / m - delta).abs() <= 0.01 * delta {
         360.0 / m
