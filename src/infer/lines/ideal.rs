@@ -8,9 +8,10 @@
 //! δ it turns. Walking the graph's steps in order, each from the ideal
 //! position of its start vertex (a vertex keeps the position it got first,
 //! so a branch starts where its parent passed), along the nearest allowed
-//! direction, gives the drawing those steps stand for; it is read and
-//! searched as a clean one, and the program found is then checked against
-//! the drawing as it is, within its measured noise.
+//! direction, gives the drawing those steps stand for, placed where it
+//! fits the drawing best; it is refused when a vertex of it lies more than
+//! half a step from the drawing's. It is read and searched as a clean
+//! drawing, and the program must draw it exactly.
 //!
 //! Owns: the redrawing. Must not search grammars.
 
@@ -24,35 +25,92 @@ use std::collections::HashMap;
 pub const NOISY: f64 = 0.005;
 
 /// The graph's steps in order, each turned to the nearest multiple of δ
-/// (from the drawing's own phase) and one step long, as polylines; `None`
-/// when the drawing is not noisy or has no δ that divides a full turn.
+/// (from the drawing's own phase) and one step long, as polylines, placed
+/// where they fit the drawing best (a similarity, least squares over the
+/// vertices); `None` when the drawing is not noisy, has no δ that divides a
+/// full turn, or when a vertex of the redrawing lies more than half a step
+/// from the drawing's (a step misread, or a drift).
 pub fn redrawn(g: &Graph) -> Option<Vec<Vec<DVec2>>> {
     if g.noise < NOISY || g.order.is_empty() {
         return None;
     }
-    let delta = 360.0 / f64::from(turns_round(g)?);
+    let m = turns_round(g)?;
+    let delta = 360.0 / f64::from(m);
     let phase = synth::phase(g, delta).unwrap_or(0.0);
     let d = delta.to_radians();
-    let snap = |a: f64| phase + ((a - phase) / d).round() * d;
-    let mut at: HashMap<u32, DVec2> = HashMap::new();
-    let mut out: Vec<Vec<DVec2>> = Vec::new();
+    // Each vertex in whole steps along multiples of δ from the first.
+    // (Vertices in the order first reached, so that the fit sums alike on
+    // every run.)
+    let mut index: HashMap<u32, usize> = HashMap::new();
+    let mut lattice: Vec<(u32, DVec2)> = Vec::new();
+    let mut place_at = |v: u32, l: DVec2| -> DVec2 {
+        let i = *index.entry(v).or_insert_with(|| {
+            lattice.push((v, l));
+            lattice.len() - 1
+        });
+        lattice[i].1
+    };
+    let mut polylines: Vec<Vec<u32>> = Vec::new();
     let mut last = u32::MAX;
+    let origin = g.points[g.order[0].0 as usize];
     for &(a, b) in &g.order {
         let e = g.edge(a, b)?;
-        let from = *at.entry(a).or_insert(g.points[a as usize]);
-        let dir = snap(g.direction(e, a));
-        let to = *at
-            .entry(b)
-            .or_insert(from + g.step * DVec2::new(dir.cos(), dir.sin()));
+        let from = place_at(a, (g.points[a as usize] - origin) / g.step);
+        let k = ((g.direction(e, a) - phase) / d).round();
+        place_at(b, from + DVec2::new((k * d).cos(), (k * d).sin()));
         if a != last {
-            out.push(vec![from]);
+            polylines.push(vec![a]);
         }
-        if let Some(l) = out.last_mut() {
-            l.push(to);
+        if let Some(l) = polylines.last_mut() {
+            l.push(b);
         }
         last = b;
     }
-    Some(out)
+    let pairs: Vec<(DVec2, DVec2)> = lattice
+        .iter()
+        .map(|&(v, l)| (l, g.points[v as usize]))
+        .collect();
+    let place = fit(&pairs)?;
+    let worst = pairs
+        .iter()
+        .map(|&(l, p)| place(l).distance(p))
+        .fold(0.0, f64::max);
+    if worst > 0.5 * g.step {
+        return None;
+    }
+    Some(
+        polylines
+            .iter()
+            .map(|l| l.iter().map(|v| place(lattice[index[v]].1)).collect())
+            .collect(),
+    )
+}
+
+/// The similarity z ↦ c + s·z (s a complex number: a turn and a scale)
+/// that puts the first of each pair nearest the second, least squares.
+fn fit(pairs: &[(DVec2, DVec2)]) -> Option<impl Fn(DVec2) -> DVec2> {
+    let n = pairs.len() as f64;
+    if n < 2.0 {
+        return None;
+    }
+    let (cz, cw) = pairs
+        .iter()
+        .fold((DVec2::ZERO, DVec2::ZERO), |(a, b), (z, w)| (a + *z, b + *w));
+    let (cz, cw) = (cz / n, cw / n);
+    let (mut num, mut den) = (DVec2::ZERO, 0.0);
+    for (z, w) in pairs {
+        let (z, w) = (*z - cz, *w - cw);
+        num += DVec2::new(w.x * z.x + w.y * z.y, w.y * z.x - w.x * z.y);
+        den += z.length_squared();
+    }
+    if den <= 0.0 {
+        return None;
+    }
+    let s = num / den;
+    Some(move |p: DVec2| {
+        let z = p - cz;
+        DVec2::new(s.x * z.x - s.y * z.y, s.x * z.y + s.y * z.x) + cw
+    })
 }
 
 /// The most steps of δ a full turn is tried at.

@@ -152,7 +152,7 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
     let mut again: Vec<(Vec<Vec<DVec2>>, Option<f64>)> = Vec::new();
     if let Some(g) = &graph {
         again.extend(walk::trees(g).into_iter().map(|w| (w, None)));
-        again.extend(ideal::redrawn(g).map(|w| (w, Some(g.noise))));
+        again.extend(ideal::redrawn(g).map(|w| (w, None)));
     }
     let as_drawn: Vec<(DVec2, DVec2)> = lines
         .iter()
@@ -577,12 +577,10 @@ fn finish(
     let check = |settings: &emit::Settings| {
         let draft = crate::fmt::format_file(&emit::program(g, settings));
         verify::redraw(&draft, &r.segments, r.step).filter(|d| {
-            // Within 10⁻³ of the diagonal, or of four times the drawing's
-            // own noise (its points' spread about their vertices, its
-            // steps' about their length) when larger: the grammar has
-            // matched the drawing step by step already, this checks where
-            // the program puts it.
-            let limit = (1e-3f64).max(4.0 * noise * r.step / d.diagonal.max(1e-300));
+            // Within 10⁻³ of the diagonal, or of the drawing's own noise
+            // (its points' spread about their vertices, its steps' about
+            // their length) when larger.
+            let limit = (1e-3f64).max(2.0 * noise * r.step / d.diagonal.max(1e-300));
             d.drawn == d.steps && d.relative() <= limit
         })
     };
