@@ -95,7 +95,9 @@ fn fit(pairs: &[(DVec2, DVec2)]) -> Option<impl Fn(DVec2) -> DVec2> {
     }
     let (cz, cw) = pairs
         .iter()
-        .fold((DVec2::ZERO, DVec2::ZERO), |(a, b), (z, w)| (a + *z, b + *w));
+        .fold((DVec2::ZERO, DVec2::ZERO), |(a, b), (z, w)| {
+            (a + *z, b + *w)
+        });
     let (cz, cw) = (cz / n, cw / n);
     let (mut num, mut den) = (DVec2::ZERO, 0.0);
     for (z, w) in pairs {

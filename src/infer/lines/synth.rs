@@ -1066,7 +1066,9 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
     if let Some((chain, closed)) = g.chain() {
         // One curve: its steps in order, from where its turns' blocks say
         // it starts.
-        if let Some(found) = along_chain(&mut shared, &chain, closed, n_max) {
+        // An open curve drawn in one stroke was followed as drawn already.
+        let followed = g.order.len() == chain.len() && g.order.windows(2).all(|w| w[0].1 == w[1].0);
+        if let Some(found) = along_chain(&mut shared, &chain, closed, n_max, followed) {
             return Some(found);
         }
         if shared.exhausted() {
@@ -1165,12 +1167,14 @@ fn along(shared: &mut Shared, depths: RangeInclusive<u32>, order: &[(u32, u32)])
 /// steps came in any order: from the starts and at the depths its turns'
 /// blocks give (`blocks`), each read forwards and backwards, with one
 /// letter; an open curve is then read from each end at every depth, with
-/// every letter the limits allow.
+/// every letter the limits allow, unless it was `followed` so already (its
+/// paths drew it in one stroke).
 fn along_chain(
     shared: &mut Shared,
     chain: &[(u32, u32)],
     closed: bool,
     n_max: u32,
+    followed: bool,
 ) -> Option<Found> {
     let g = shared.g;
     let delta = shared.delta;
@@ -1203,7 +1207,7 @@ fn along_chain(
             return f;
         }
     }
-    if closed {
+    if closed || followed {
         return None;
     }
     along(shared, 2..=n_max, chain)
