@@ -158,6 +158,8 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
         .iter()
         .flat_map(|l| l.windows(2).map(|w| (w[0], w[1])))
         .collect();
+    // Together they may take half the budget, each an equal share.
+    let share = opts.budget / (2 * again.len().max(1)) as u32;
     for (walk, noise) in again {
         if late() {
             tried.timed_out = true;
@@ -168,7 +170,10 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
             ..Tried::default()
         };
         let truth = noise.map(|n| (&as_drawn[..], n));
-        if let Some(found) = by_reading(&walk, name, opts, deadline, truth, &mut more) {
+        let until = Instant::now()
+            .checked_add(share)
+            .map_or(deadline, |t| Some(deadline.map_or(t, |d| d.min(t))));
+        if let Some(found) = by_reading(&walk, name, opts, until, truth, &mut more) {
             return Lines::Found(found);
         }
         tried.stats = more.stats;
@@ -327,8 +332,15 @@ fn from_graph(
         };
         let branches =
             g.adj.iter().any(|a| a.len() > 2) || g.adj.iter().filter(|a| a.len() == 1).count() > 2;
+        // Half steps are the rarer reading: a quarter of the work.
+        let total = if split == 1 {
+            opts.total
+        } else {
+            opts.total / 4
+        };
         let limits = synth::Limits {
             brackets: branches,
+            total,
             ..*opts
         };
         let Some(found) = synth::search(&g, &limits).map(|f| f.squared().unfolded()) else {
