@@ -323,6 +323,7 @@ fn from_graph(
 ) -> Result<Box<Inferred>, bool> {
     let deadline = opts.deadline;
     let late = || deadline.is_some_and(|d| Instant::now() >= d);
+    let mut noisy = false;
     for split in [1, 2] {
         if late() {
             return Err(true);
@@ -332,15 +333,14 @@ fn from_graph(
         };
         let branches =
             g.adj.iter().any(|a| a.len() > 2) || g.adj.iter().filter(|a| a.len() == 1).count() > 2;
-        // Half steps are the rarer reading: a quarter of the work.
-        let total = if split == 1 {
-            opts.total
-        } else {
-            opts.total / 4
-        };
+        // Half steps of a noisy drawing are noise.
+        if split == 1 {
+            noisy = g.noise >= ideal::NOISY;
+        } else if noisy {
+            continue;
+        }
         let limits = synth::Limits {
             brackets: branches,
-            total,
             ..*opts
         };
         let Some(found) = synth::search(&g, &limits).map(|f| f.squared().unfolded()) else {

@@ -1123,11 +1123,19 @@ fn over_graph(shared: &mut Shared, plan: &[(usize, (u32, u32))], n_max: u32) -> 
 /// by bound.
 fn in_order(shared: &mut Shared, n_max: u32) -> Option<Found> {
     let g = shared.g;
-    // Steps that do not start where the last ended: a turtle's order has
-    // one per branch at most (a plant's are fewer than half its steps);
-    // more say that the paths came in another order.
-    let jumps = g.order.windows(2).filter(|w| w[0].1 != w[1].0).count();
-    if 2 * jumps > g.order.len() {
+    // Steps that start away from everything drawn before: a turtle's
+    // branches start where it has been, so only moves do; more than half
+    // say that the paths came in another order.
+    let mut seen = vec![false; g.points.len()];
+    let mut strays = 0;
+    for (i, &(a, b)) in g.order.iter().enumerate() {
+        if i > 0 && !seen[a as usize] {
+            strays += 1;
+        }
+        seen[a as usize] = true;
+        seen[b as usize] = true;
+    }
+    if 2 * strays > g.order.len() {
         return None;
     }
     // A drawing in one stroke needs no branches.
