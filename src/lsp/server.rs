@@ -404,12 +404,12 @@ impl<W: Write> Server<W> {
             }
             req::Formatting::METHOD => self.on::<req::Formatting>(r, |s, p| {
                 let a = s.doc(&p.text_document.uri)?;
-                Ok(format::format(&a.text))
+                Ok(format::format(a))
             }),
             req::RangeFormatting::METHOD => self.on::<req::RangeFormatting>(r, |s, p| {
                 let a = s.doc(&p.text_document.uri)?;
                 let range = a.lines.span(&a.text, p.range);
-                Ok(format::format_range(&a.text, range))
+                Ok(format::format_range(a, range))
             }),
             req::CodeActionRequest::METHOD => self.on::<req::CodeActionRequest>(r, |s, p| {
                 let a = s.doc(&p.text_document.uri)?;
