@@ -17,7 +17,8 @@ pub enum LexError {
     Unexpected,
     UnterminatedComment,
     UnterminatedString,
-    InvalidEscape(usize),
+    /// The escape's start and end: `\` and the character after it, whole.
+    InvalidEscape(usize, usize),
     NumberOutOfRange,
 }
 
@@ -206,8 +207,9 @@ fn string(lex: &mut logos::Lexer<Token>) -> Result<String, LexError> {
                 Some((_, '\\')) => out.push('\\'),
                 Some((_, 'n')) => out.push('\n'),
                 Some((_, 't')) => out.push('\t'),
-                Some((j, _)) => {
+                Some((j, escaped)) => {
                     let at = lex.span().end + i;
+                    let end = at + 1 + escaped.len_utf8();
                     lex.bump(j);
                     // Skip to the closing quote so one bad escape is one error.
                     let tail = lex.remainder();
@@ -215,7 +217,7 @@ fn string(lex: &mut logos::Lexer<Token>) -> Result<String, LexError> {
                         .find(['"', '\n'])
                         .map_or(tail.len(), |k| k + usize::from(tail[k..].starts_with('"')));
                     lex.bump(stop);
-                    return Err(LexError::InvalidEscape(at));
+                    return Err(LexError::InvalidEscape(at, end));
                 }
                 None => break,
             },
@@ -308,7 +310,7 @@ pub fn lex(source: &str) -> Lexed {
                 flush_stray(&mut stray, &mut diagnostics);
                 // Keep a stand-in token so that the parser does not trip over the gap.
                 let stand_in = match e {
-                    LexError::UnterminatedString | LexError::InvalidEscape(_) => {
+                    LexError::UnterminatedString | LexError::InvalidEscape(..) => {
                         Some(Token::Str(String::new()))
                     }
                     LexError::NumberOutOfRange => Some(Token::Number(0.0)),
@@ -416,9 +418,9 @@ fn token_error(e: LexError, span: Span) -> Diagnostic {
                 .primary(span, "this string has no closing `\"` on its line")
                 .help("add `\"` at the end of the string")
         }
-        LexError::InvalidEscape(at) => {
+        LexError::InvalidEscape(at, end) => {
             Diagnostic::error(Code::InvalidEscape, "unknown escape sequence in string")
-                .primary(Span::new(at, at + 2), "not an escape lsyc knows")
+                .primary(Span::new(at, end), "not an escape lsyc knows")
                 .help("the escapes are \\\" \\\\ \\n \\t")
         }
         LexError::NumberOutOfRange => {

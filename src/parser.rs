@@ -122,6 +122,7 @@ pub fn parse(source: &str) -> Parsed {
     let result = grammar::FileParser::new()
         .parse(&mut state, lexed.tokens.into_iter().map(Ok::<_, LexError>));
     let index = LineIndex::new(source);
+    let end_word = end_word(&tokens);
     let mut syntax = Vec::new();
     for rec in state.recovered.drain(..) {
         syntax.push(syntax_error(
@@ -130,12 +131,20 @@ pub fn parse(source: &str) -> Parsed {
             &lexed.comments,
             source,
             &index,
+            end_word,
         ));
     }
     let mut file = match result {
         Ok(file) => file,
         Err(e) => {
-            syntax.push(syntax_error(e, &tokens, &lexed.comments, source, &index));
+            syntax.push(syntax_error(
+                e,
+                &tokens,
+                &lexed.comments,
+                source,
+                &index,
+                end_word,
+            ));
             File::default()
         }
     };
@@ -290,16 +299,23 @@ fn missing_semicolon(
     at: usize,
     index: &LineIndex,
 ) -> Option<usize> {
-    let pos = tokens.partition_point(|t| t.0 < at);
     let line = index.line(at);
-    // The first token on the unexpected token's line.
-    let mut first = pos;
-    while first > 0 && index.line(tokens[first - 1].0) == line {
-        first -= 1;
-    }
+    // The first token on the unexpected token's line (a search: one long
+    // line can hold an error per token).
+    let line_start = index.line_start(line);
+    let first = tokens.partition_point(|t| t.0 < line_start);
     let prev = tokens.get(first.checked_sub(1)?)?;
     let ends_statement = matches!(prev.1, Token::Semi | Token::LBrace | Token::RBrace);
     (!ends_statement && index.line(prev.2) < line).then_some(prev.2)
+}
+
+/// Where cpfg's or L-Py's `endlsystem` (or `endgroup`) first appears, if
+/// anywhere: every syntax error of the file mentions it.
+fn end_word(tokens: &[(usize, Token, usize)]) -> Option<Span> {
+    tokens
+        .iter()
+        .find(|t| matches!(&t.1, Token::Ident(w) if w == "endlsystem" || w == "endgroup"))
+        .map(|t| Span::new(t.0, t.2))
 }
 
 fn syntax_error(
@@ -308,9 +324,10 @@ fn syntax_error(
     comments: &[lexer::Comment],
     source: &str,
     index: &LineIndex,
+    end_word: Option<Span>,
 ) -> Diagnostic {
     let d = syntax_error_at(e, tokens, source, index);
-    explain_context(d, tokens, comments, source, index)
+    explain_context(d, tokens, comments, source, index, end_word)
 }
 
 /// Adds notes for the usual traps near a syntax error: `//` glued to modules
@@ -321,6 +338,7 @@ fn explain_context(
     comments: &[lexer::Comment],
     source: &str,
     index: &LineIndex,
+    end_word: Option<Span>,
 ) -> Diagnostic {
     let at = d.position() as usize;
     let line = index.line(at);
@@ -367,14 +385,11 @@ fn explain_context(
         }
     }
     // cpfg and L-Py close an lsystem with a word; lsyc with `}`.
-    if let Some(t) = tokens
-        .iter()
-        .find(|t| matches!(&t.1, Token::Ident(w) if w == "endlsystem" || w == "endgroup"))
-    {
+    if let Some(word) = end_word {
         d = d
-            .secondary(Span::new(t.0, t.2), "cpfg's and L-Py's end of an lsystem")
+            .secondary(word, "cpfg's and L-Py's end of an lsystem")
             .help("an lsyc lsystem ends with its closing `}`: remove `endlsystem`")
-            .fix("remove it", Span::new(t.0, t.2), "");
+            .fix("remove it", word, "");
     }
     d
 }
@@ -414,15 +429,18 @@ fn syntax_error_at(
                     "{tok} is a keyword of the language and cannot be used as a name"
                 ));
             }
-            let in_condition = tokens
+            // Tokens are in source order: the ones before `l` end at `before`
+            // (a search, not a scan: a file can have an error per token).
+            let before = tokens.partition_point(|t| t.0 < l);
+            let in_condition = tokens[..before]
                 .iter()
                 .rev()
-                .skip_while(|t| t.0 >= l)
                 .take_while(|t| !matches!(t.1, Token::Semi | Token::LBrace | Token::RBrace))
                 .any(|t| t.1 == Token::Colon);
             if tok == Token::Assign && !in_condition && expected.iter().any(|e| e == "\"->\"") {
                 // `X = F[+X]`: the rule arrow of many web L-system tools; `X => F`.
-                let arrow = match tokens.iter().find(|t| t.0 == r) {
+                let after = tokens.partition_point(|t| t.0 < r);
+                let arrow = match tokens.get(after).filter(|t| t.0 == r) {
                     Some(gt) if gt.1 == Token::Gt => Span::new(l, gt.2),
                     _ => span,
                 };
@@ -435,11 +453,7 @@ fn syntax_error_at(
                     .fix("replace with `==`", span, "==");
             }
             if tok == Token::Star
-                && let Some(colon) = tokens
-                    .iter()
-                    .rev()
-                    .find(|t| t.0 < l)
-                    .filter(|t| t.1 == Token::Colon)
+                && let Some(colon) = tokens[..before].last().filter(|t| t.1 == Token::Colon)
             {
                 d = d
                     .help(

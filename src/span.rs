@@ -68,6 +68,11 @@ impl LineIndex {
         (line + 1, col + 1)
     }
 
+    /// The byte offset where 0-based `line` starts.
+    pub fn line_start(&self, line: usize) -> usize {
+        self.starts[line]
+    }
+
     /// 0-based line of a byte offset.
     pub fn line(&self, offset: usize) -> usize {
         match self.starts.binary_search(&offset) {

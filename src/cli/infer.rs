@@ -81,7 +81,19 @@ pub struct Args {
     /// Line drawings: do not search for a D0L system; infer elements.
     #[arg(long, conflicts_with = "skeleton")]
     pub no_lines: bool,
+
+    /// The largest drawing read, in MiB (1 to 64: the readers are bounded for 64 MiB at most); a larger one is refused before it is read.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = MAX_INPUT_MIB,
+        value_parser = clap::value_parser!(u64).range(1..=MAX_INPUT_MIB)
+    )]
+    pub max_input_mib: u64,
 }
+
+/// The most `--max-input-mib` allows (and its default): the readers' own limit.
+const MAX_INPUT_MIB: u64 = (MAX_SVG_BYTES >> 20) as u64;
 
 pub fn run(args: &Args, reporter: &Reporter) -> u8 {
     let (input, what) = match (&args.skeleton, &args.art) {
@@ -106,7 +118,7 @@ pub fn run(args: &Args, reporter: &Reporter) -> u8 {
         return code;
     }
     let name = input.display().to_string();
-    let data = match read_input(input, &name, reporter) {
+    let data = match read_input(input, &name, args.max_input_mib, reporter) {
         Ok(d) => d,
         Err(code) => return code,
     };
@@ -322,16 +334,18 @@ fn same_as_input(
     Some(2)
 }
 
-fn read_input(path: &std::path::Path, name: &str, reporter: &Reporter) -> Result<Vec<u8>, u8> {
-    let too_large = std::fs::metadata(path).is_ok_and(|m| m.len() > MAX_SVG_BYTES as u64);
-    if too_large {
-        reporter.error(
-            &format!("`{name}` is larger than {} MiB", MAX_SVG_BYTES >> 20),
-            None,
-        );
-        return Err(1);
-    }
-    std::fs::read(path).map_err(|e| {
+/// Reads the drawing, refusing one over `max_mib` MiB: by its size before
+/// reading when it has one, and in any case by reading at most one byte
+/// more than the limit (a device or a pipe has no size to ask).
+fn read_input(
+    path: &std::path::Path,
+    name: &str,
+    max_mib: u64,
+    reporter: &Reporter,
+) -> Result<Vec<u8>, u8> {
+    use std::io::Read;
+    let limit = max_mib << 20;
+    let cannot_read = |e: std::io::Error| {
         let why = match e.kind() {
             std::io::ErrorKind::NotFound => "no such file".to_string(),
             std::io::ErrorKind::IsADirectory => "it is a directory".to_string(),
@@ -339,7 +353,40 @@ fn read_input(path: &std::path::Path, name: &str, reporter: &Reporter) -> Result
         };
         reporter.error(&format!("cannot read `{name}`: {why}"), None);
         1
-    })
+    };
+    let too_large = |size: Option<u64>| {
+        let size = size.map_or_else(String::new, |n| {
+            format!("{:.1} MiB, ", n as f64 / f64::from(1 << 20))
+        });
+        let help = if max_mib < MAX_INPUT_MIB {
+            format!("raise the limit with --max-input-mib (at most {MAX_INPUT_MIB})")
+        } else {
+            "lsyc infer reads drawings up to 64 MiB: infer a part of the drawing at a time"
+                .to_string()
+        };
+        reporter.error(
+            &format!("`{name}` is {size}over the {max_mib} MiB limit (--max-input-mib)"),
+            Some(&help),
+        );
+        1
+    };
+    let file = std::fs::File::open(path).map_err(cannot_read)?;
+    let size = file.metadata().map_err(cannot_read)?;
+    if size.is_dir() {
+        reporter.error(&format!("cannot read `{name}`: it is a directory"), None);
+        return Err(1);
+    }
+    if size.len() > limit {
+        return Err(too_large(Some(size.len())));
+    }
+    let mut data = Vec::new();
+    file.take(limit + 1)
+        .read_to_end(&mut data)
+        .map_err(cannot_read)?;
+    if data.len() as u64 > limit {
+        return Err(too_large(None));
+    }
+    Ok(data)
 }
 
 /// Writes the program to `out` (atomically) with a summary on stderr, or to stdout.

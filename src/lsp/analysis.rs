@@ -72,6 +72,12 @@ impl Analysis {
         }
     }
 
+    /// Whether the text parsed without a syntax error (and was analysed at
+    /// all): the checker runs exactly then, so `file` is the whole tree.
+    pub fn parsed(&self) -> bool {
+        self.checked.is_some()
+    }
+
     pub fn range(&self, span: Span) -> lsp::Range {
         self.lines.range(&self.text, span)
     }

@@ -5,30 +5,31 @@
 //! such a file), else one edit spanning only the part that changes. Range
 //! formatting prints the top-level items the range touches with
 //! `fmt::format_items`, the same printer, and leaves the rest of the file as
-//! it is (the blank lines around that run of items included).
+//! it is (the blank lines around that run of items included). Both print the
+//! tree the document's analysis already holds: a request parses nothing.
 
+use super::analysis::Analysis;
 use super::text::LineIndex;
 use crate::fmt::{format_file, format_items};
-use crate::parser;
 use crate::span::Span;
 use lsp_types::TextEdit;
 
-/// The edits that make `text` canonical, or `None` if it has syntax errors.
-pub fn format(text: &str) -> Option<Vec<TextEdit>> {
-    let parsed = parser::parse(text);
-    if parsed.diagnostics.iter().any(|d| d.is_error()) {
+/// The edits that make the document canonical, or `None` if it has syntax
+/// errors (or was too large to analyse).
+pub fn format(a: &Analysis) -> Option<Vec<TextEdit>> {
+    if !a.parsed() {
         return None;
     }
-    Some(edit(text, 0, text.len(), &format_file(&parsed.file)))
+    Some(edit(&a.text, 0, a.text.len(), &format_file(&a.file)))
 }
 
 /// The edits that make the items touched by bytes `range` canonical, or
-/// `None` if the text has syntax errors.
-pub fn format_range(text: &str, range: std::ops::Range<usize>) -> Option<Vec<TextEdit>> {
-    let parsed = parser::parse(text);
-    if parsed.diagnostics.iter().any(|d| d.is_error()) {
+/// `None` if the document has syntax errors (or was too large to analyse).
+pub fn format_range(a: &Analysis, range: std::ops::Range<usize>) -> Option<Vec<TextEdit>> {
+    if !a.parsed() {
         return None;
     }
+    let text = a.text.as_str();
     // Each item's extent: the item with its comments (leading ones may sit
     // inside it, a trailing one after it).
     let extent = |n: &crate::ast::Node<crate::ast::Item>| {
@@ -38,7 +39,7 @@ pub fn format_range(text: &str, range: std::ops::Range<usize>) -> Option<Vec<Tex
             .chain(t.trailing.as_ref())
             .fold(n.span, |s, c| s.to(c.span))
     };
-    let items = &parsed.file.items.stmts;
+    let items = &a.file.items.stmts;
     let touched: Vec<usize> = (0..items.len())
         .filter(|&i| {
             let e = extent(&items[i]);
@@ -50,7 +51,7 @@ pub fn format_range(text: &str, range: std::ops::Range<usize>) -> Option<Vec<Tex
     };
     let start = extent(&items[first]).start as usize;
     let end = extent(&items[last]).end as usize;
-    let out = format_items(&parsed.file, first..last + 1);
+    let out = format_items(&a.file, first..last + 1);
     let out = out.strip_suffix('\n').unwrap_or(&out);
     Some(edit(text, start, end, out))
 }

@@ -1,6 +1,7 @@
 //! The server's main loop: one thread, one message at a time (`lsyc lsp`
 //! reads its input on a second thread, a few messages ahead, so that a
-//! `$/cancelRequest` stops a request still waiting).
+//! `$/cancelRequest` stops a request still waiting, and marks the request
+//! being answered cancelled the moment its `$/cancelRequest` arrives).
 //!
 //! Owns: the protocol's life cycle (initialize, shutdown, exit), the open
 //! documents, and dispatching requests by type to the features. Every request
@@ -19,6 +20,8 @@ use lsp_types::request::{self as req, Request as _};
 use std::collections::{HashMap, HashSet, VecDeque};
 use std::io::{self, BufRead, Write};
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum State {
@@ -36,6 +39,43 @@ pub struct Server<W: Write> {
     out: W,
     state: State,
     docs: HashMap<String, Document>,
+    running: Arc<Running>,
+}
+
+/// The request being answered, shared with the thread that reads the
+/// input: a `$/cancelRequest` naming it raises `cancelled` at once, while
+/// the loop is still busy with it. The loop looks at the flag when the
+/// request's parameters are read and when its answer is ready (before the
+/// answer is serialized and sent); a cancelled request is answered
+/// `RequestCanceled` and its result dropped.
+#[derive(Default)]
+struct Running {
+    id: Mutex<Option<lsp_server::RequestId>>,
+    cancelled: AtomicBool,
+}
+
+impl Running {
+    fn start(&self, id: &lsp_server::RequestId) {
+        let mut running = self.id.lock().unwrap_or_else(|e| e.into_inner());
+        self.cancelled.store(false, Ordering::SeqCst);
+        *running = Some(id.clone());
+    }
+
+    fn finish(&self) {
+        *self.id.lock().unwrap_or_else(|e| e.into_inner()) = None;
+    }
+
+    /// Marks the request cancelled if it is the one being answered.
+    fn cancel(&self, id: &lsp_server::RequestId) {
+        let running = self.id.lock().unwrap_or_else(|e| e.into_inner());
+        if running.as_ref() == Some(id) {
+            self.cancelled.store(true, Ordering::SeqCst);
+        }
+    }
+
+    fn is_cancelled(&self) -> bool {
+        self.cancelled.load(Ordering::SeqCst)
+    }
 }
 
 /// How the session ended: `exit` after `shutdown` is a clean end (the
@@ -88,25 +128,33 @@ const READ_AHEAD: usize = 64;
 /// the input, reading on the calling thread (a `$/cancelRequest` is seen
 /// only once the requests before it are answered).
 pub fn serve(input: impl BufRead, output: impl Write) -> io::Result<End> {
-    run(&mut Direct(input), output)
+    run(&mut Direct(input), output, Arc::default())
 }
 
 /// As [`serve`], with the input read by a thread of its own, so that a
 /// `$/cancelRequest` that arrives while earlier requests are answered stops
-/// its request before it starts (answered `RequestCanceled`).
+/// its request before it starts, and one that arrives while its request is
+/// answered drops the answer (either way answered `RequestCanceled`).
 pub fn serve_threaded(input: impl BufRead + Send + 'static, output: impl Write) -> io::Result<End> {
     let (tx, rx) = std::sync::mpsc::sync_channel(READ_AHEAD);
+    let running = Arc::new(Running::default());
+    let seen = Arc::clone(&running);
     std::thread::spawn(move || {
         let mut input = input;
         loop {
             let m = transport::read(&mut input);
             let end = matches!(m, Ok(Incoming::Eof) | Err(_));
+            if let Ok(m) = &m
+                && let Some(id) = cancelled_id(m)
+            {
+                seen.cancel(&id);
+            }
             if tx.send(m).is_err() || end {
                 return;
             }
         }
     });
-    run(&mut Reader(rx), output)
+    run(&mut Reader(rx), output, running)
 }
 
 /// The id a `$/cancelRequest` names, if `m` is one.
@@ -134,8 +182,13 @@ struct Queue {
 
 impl Queue {
     /// Reads what has already arrived (up to [`READ_AHEAD`] messages),
-    /// noting cancellations of the requests waiting.
-    fn look_ahead(&mut self, source: &mut dyn Source) -> io::Result<()> {
+    /// noting cancellations of the requests waiting and of `current`, the
+    /// one about to be answered.
+    fn look_ahead(
+        &mut self,
+        source: &mut dyn Source,
+        current: &lsp_server::RequestId,
+    ) -> io::Result<()> {
         while self.waiting.len() < READ_AHEAD {
             let Some(m) = source.ready() else {
                 return Ok(());
@@ -146,7 +199,7 @@ impl Queue {
                     .waiting
                     .iter()
                     .any(|w| matches!(w, Incoming::Message(Message::Request(r)) if r.id == id));
-                if waiting {
+                if waiting || id == *current {
                     self.cancelled.insert(id);
                 }
             }
@@ -156,11 +209,12 @@ impl Queue {
     }
 }
 
-fn run(source: &mut dyn Source, output: impl Write) -> io::Result<End> {
+fn run(source: &mut dyn Source, output: impl Write, running: Arc<Running>) -> io::Result<End> {
     let mut s = Server {
         out: output,
         state: State::Uninitialized,
         docs: HashMap::new(),
+        running,
     };
     let mut queue = Queue::default();
     loop {
@@ -174,18 +228,17 @@ fn run(source: &mut dyn Source, output: impl Write) -> io::Result<End> {
                 transport::write_error(&mut s.out, id, code, &message)?;
             }
             Incoming::Message(Message::Request(r)) => {
-                queue.look_ahead(source)?;
-                let resp = if queue.cancelled.remove(&r.id) {
-                    Response {
-                        id: r.id,
-                        response_result: Err(error(
-                            ErrorCode::RequestCanceled,
-                            format!("`{}` was cancelled", r.method),
-                        )),
-                    }
+                // Running from here: a cancellation the reader sees from now
+                // on raises the flag; one read before is in the queue, and
+                // `look_ahead` finds it.
+                s.running.start(&r.id);
+                queue.look_ahead(source, &r.id)?;
+                let resp = if queue.cancelled.remove(&r.id) || s.running.is_cancelled() {
+                    cancelled(r.id, &r.method)
                 } else {
                     s.request(r)
                 };
+                s.running.finish();
                 transport::write(&mut s.out, resp.into())?;
             }
             Incoming::Message(Message::Notification(n)) => {
@@ -201,6 +254,16 @@ fn run(source: &mut dyn Source, output: impl Write) -> io::Result<End> {
             // The server sends no requests, so no response is awaited.
             Incoming::Message(Message::Response(_)) => {}
         }
+    }
+}
+
+fn cancelled(id: lsp_server::RequestId, method: &str) -> Response {
+    Response {
+        id,
+        response_result: Err(error(
+            ErrorCode::RequestCanceled,
+            format!("`{method}` was cancelled"),
+        )),
     }
 }
 
@@ -404,12 +467,12 @@ impl<W: Write> Server<W> {
             }
             req::Formatting::METHOD => self.on::<req::Formatting>(r, |s, p| {
                 let a = s.doc(&p.text_document.uri)?;
-                Ok(format::format(&a.text))
+                Ok(format::format(a))
             }),
             req::RangeFormatting::METHOD => self.on::<req::RangeFormatting>(r, |s, p| {
                 let a = s.doc(&p.text_document.uri)?;
                 let range = a.lines.span(&a.text, p.range);
-                Ok(format::format_range(&a.text, range))
+                Ok(format::format_range(a, range))
             }),
             req::CodeActionRequest::METHOD => self.on::<req::CodeActionRequest>(r, |s, p| {
                 let a = s.doc(&p.text_document.uri)?;
@@ -480,12 +543,19 @@ impl<W: Write> Server<W> {
                 };
             }
         };
+        if self.running.is_cancelled() {
+            return cancelled(r.id, R::METHOD);
+        }
         let result = catch_unwind(AssertUnwindSafe(|| f(self, params))).unwrap_or_else(|_| {
             Err(error(
                 ErrorCode::InternalError,
                 format!("lsyc failed while answering `{}`", R::METHOD),
             ))
         });
+        // Cancelled while it ran: the answer is dropped, not serialized.
+        if self.running.is_cancelled() {
+            return cancelled(r.id, R::METHOD);
+        }
         match result.and_then(|v| {
             serde_json::to_value(v).map_err(|e| error(ErrorCode::InternalError, e.to_string()))
         }) {

@@ -356,6 +356,71 @@ fn bad_drawings_are_clear_errors() {
 }
 
 #[test]
+fn max_input_mib_refuses_a_larger_drawing_by_name() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // A drawing just over 1 MiB: one stroke after a long comment.
+    let art = dir.path().join("padded.svg");
+    let mut text =
+        String::from(r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100"><!--"#);
+    text.push_str(&" ".repeat(1 << 20));
+    text.push_str(r#"--><path d="M10 10 L90 90" stroke="black" fill="none"/></svg>"#);
+    std::fs::write(&art, &text).expect("write");
+    let infer = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_lsyc"))
+            .arg("infer")
+            .args(args)
+            .output()
+            .expect("runs")
+    };
+    let path = art.to_str().expect("utf-8 path");
+    let out = infer(&[path, "--max-input-mib", "1", "--no-lines"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(out.stdout.is_empty(), "{err}");
+    assert!(
+        err.contains("padded.svg") && err.contains("1.0 MiB, over the 1 MiB limit"),
+        "{err}"
+    );
+    assert!(err.contains("--max-input-mib"), "{err}");
+    // The default (64 MiB) and a limit above the size read it.
+    for args in [
+        &[path, "--no-lines"][..],
+        &[path, "--no-lines", "--max-input-mib", "2"],
+    ] {
+        let out = infer(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {err}");
+        assert!(
+            String::from_utf8_lossy(&out.stdout).contains("lsystem"),
+            "{args:?}"
+        );
+    }
+    // A sketch is read under the same limit.
+    let out = infer(&["--skeleton", path, "--max-input-mib", "1"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("padded.svg") && err.contains("--max-input-mib"),
+        "{err}"
+    );
+    // A file with no size to ask is read to the limit and no further.
+    let out = infer(&["/dev/zero", "--max-input-mib", "1"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("`/dev/zero` is over the 1 MiB limit"), "{err}");
+    // Beyond what the readers are bounded for, or nothing: usage errors.
+    for n in ["0", "65"] {
+        let out = infer(&[path, "--max-input-mib", n]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{n}: {err}");
+        assert!(
+            err.contains("--max-input-mib") && err.contains("1..=64"),
+            "{err}"
+        );
+    }
+}
+
+#[test]
 fn an_element_is_replaced_by_another_drawing() {
     let dir = tempfile::tempdir().expect("tempdir");
     let prog = dir.path().join("grid.lsy");

@@ -756,7 +756,7 @@ fn every_file_every_name() {
         }
         outline::outline(&a);
         let parsed = lsyc::parser::parse(&text);
-        match format::format(&text) {
+        match format::format(&a) {
             Some(edits) => {
                 let want = lsyc::fmt::format_file(&parsed.file);
                 let edits = serde_json::to_value(edits).expect("json");

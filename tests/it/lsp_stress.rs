@@ -199,3 +199,41 @@ fn cancelled_requests_are_not_answered_with_work() {
         }
     }
 }
+
+#[test]
+fn a_request_cancelled_while_it_runs_is_answered_cancelled() {
+    let mut c = Client::start();
+    c.open(&big_program(1_500_000));
+    let formatting = || {
+        json!({"textDocument": {"uri": URI},
+        "options": {"tabSize": 4, "insertSpaces": true}})
+    };
+    // Formatting the whole document, not cancelled: it answers, in `took`.
+    let start = std::time::Instant::now();
+    c.request(1, "textDocument/formatting", formatting());
+    let first = c.until(|m| m["id"] == 1);
+    assert!(first["error"].is_null(), "{first}");
+    let took = start.elapsed();
+    eprintln!("formatting a 1.5 MB document: {took:?}");
+    // Again, cancelled a quarter of the way through. Nothing else is queued,
+    // so the server is answering it when the cancellation arrives: only the
+    // request being answered can be stopped.
+    c.request(2, "textDocument/formatting", formatting());
+    std::thread::sleep(took / 4);
+    c.send(&json!({"jsonrpc": "2.0", "method": "$/cancelRequest", "params": {"id": 2}}));
+    let m = c.until(|m| m["id"] == 2);
+    // (The document itself is not printed: 1.5 MB.)
+    let answer = if m["result"].is_null() {
+        "no result"
+    } else {
+        "the formatting edits"
+    };
+    assert_eq!(m["error"]["code"], -32800, "answered {answer}");
+    assert!(m["result"].is_null(), "answered {answer}");
+    // A cancellation for a request already answered changes nothing, and
+    // the server goes on answering.
+    c.send(&json!({"jsonrpc": "2.0", "method": "$/cancelRequest", "params": {"id": 1}}));
+    c.request(3, "textDocument/hover", hover_at(2, 12));
+    let m = c.until(|m| m["id"] == 3);
+    assert!(m["result"]["contents"].is_object(), "{m}");
+}

@@ -2,7 +2,8 @@
 //! connections with the common 1024 open-file limit, a never-ending export
 //! stopped by an edit, pages that reload or open a second tab, two dozen
 //! concurrent hovers on a large program with the server's memory measured,
-//! and a save refused because the file changed on disk.
+//! a save refused because the file changed on disk, and clients that leave
+//! mid-run (their jobs stop and free the workers).
 
 use crate::support::root;
 use serde_json::{Value, json};
@@ -411,4 +412,52 @@ fn a_slow_client_is_closed() {
     assert!(s.alive());
     let (status, _) = request(s.port, "GET", "/api/file", "", SOON);
     assert_eq!(status, 200);
+}
+
+#[test]
+fn a_client_gone_mid_run_stops_its_job() {
+    let (_dir, file) = scratch("monopodial-tree.lsy");
+    let s = serve(&file);
+    let port = s.port;
+    // More never-ending runs than the pool has workers (at most 4), each
+    // from a page of its own (so none supersedes another), and each client
+    // gone while its run is under way.
+    let gone: Vec<TcpStream> = (0..6)
+        .map(|i| {
+            let body = json!({ "session": format!("gone{i}"), "seq": 1, "source": NEVER_ENDING })
+                .to_string();
+            let mut c = TcpStream::connect(("127.0.0.1", port)).expect("connects");
+            write!(
+                c,
+                "POST /api/run HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nOrigin: http://127.0.0.1:{port}\r\n\
+                 Content-Type: application/json\r\nContent-Length: {}\r\n\r\n{body}",
+                body.len()
+            )
+            .expect("sends");
+            c
+        })
+        .collect();
+    std::thread::sleep(Duration::from_millis(1000));
+    // Every worker is taken by a run that never ends: another page waits.
+    let probe = json!({ "session": "probe", "seq": 1, "source": "lsystem A { axiom F; }" });
+    let waiting = std::thread::spawn(move || {
+        let started = Instant::now();
+        let (_, reply) = post(port, "/api/run", &probe, LONG);
+        (reply, started.elapsed())
+    });
+    std::thread::sleep(Duration::from_millis(1000));
+    assert!(
+        !waiting.is_finished(),
+        "a run got a worker while all were busy"
+    );
+    let closed = Instant::now();
+    for c in gone {
+        let _ = c.shutdown(std::net::Shutdown::Both);
+    }
+    // The clients are gone, so are their jobs: the waiting page is answered.
+    let (reply, _) = waiting.join().expect("answers");
+    let took = closed.elapsed();
+    eprintln!("six clients gone mid-run: the waiting run answered {took:?} later");
+    assert_eq!(reply["ok"], true, "{reply}");
+    assert!(took < SOON, "answered {took:?} after the clients left");
 }

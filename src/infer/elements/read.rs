@@ -113,11 +113,17 @@ pub const MAX_BOX_TESTS: u64 = 100_000_000;
 /// is not read, for a message.
 pub fn read(data: &[u8]) -> Result<Drawing, Refusal> {
     let tree = svg::parse(data)?;
+    from_tree(data, &tree)
+}
+
+/// [`read`], from the tree `svg::parse` made of `data` (for a caller that
+/// has parsed the document already).
+pub fn from_tree(data: &[u8], tree: &usvg::Tree) -> Result<Drawing, Refusal> {
     let mut d = Drawing::default();
     let mut work = Work::default();
-    let user = svg::user_space(data, &tree);
+    let user = svg::user_space(data, tree);
     // Images and text are reported from the document (see `skipped_in_xml`).
-    for (p, t) in svg::paths(&tree) {
+    for (p, t) in svg::paths(tree) {
         path_elements(p, user.pre_concat(t), &mut d, &mut work)?;
     }
     d.skipped.extend(skipped_in_xml(data));
