@@ -1092,16 +1092,18 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
         plan.extend(starts[ends..].iter().map(|&start| (b, start)));
     }
     // A drawing one stroke can draw is tried as one first (brackets
-    // multiply the choices); then, with its own count of work, with
-    // brackets when the drawing branches.
+    // multiply the choices), with half the work; then with brackets, when
+    // the drawing branches, with the rest.
     let bracketed = shared.limits.brackets;
     if bracketed && g.one_stroke() {
+        let total = shared.limits.total;
         shared.limits.brackets = false;
+        shared.limits.total = total / 2;
         if let Some(found) = over_graph(&mut shared, &plan, n_max) {
             return Some(found);
         }
         shared.limits.brackets = true;
-        shared.spent = 0;
+        shared.limits.total = total;
     }
     over_graph(&mut shared, &plan, n_max)
 }
