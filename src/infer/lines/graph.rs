@@ -147,6 +147,23 @@ impl Graph {
         reached == 2 * self.edges.len()
     }
 
+    /// Steps (from, to) in order as polylines: a new one wherever a step
+    /// does not start where the last ended.
+    pub fn polylines(&self, steps: impl Iterator<Item = (u32, u32)>) -> Vec<Vec<DVec2>> {
+        let mut out: Vec<Vec<DVec2>> = Vec::new();
+        let mut at = u32::MAX;
+        for (a, b) in steps {
+            if a != at {
+                out.push(vec![self.points[a as usize]]);
+            }
+            if let Some(l) = out.last_mut() {
+                l.push(self.points[b as usize]);
+            }
+            at = b;
+        }
+        out
+    }
+
     /// The drawing's diagonal, user units.
     pub fn diagonal(&self) -> f64 {
         let (lo, hi) = self.points.iter().fold(

@@ -1236,20 +1236,10 @@ const BOUNDS: [usize; 10] = [4, 6, 8, 10, 12, 15, 18, 22, 26, 32];
 /// The drawn edges, in the order drawn, as polylines: a new one wherever a
 /// step does not start where the last ended.
 fn walk(g: &Graph, trail: &[(u32, u32)]) -> Vec<Vec<DVec2>> {
-    let mut out: Vec<Vec<DVec2>> = Vec::new();
-    let mut at = u32::MAX;
-    for &(e, from) in trail {
+    g.polylines(trail.iter().map(|&(e, from)| {
         let [a, b] = g.edges[e as usize];
-        let to = if a == from { b } else { a };
-        if from != at {
-            out.push(vec![g.points[from as usize]]);
-        }
-        if let Some(l) = out.last_mut() {
-            l.push(g.points[to as usize]);
-        }
-        at = to;
-    }
-    out
+        (from, if a == from { b } else { a })
+    }))
 }
 
 #[cfg(test)]

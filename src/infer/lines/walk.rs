@@ -143,18 +143,7 @@ fn walk(g: &Graph, root: u32, order: Order) -> Vec<Vec<DVec2>> {
             stack.push((to, e, g.direction(e, v)));
         }
     }
-    let mut out: Vec<Vec<DVec2>> = Vec::new();
-    let mut at = u32::MAX;
-    for (a, b) in steps {
-        if a != at {
-            out.push(vec![g.points[a as usize]]);
-        }
-        if let Some(l) = out.last_mut() {
-            l.push(g.points[b as usize]);
-        }
-        at = b;
-    }
-    out
+    g.polylines(steps.into_iter())
 }
 
 /// Orders a vertex's edges (turn, to, edge).
