@@ -512,8 +512,10 @@ fn a_random_walk_falls_back_to_elements_within_the_budget() {
         "a D0L system for a random walk?"
     );
     assert!(
-        // The budget, and a hang guard for what follows it (not a timing).
-        took < Duration::from_millis(1500) + Duration::from_secs(60),
+        // The budget, and a hang guard for what follows it (not a timing:
+        // the stroke graph's searches are bounded by counts of work, which
+        // a debug build on a busy machine takes about a minute over).
+        took < Duration::from_millis(1500) + Duration::from_secs(120),
         "{took:?}"
     );
     // The command line: a note, then the elements' program.
