@@ -47,7 +47,7 @@ const ORDERS: [Order; 4] = [
 /// The drawing as the polylines of each walk worth trying, when its graph
 /// is a tree that branches; none otherwise.
 pub fn trees(g: &Graph) -> Vec<Vec<Vec<DVec2>>> {
-    if !is_branching_tree(g) {
+    if !branches(g) {
         return Vec::new();
     }
     let mut out = Vec::new();
@@ -64,7 +64,7 @@ pub fn trees(g: &Graph) -> Vec<Vec<Vec<DVec2>>> {
 
 /// Whether the edges are connected and some vertex has three or more (a
 /// tree, or one whose branches touch or cross: each edge is walked once).
-fn is_branching_tree(g: &Graph) -> bool {
+fn branches(g: &Graph) -> bool {
     g.adj.iter().any(|a| a.len() > 2) && g.connected()
 }
 
@@ -153,7 +153,7 @@ fn sort(next: &mut [(f64, u32, u32)], order: Order) {
         Order::Left => next.sort_by(left),
         Order::Right => next.sort_by(|a, b| left(b, a)),
         Order::LeftStraightLast | Order::RightStraightLast => {
-            if matches!(order, Order::Left | Order::LeftStraightLast) {
+            if matches!(order, Order::LeftStraightLast) {
                 next.sort_by(left);
             } else {
                 next.sort_by(|a, b| left(b, a));
