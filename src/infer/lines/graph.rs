@@ -391,6 +391,10 @@ fn pieces(segs: &[(u32, u32)], points: &[DVec2], tol: f64, unit: f64) -> Vec<(u3
     // segment lies within h/2 + tol of a sample.
     let h = 0.5 * unit.max(tol);
     let grid = PointGrid::with_cell(points, h);
+    // How near a whole number of steps, from the drawing's own tolerance:
+    // at 72° and 36° a vertex can lie on a step 1.236 or 0.764 steps
+    // along it (where another stroke crosses it), which is not a touch.
+    let whole = (3.0 * tol / unit).clamp(0.02, WHOLE);
     let mut out = Vec::with_capacity(segs.len());
     for &(a, b) in segs {
         let (pa, pb) = (points[a as usize], points[b as usize]);
@@ -418,7 +422,7 @@ fn pieces(segs: &[(u32, u32)], points: &[DVec2], tol: f64, unit: f64) -> Vec<(u3
                 let rest = len / unit - along;
                 if along.round() < 1.0
                     || rest.round() < 1.0
-                    || (along - along.round()).abs() > WHOLE
+                    || (along - along.round()).abs() > whole
                 {
                     continue;
                 }

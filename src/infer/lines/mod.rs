@@ -19,6 +19,7 @@ pub mod emit;
 pub mod grammar;
 pub mod graph;
 pub mod ideal;
+pub mod levels;
 pub mod read;
 pub mod search;
 pub mod synth;

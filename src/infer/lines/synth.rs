@@ -21,7 +21,7 @@
 //! candidate (`grammar::matches`, the library's redraw).
 
 use super::graph::Graph;
-use super::{blocks, turtle};
+use super::{blocks, levels, turtle};
 use glam::DVec2;
 use std::ops::RangeInclusive;
 use std::time::Instant;
@@ -706,10 +706,10 @@ impl<'a> Search<'a> {
                     self.limits.rule
                 };
                 let mut v = Vec::new();
-                // A successor that only copies its letter explains nothing.
-                let identity = rule != AXIOM
-                    && letters == 1
-                    && (r.syms.len() == 1 || r.syms.contains(&Sym::Letter(rule)));
+                // A successor that only copies its letter explains nothing
+                // (one unnamed letter closed alone is named another letter:
+                // `F -> G` delays F a step).
+                let identity = rule != AXIOM && letters == 1 && r.syms.contains(&Sym::Letter(rule));
                 if letters > 0 && open == 0 && !identity {
                     v.push(Alt::Close);
                 }
@@ -1108,17 +1108,26 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
     over_graph(&mut shared, &plan, n_max)
 }
 
-/// The search over the graph alone, start by start and bound by bound.
+/// The search over the graph alone, with one drawing letter, then two,
+/// then three (each more letter multiplies the choices), start by start
+/// and bound by bound.
 fn over_graph(shared: &mut Shared, plan: &[(usize, (u32, u32))], n_max: u32) -> Option<Found> {
-    for &(bound, start) in plan {
-        if shared.exhausted() {
-            return None;
-        }
-        if let Some(best) = shared.best_of(start, bound, 2..=n_max, None) {
-            return Some(best);
+    let most = shared.limits.letters;
+    let mut found = None;
+    'letters: for letters in 1..=most {
+        shared.limits.letters = letters;
+        for &(bound, start) in plan {
+            if shared.exhausted() {
+                break 'letters;
+            }
+            found = shared.best_of(start, bound, 2..=n_max, None);
+            if found.is_some() {
+                break 'letters;
+            }
         }
     }
-    None
+    shared.limits.letters = most;
+    found
 }
 
 /// The search that follows the paths' order, forwards and backwards, bound
@@ -1158,19 +1167,87 @@ fn along(shared: &mut Shared, depths: RangeInclusive<u32>, order: &[(u32, u32)])
     let g = shared.g;
     let forwards = order.to_vec();
     let backwards: Vec<(u32, u32)> = order.iter().rev().map(|&(a, b)| (b, a)).collect();
-    for bound in BOUNDS {
-        for order in [&forwards, &backwards] {
-            let &(from, to) = order.first()?;
-            let e = g.edge(from, to)?;
-            if shared.exhausted() {
-                return None;
-            }
-            if let Some(best) = shared.best_of((from, e), bound, depths.clone(), Some(order)) {
-                return Some(best);
+    for order in [&forwards, &backwards] {
+        if let Some(found) = by_levels(shared, order) {
+            return Some(found);
+        }
+    }
+    let most = shared.limits.letters;
+    let mut found = None;
+    'letters: for letters in 1..=most {
+        shared.limits.letters = letters;
+        for bound in BOUNDS {
+            for order in [&forwards, &backwards] {
+                let (Some(&(from, to)), false) = (order.first(), shared.exhausted()) else {
+                    break 'letters;
+                };
+                let Some(e) = g.edge(from, to) else {
+                    break 'letters;
+                };
+                found = shared.best_of((from, e), bound, depths.clone(), Some(order));
+                if found.is_some() {
+                    break 'letters;
+                }
             }
         }
     }
-    None
+    shared.limits.letters = most;
+    found
+}
+
+/// An edge-rewriting grammar read level by level (`levels`) off a curve
+/// drawn in one stroke in `order`, with one letter, then two, then three.
+fn by_levels(shared: &mut Shared, order: &[(u32, u32)]) -> Option<Found> {
+    let g = shared.g;
+    let m = (360.0 / shared.delta).round();
+    let one_stroke = order.windows(2).all(|w| w[0].1 == w[1].0);
+    if order.len() < 4 || !one_stroke || (360.0 / shared.delta - m).abs() > 1e-6 {
+        return None;
+    }
+    let mut trail = Vec::with_capacity(order.len());
+    for &(a, b) in order {
+        trail.push((g.edge(a, b)?, a));
+    }
+    let turns: Vec<i32> = trail
+        .windows(2)
+        .map(|w| {
+            let d = g.direction(w[1].0, w[1].1) - g.direction(w[0].0, w[0].1);
+            (turtle::wrap_degrees(d.to_degrees()) / shared.delta).round() as i32
+        })
+        .collect();
+    // One letter, then two, then three, each with no one-step successor
+    // first; the smallest grammar of all (a later pass only looks for a
+    // smaller one).
+    let passes = (1..=shared.limits.letters).flat_map(|k| [(k, false), (k, true)]);
+    let mut best: Option<levels::Parsed> = None;
+    for (letters, single) in passes {
+        if shared.exhausted() {
+            break;
+        }
+        let limits = levels::Limits {
+            letters,
+            single,
+            block: shared.limits.rule,
+            // Letters, not symbols: a polygon of up to 32 sides.
+            axiom: shared.limits.axiom.max(32),
+            work: shared.limits.work.min(shared.limits.total - shared.spent),
+            bound: best.as_ref().map_or(usize::MAX, levels::Parsed::size),
+        };
+        match levels::parse(&turns, m as i32, &limits) {
+            Ok(p) => {
+                shared.spent += p.work;
+                best = Some(p);
+            }
+            Err(work) => shared.spent += work.max(1),
+        }
+    }
+    best.map(|p| Found {
+        axiom: p.axiom,
+        rules: p.rules,
+        depth: p.depth,
+        delta: shared.delta,
+        walk: walk(g, &trail),
+    })
 }
 
 /// The search along a curve (every vertex on at most two edges) whose
