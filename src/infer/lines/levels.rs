@@ -207,6 +207,10 @@ impl Parse<'_> {
                         self.bound = p.size();
                         best = Some(p);
                     }
+                    // A smaller one is looked for a while longer, not
+                    // through every cut.
+                    let more = self.work.saturating_mul(4).max(self.work + 20_000);
+                    self.limits.work = self.limits.work.min(more);
                 }
                 Task::Fail => {}
                 Task::Choose(level, alts) => points.push(Point {
@@ -663,7 +667,7 @@ mod tests {
 
     /// The turns between the steps of `axiom` derived `n` times (every
     /// letter draws; `+`/`-` turn by one).
-    fn turns(axiom: &str, rules: &[(char, &str)], n: u32) -> Vec<i32> {
+    pub fn turns(axiom: &str, rules: &[(char, &str)], n: u32) -> Vec<i32> {
         let mut w = axiom.to_string();
         for _ in 0..n {
             w = w

@@ -1167,16 +1167,24 @@ fn along(shared: &mut Shared, depths: RangeInclusive<u32>, order: &[(u32, u32)])
     let g = shared.g;
     let forwards = order.to_vec();
     let backwards: Vec<(u32, u32)> = order.iter().rev().map(|&(a, b)| (b, a)).collect();
-    for order in [&forwards, &backwards] {
-        if let Some(found) = by_levels(shared, order) {
-            return Some(found);
-        }
+    // The level parse first; what it finds is the smallest of its cuts,
+    // but a successor of one step (`F -> G`) it reaches less surely than
+    // the search below, which then looks for a smaller grammar with a
+    // quarter of the work.
+    let parsed = [&forwards, &backwards]
+        .into_iter()
+        .filter_map(|order| by_levels(shared, order))
+        .min_by_key(Found::size);
+    let (total, spent) = (shared.limits.total, shared.spent);
+    let limit = parsed.as_ref().map_or(usize::MAX, Found::size);
+    if parsed.is_some() {
+        shared.limits.total = spent + (total - spent.min(total)) / 4;
     }
     let most = shared.limits.letters;
     let mut found = None;
     'letters: for letters in 1..=most {
         shared.limits.letters = letters;
-        for bound in BOUNDS {
+        for bound in BOUNDS.into_iter().filter(|&b| b < limit) {
             for order in [&forwards, &backwards] {
                 let (Some(&(from, to)), false) = (order.first(), shared.exhausted()) else {
                     break 'letters;
@@ -1184,7 +1192,9 @@ fn along(shared: &mut Shared, depths: RangeInclusive<u32>, order: &[(u32, u32)])
                 let Some(e) = g.edge(from, to) else {
                     break 'letters;
                 };
-                found = shared.best_of((from, e), bound, depths.clone(), Some(order));
+                found = shared
+                    .best_of((from, e), bound, depths.clone(), Some(order))
+                    .filter(|f| f.size() < limit);
                 if found.is_some() {
                     break 'letters;
                 }
@@ -1192,7 +1202,8 @@ fn along(shared: &mut Shared, depths: RangeInclusive<u32>, order: &[(u32, u32)])
         }
     }
     shared.limits.letters = most;
-    found
+    shared.limits.total = total;
+    found.or(parsed)
 }
 
 /// An edge-rewriting grammar read level by level (`levels`) off a curve
