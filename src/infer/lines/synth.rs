@@ -1209,6 +1209,20 @@ fn along(shared: &mut Shared, depths: RangeInclusive<u32>, order: &[(u32, u32)])
 /// An edge-rewriting grammar read level by level (`levels`) off a curve
 /// drawn in one stroke in `order`, with one letter, then two, then three.
 fn by_levels(shared: &mut Shared, order: &[(u32, u32)]) -> Option<Found> {
+    let passes: Vec<(usize, bool)> = (1..=shared.limits.letters)
+        .flat_map(|k| [(k, false), (k, true)])
+        .collect();
+    levels_with(shared, order, &passes, shared.limits.work)
+}
+
+/// The level parse of `order` in the passes given (letters, one-step
+/// successors), each with at most `work`.
+fn levels_with(
+    shared: &mut Shared,
+    order: &[(u32, u32)],
+    passes: &[(usize, bool)],
+    work: u64,
+) -> Option<Found> {
     let g = shared.g;
     let m = (360.0 / shared.delta).round();
     let one_stroke = order.windows(2).all(|w| w[0].1 == w[1].0);
@@ -1229,9 +1243,8 @@ fn by_levels(shared: &mut Shared, order: &[(u32, u32)]) -> Option<Found> {
     // One letter, then two, then three, each with no one-step successor
     // first; the smallest grammar of all (a later pass only looks for a
     // smaller one).
-    let passes = (1..=shared.limits.letters).flat_map(|k| [(k, false), (k, true)]);
     let mut best: Option<levels::Parsed> = None;
-    for (letters, single) in passes {
+    for &(letters, single) in passes {
         if shared.exhausted() {
             break;
         }
@@ -1241,7 +1254,7 @@ fn by_levels(shared: &mut Shared, order: &[(u32, u32)]) -> Option<Found> {
             block: shared.limits.rule,
             // Letters, not symbols: a polygon of up to 32 sides.
             axiom: shared.limits.axiom.max(32),
-            work: shared.limits.work.min(shared.limits.total - shared.spent),
+            work: work.min(shared.limits.total - shared.spent),
             bound: best.as_ref().map_or(usize::MAX, levels::Parsed::size),
         };
         match levels::parse(&turns, m as i32, &limits) {
@@ -1305,10 +1318,39 @@ fn along_chain(
             return f;
         }
     }
-    if closed || followed {
+    if closed {
+        return around(shared, chain);
+    }
+    if followed {
         return None;
     }
     along(shared, 2..=n_max, chain)
+}
+
+/// A closed curve of two or three letters whose start is lost: the level
+/// parse from every step in turn, both ways, with a little work each (a
+/// wrong start fails within a few blocks), within half the work left.
+fn around(shared: &mut Shared, chain: &[(u32, u32)]) -> Option<Found> {
+    const EACH: u64 = 2_000;
+    let passes: Vec<(usize, bool)> = (2..=shared.limits.letters).map(|k| (k, false)).collect();
+    let total = shared.limits.total;
+    shared.limits.total = shared.spent + (total - shared.spent.min(total)) / 2;
+    let mut found = None;
+    for at in 0..chain.len() {
+        if shared.exhausted() {
+            break;
+        }
+        let mut order = chain[at..].to_vec();
+        order.extend_from_slice(&chain[..at]);
+        let backwards: Vec<(u32, u32)> = order.iter().rev().map(|&(a, b)| (b, a)).collect();
+        found = levels_with(shared, &order, &passes, EACH)
+            .or_else(|| levels_with(shared, &backwards, &passes, EACH));
+        if found.is_some() {
+            break;
+        }
+    }
+    shared.limits.total = total;
+    found
 }
 
 /// The most unit edges a drawing may have for this search (its work limit
