@@ -30,9 +30,9 @@ const BUDGET: Duration = Duration::from_secs(40);
 /// (clean, rotated, jittered, split, shuffled).
 const FLOORS: &[(Class, [usize; 5])] = &[
     (Class::Edge1, [29, 29, 21, 29, 22]),
-    (Class::Edge2, [24, 23, 4, 23, 10]),
-    (Class::Edge3, [7, 7, 2, 7, 2]),
-    (Class::Node, [12, 12, 0, 11, 9]),
+    (Class::Edge2, [24, 23, 12, 23, 10]),
+    (Class::Edge3, [7, 7, 5, 7, 2]),
+    (Class::Node, [12, 12, 2, 11, 10]),
     (Class::Bracketed, [29, 29, 7, 28, 20]),
     (Class::Moves, [7, 7, 3, 7, 1]),
 ];

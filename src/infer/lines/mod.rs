@@ -206,7 +206,7 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
     }
     // Read as steps but unexplained: say that, not why another reading failed.
     if why.is_empty() || steps > 0 {
-        why = "no D0L system with one or two rewritten letters draws it".into();
+        why = "no D0L system of the classes it searches (one to three drawing letters, node letters, branches, moves) draws it".into();
     }
     Lines::Unexplained {
         why,
