@@ -63,6 +63,9 @@ impl Parsed {
 
 /// Letters at most (the sums table is this square).
 const MAX_LETTERS: usize = 3;
+/// The most steps of δ in a full turn parsed (a sum is guessed among them,
+/// and the leading and trailing turns split over m^letters ways).
+const MAX_TURNS: i32 = 36;
 /// Levels at most (a successor of one step only delays its letter, so a
 /// linear system can be deep).
 const MAX_LEVELS: usize = 64;
@@ -160,7 +163,11 @@ struct Parse<'a> {
 /// The grammar found first, with at most `limits.letters` letters, the
 /// deepest parse first.
 pub fn parse(turns: &[i32], m: i32, limits: &Limits) -> Result<Parsed, u64> {
-    if m < 2 || turns.is_empty() || limits.letters == 0 || limits.letters > MAX_LETTERS {
+    if !(2..=MAX_TURNS).contains(&m)
+        || turns.is_empty()
+        || limits.letters == 0
+        || limits.letters > MAX_LETTERS
+    {
         return Err(0);
     }
     let turns: Vec<i32> = turns.iter().map(|t| t.rem_euclid(m)).collect();
@@ -774,6 +781,15 @@ mod tests {
             parsed("F", &[('F', "F+F--F+F")], 4, 6, 1),
             "F @8; F -> F+F+++"
         );
+    }
+
+    /// A fine angle (m > 36) or no turns at all is not parsed.
+    #[test]
+    fn fine_angles_are_not_parsed() {
+        let t = turns("F", &[('F', "F+F-F-F+F")], 3);
+        assert_eq!(parse(&t, 72, &limits(1)), Err(0));
+        assert_eq!(parse(&[], 4, &limits(1)), Err(0));
+        assert!(parse(&t, 4, &limits(1)).is_ok());
     }
 
     #[test]
