@@ -159,9 +159,10 @@ struct Parse<'a> {
 }
 
 /// Reads an edge-rewriting grammar off a curve drawn in one stroke whose
-/// `turns[i]` (multiples of δ₀ = 360°/m) is between steps `i` and `i + 1`.
-/// The grammar found first, with at most `limits.letters` letters, the
-/// deepest parse first.
+/// `turns[i]` (multiples of δ₀ = 360°/m) is between steps `i` and `i + 1`:
+/// the smallest found, with at most `limits.letters` letters and fewer
+/// symbols than `limits.bound`, looking a while past the first cut that
+/// draws the curve; or the work spent finding none.
 pub fn parse(turns: &[i32], m: i32, limits: &Limits) -> Result<Parsed, u64> {
     if !(2..=MAX_TURNS).contains(&m)
         || turns.is_empty()
