@@ -120,35 +120,12 @@ mod tests {
     /// by one), before each step (the first one's closing turn, when the
     /// curve closes, is `close`).
     fn turns(axiom: &str, w: &str, n: u32, close: i32) -> Vec<i32> {
-        let mut s = axiom.to_string();
-        for _ in 0..n {
-            s = s
-                .chars()
-                .map(|c| {
-                    if c == 'F' {
-                        w.to_string()
-                    } else {
-                        c.to_string()
-                    }
-                })
-                .collect();
-        }
         let mut out = vec![close];
-        let mut t = 0;
-        let mut first = true;
-        for c in s.chars() {
-            match c {
-                '+' => t += 1,
-                '-' => t -= 1,
-                _ => {
-                    if !first {
-                        out.push(t);
-                    }
-                    first = false;
-                    t = 0;
-                }
-            }
-        }
+        out.extend(crate::infer::lines::levels::tests::turns(
+            axiom,
+            &[('F', w)],
+            n,
+        ));
         out
     }
 

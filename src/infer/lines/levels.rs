@@ -670,12 +670,12 @@ fn signed(t: i32, m: i32) -> i32 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     /// The turns between the steps of `axiom` derived `n` times (every
-    /// letter draws; `+`/`-` turn by one).
-    pub fn turns(axiom: &str, rules: &[(char, &str)], n: u32) -> Vec<i32> {
+    /// letter draws; `+`/`-` turn by one). (Also `blocks`'s tests'.)
+    pub(in crate::infer::lines) fn turns(axiom: &str, rules: &[(char, &str)], n: u32) -> Vec<i32> {
         let mut w = axiom.to_string();
         for _ in 0..n {
             w = w
