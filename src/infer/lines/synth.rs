@@ -1223,6 +1223,18 @@ fn levels_with(
     passes: &[(usize, bool)],
     work: u64,
 ) -> Option<Found> {
+    let (trail, turns) = stroke(shared, order)?;
+    let p = parse_turns(shared, &turns, passes, work)?;
+    Some(found_of(shared, p, &trail))
+}
+
+/// A curve's drawn edges (each with the vertex it is drawn from) and its
+/// turns between steps in δ₀.
+type Stroke = (Vec<(u32, u32)>, Vec<i32>);
+
+/// The stroke of a curve drawn in one stroke in `order`, when δ₀ divides
+/// a full turn.
+fn stroke(shared: &Shared, order: &[(u32, u32)]) -> Option<Stroke> {
     let g = shared.g;
     let m = (360.0 / shared.delta).round();
     let one_stroke = order.windows(2).all(|w| w[0].1 == w[1].0);
@@ -1233,16 +1245,27 @@ fn levels_with(
     for &(a, b) in order {
         trail.push((g.edge(a, b)?, a));
     }
-    let turns: Vec<i32> = trail
-        .windows(2)
-        .map(|w| {
-            let d = g.direction(w[1].0, w[1].1) - g.direction(w[0].0, w[0].1);
-            (turtle::wrap_degrees(d.to_degrees()) / shared.delta).round() as i32
-        })
-        .collect();
-    // One letter, then two, then three, each with no one-step successor
-    // first; the smallest grammar of all (a later pass only looks for a
-    // smaller one).
+    let turns = trail.windows(2).map(|w| turn(shared, w[0], w[1])).collect();
+    Some((trail, turns))
+}
+
+/// The turn from drawn edge `a` to drawn edge `b`, in δ₀.
+fn turn(shared: &Shared, a: (u32, u32), b: (u32, u32)) -> i32 {
+    let g = shared.g;
+    let d = g.direction(b.0, b.1) - g.direction(a.0, a.1);
+    (turtle::wrap_degrees(d.to_degrees()) / shared.delta).round() as i32
+}
+
+/// The level parse of `turns` in the passes given: one letter, then two,
+/// then three, each with no one-step successor first; the smallest grammar
+/// of all (a later pass only looks for a smaller one).
+fn parse_turns(
+    shared: &mut Shared,
+    turns: &[i32],
+    passes: &[(usize, bool)],
+    work: u64,
+) -> Option<levels::Parsed> {
+    let m = (360.0 / shared.delta).round() as i32;
     let mut best: Option<levels::Parsed> = None;
     for &(letters, single) in passes {
         if shared.exhausted() {
@@ -1257,7 +1280,7 @@ fn levels_with(
             work: work.min(shared.limits.total - shared.spent),
             bound: best.as_ref().map_or(usize::MAX, levels::Parsed::size),
         };
-        match levels::parse(&turns, m as i32, &limits) {
+        match levels::parse(turns, m, &limits) {
             Ok(p) => {
                 shared.spent += p.work;
                 best = Some(p);
@@ -1265,13 +1288,18 @@ fn levels_with(
             Err(work) => shared.spent += work.max(1),
         }
     }
-    best.map(|p| Found {
+    best
+}
+
+/// A parse as a found grammar whose walk is `trail`.
+fn found_of(shared: &Shared, p: levels::Parsed, trail: &[(u32, u32)]) -> Found {
+    Found {
         axiom: p.axiom,
         rules: p.rules,
         depth: p.depth,
         delta: shared.delta,
-        walk: walk(g, &trail),
-    })
+        walk: walk(shared.g, trail),
+    }
 }
 
 /// The search along a curve (every vertex on at most two edges) whose
@@ -1333,18 +1361,36 @@ fn along_chain(
 fn around(shared: &mut Shared, chain: &[(u32, u32)]) -> Option<Found> {
     const EACH: u64 = 2_000;
     let passes: Vec<(usize, bool)> = (2..=shared.limits.letters).map(|k| (k, false)).collect();
+    // The turns once, round the curve: `cyclic[i]` from step i to the next.
+    let (trail, _) = stroke(shared, chain)?;
+    let n = trail.len();
+    let cyclic: Vec<i32> = (0..n)
+        .map(|i| turn(shared, trail[i], trail[(i + 1) % n]))
+        .collect();
     let total = shared.limits.total;
     shared.limits.total = shared.spent + (total - shared.spent.min(total)) / 2;
     let mut found = None;
-    for at in 0..chain.len() {
+    for at in 0..n {
         if shared.exhausted() {
             break;
         }
-        let mut order = chain[at..].to_vec();
-        order.extend_from_slice(&chain[..at]);
-        let backwards: Vec<(u32, u32)> = order.iter().rev().map(|&(a, b)| (b, a)).collect();
-        found = levels_with(shared, &order, &passes, EACH)
-            .or_else(|| levels_with(shared, &backwards, &passes, EACH));
+        // From step `at` on, and the same steps the other way round.
+        let forwards: Vec<i32> = (0..n - 1).map(|j| cyclic[(at + j) % n]).collect();
+        let backwards: Vec<i32> = forwards.iter().rev().map(|t| -t).collect();
+        let order = |back: bool| -> Vec<(u32, u32)> {
+            let mut o = chain[at..].to_vec();
+            o.extend_from_slice(&chain[..at]);
+            if back {
+                o = o.iter().rev().map(|&(a, b)| (b, a)).collect();
+            }
+            o
+        };
+        for (turns, back) in [(&forwards, false), (&backwards, true)] {
+            if let Some(p) = parse_turns(shared, turns, &passes, EACH) {
+                found = stroke(shared, &order(back)).map(|(t, _)| found_of(shared, p, &t));
+                break;
+            }
+        }
         if found.is_some() {
             break;
         }
