@@ -19,9 +19,16 @@
 //! first meet inside a block. Every choice is backed up when a later block
 //! contradicts it, within a count of work.
 //!
+//! The curve is a `Drawing` the parse walks step by step: the turns of a
+//! stroke drawn in order (`parse`), or a walk over a stroke graph whose
+//! steps came in any order (`parse_drawing`), where a curve that touches
+//! itself leaves a choice of turns at each vertex it passes twice. The
+//! parse takes those choices with its own: a wrong one fails as a wrong cut
+//! does.
+//!
 //! Owns: the level parse. Must not read the drawing (`synth` gives it the
-//! turns) or accept a grammar (it goes through the same checks as every
-//! other candidate).
+//! turns, `euler` the walk) or accept a grammar (it goes through the same
+//! checks as every other candidate).
 
 use super::synth::Sym;
 
@@ -50,8 +57,65 @@ pub struct Parsed {
     pub axiom: Vec<Sym>,
     pub rules: Vec<Vec<Sym>>,
     pub depth: u32,
+    /// The turns (0..m) of the walk the grammar draws, between its steps.
+    pub turns: Vec<i32>,
     /// Work spent.
     pub work: u64,
+}
+
+/// A curve the parse walks, step by step.
+pub trait Drawing {
+    /// Steps in all.
+    fn steps(&self) -> usize;
+    /// Steps drawn so far.
+    fn drawn(&self) -> usize;
+    /// The turns (0..m) the next step may take after the last one drawn
+    /// (the first step has one, 0), into `out`.
+    fn choices(&mut self, out: &mut Vec<i32>);
+    /// Draws the next step turning by `t` (ignored for the first); `false`
+    /// when none may.
+    fn take(&mut self, t: i32) -> bool;
+    /// Undraws every step after the first `n`.
+    fn back(&mut self, n: usize);
+    /// Work done beyond the steps drawn since last asked (looks ahead).
+    fn spent(&mut self) -> u64 {
+        0
+    }
+}
+
+/// The turns of a curve drawn in one stroke, in order.
+struct Fixed<'a> {
+    turns: &'a [i32],
+    drawn: usize,
+}
+
+impl Drawing for Fixed<'_> {
+    fn steps(&self) -> usize {
+        self.turns.len() + 1
+    }
+
+    fn drawn(&self) -> usize {
+        self.drawn
+    }
+
+    fn choices(&mut self, out: &mut Vec<i32>) {
+        match self.drawn {
+            0 => out.push(0),
+            n if n < self.steps() => out.push(self.turns[n - 1]),
+            _ => {}
+        }
+    }
+
+    fn take(&mut self, t: i32) -> bool {
+        let n = self.drawn;
+        let ok = n == 0 || (n < self.steps() && self.turns[n - 1] == t);
+        self.drawn += ok as usize;
+        ok
+    }
+
+    fn back(&mut self, n: usize) {
+        self.drawn = n.min(self.drawn);
+    }
 }
 
 impl Parsed {
@@ -66,6 +130,9 @@ const MAX_LETTERS: usize = 3;
 /// The most steps of δ in a full turn parsed (a sum is guessed among them,
 /// and the leading and trailing turns split over m^letters ways).
 const MAX_TURNS: i32 = 36;
+/// Paths offered as new successors at one cut at most (a walk that
+/// touches itself often branches at every vertex).
+const MOST_PATHS: usize = 512;
 /// Levels at most (a successor of one step only delays its letter, so a
 /// linear system can be deep).
 const MAX_LEVELS: usize = 64;
@@ -103,8 +170,12 @@ struct Level {
 enum Alt {
     /// The next block is the successor of this letter.
     Block(u8),
-    /// The next block is a new letter's successor of this many steps.
-    New(usize),
+    /// The drawing's next block is this letter's successor, after this
+    /// turn.
+    Cut(u8, i32),
+    /// The drawing's next block is a new letter's successor, drawn as this
+    /// path of the walk (`Parse::paths`) goes.
+    New(u32),
     /// This level is the axiom.
     Freeze,
     /// The sum of the pair's trailing and leading turns.
@@ -120,10 +191,20 @@ struct Mark {
     frozen: bool,
 }
 
+/// A step of a path the walk may take from where it is: the one before
+/// (`u32::MAX` for the first), the turn to it, and how many steps in.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    parent: u32,
+    turn: i32,
+    len: u32,
+}
+
 #[derive(Clone, Debug)]
 struct Saved {
     levels: Vec<Mark>,
     shapes: usize,
+    paths: usize,
     known: Vec<bool>,
     sums: [[Option<i32>; MAX_LETTERS]; MAX_LETTERS],
 }
@@ -141,9 +222,12 @@ enum Task {
     Done,
 }
 
-struct Parse<'a> {
-    /// Turns of the drawing between consecutive steps.
-    turns: &'a [i32],
+struct Parse<'a, D: Drawing> {
+    d: &'a mut D,
+    /// Turns of the drawing between its steps drawn so far.
+    turns: Vec<i32>,
+    /// The paths offered as new successors, as trees of steps.
+    paths: Vec<Node>,
     m: i32,
     limits: Limits,
     shapes: Vec<Shape>,
@@ -164,16 +248,29 @@ struct Parse<'a> {
 /// symbols than `limits.bound`, looking a while past the first cut that
 /// draws the curve; or the work spent finding none.
 pub fn parse(turns: &[i32], m: i32, limits: &Limits) -> Result<Parsed, u64> {
+    let turns: Vec<i32> = turns.iter().map(|t| t.rem_euclid(m.max(1))).collect();
+    let mut d = Fixed {
+        turns: &turns,
+        drawn: 0,
+    };
+    parse_drawing(&mut d, m, limits)
+}
+
+/// The parse of a curve walked as `d` draws it, from its first step (none
+/// drawn yet; its turns 0..m).
+pub fn parse_drawing(d: &mut impl Drawing, m: i32, limits: &Limits) -> Result<Parsed, u64> {
     if !(2..=MAX_TURNS).contains(&m)
-        || turns.is_empty()
+        || d.steps() < 2
+        || d.drawn() != 0
         || limits.letters == 0
         || limits.letters > MAX_LETTERS
     {
         return Err(0);
     }
-    let turns: Vec<i32> = turns.iter().map(|t| t.rem_euclid(m)).collect();
     let mut p = Parse {
-        turns: &turns,
+        d,
+        turns: Vec::new(),
+        paths: Vec::new(),
         m,
         limits: *limits,
         shapes: Vec::new(),
@@ -192,9 +289,102 @@ pub fn parse(turns: &[i32], m: i32, limits: &Limits) -> Result<Parsed, u64> {
     }
 }
 
-impl Parse<'_> {
+impl<D: Drawing> Parse<'_, D> {
     fn steps(&self) -> usize {
-        self.turns.len() + 1
+        self.d.steps()
+    }
+
+    /// Draws the next step, turning by `t` after the last.
+    fn draw(&mut self, t: i32) -> bool {
+        let first = self.d.drawn() == 0;
+        if !self.d.take(t) {
+            return false;
+        }
+        if !first {
+            self.turns.push(t);
+        }
+        true
+    }
+
+    /// Draws `y`'s successor after turning by `before`.
+    fn follow(&mut self, before: i32, y: u8) -> bool {
+        if !self.draw(before) {
+            return false;
+        }
+        for k in 0..self.shapes[y as usize].inner.len() {
+            let t = self.shapes[y as usize].inner[k];
+            if !self.draw(t) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Undraws every step after the first `n`.
+    fn undraw(&mut self, n: usize) {
+        self.d.back(n);
+        self.turns.truncate(n.saturating_sub(1));
+    }
+
+    /// The turns before the drawing's next block after which the walk can
+    /// draw `y`'s successor.
+    fn cuts(&mut self, y: u8) -> Vec<i32> {
+        let n = self.done;
+        let mut choices = Vec::new();
+        self.d.choices(&mut choices);
+        choices.retain(|&c| {
+            let ok = self.follow(c, y);
+            self.undraw(n);
+            ok
+        });
+        choices
+    }
+
+    /// Every path of 1..=`most` steps the walk can take from where it is
+    /// (at most `MOST_PATHS`), as nodes of `paths`.
+    fn paths_from_here(&mut self, most: usize) -> std::ops::Range<u32> {
+        let first = self.paths.len();
+        self.grow(u32::MAX, 0, most, first + MOST_PATHS);
+        first as u32..self.paths.len() as u32
+    }
+
+    /// The paths on from node `parent`, `len` steps in, until `paths` has
+    /// `full` nodes.
+    fn grow(&mut self, parent: u32, len: usize, most: usize, full: usize) {
+        if len == most {
+            return;
+        }
+        let n = self.d.drawn();
+        let mut choices = Vec::new();
+        self.d.choices(&mut choices);
+        for c in choices {
+            if self.paths.len() >= full {
+                return;
+            }
+            if !self.draw(c) {
+                continue;
+            }
+            self.paths.push(Node {
+                parent,
+                turn: c,
+                len: len as u32 + 1,
+            });
+            let node = self.paths.len() as u32 - 1;
+            self.grow(node, len + 1, most, full);
+            self.undraw(n);
+        }
+    }
+
+    /// The turns of path node `i`, from the first.
+    fn path(&self, i: u32) -> Vec<i32> {
+        let mut path = Vec::new();
+        let mut at = i;
+        while at != u32::MAX {
+            path.push(self.paths[at as usize].turn);
+            at = self.paths[at as usize].parent;
+        }
+        path.reverse();
+        path
     }
 
     /// Every cut within the work limit, keeping the smallest grammar
@@ -204,7 +394,7 @@ impl Parse<'_> {
         let mut best: Option<Parsed> = None;
         let mut points: Vec<Point> = Vec::new();
         loop {
-            self.work += 1;
+            self.work += 1 + self.d.spent();
             if self.work > self.limits.work {
                 return best;
             }
@@ -242,7 +432,9 @@ impl Parse<'_> {
                 let (level, saved) = (p.level, p.saved.clone());
                 self.restore(&saved);
                 self.work += 1;
-                if self.apply(level, alt) {
+                let applied = self.apply(level, alt);
+                self.work += self.d.spent();
+                if applied {
                     break;
                 }
                 if self.work > self.limits.work {
@@ -274,6 +466,7 @@ impl Parse<'_> {
                 })
                 .collect(),
             shapes: self.shapes.len(),
+            paths: self.paths.len(),
             known: self.shapes.iter().map(|s| s.letters.is_some()).collect(),
             sums: self.sums,
         }
@@ -288,6 +481,7 @@ impl Parse<'_> {
             l.frozen = m.frozen;
         }
         self.shapes.truncate(s.shapes);
+        self.paths.truncate(s.paths);
         for (shape, &known) in self.shapes.iter_mut().zip(&s.known) {
             if !known {
                 shape.letters = None;
@@ -301,11 +495,12 @@ impl Parse<'_> {
                 .map(|&y| self.shapes[y as usize].inner.len() + 1)
                 .sum()
         });
+        self.undraw(self.done);
     }
 
     /// What to do next: the deepest level that can cut its next block
     /// chooses how; the drawing last.
-    fn task(&self) -> Task {
+    fn task(&mut self) -> Task {
         let all_shapes = self.shapes.len() == self.limits.letters;
         let longest = self.shapes.iter().map(|s| s.inner.len() + 1).max();
         for i in (0..self.levels.len()).rev() {
@@ -346,10 +541,10 @@ impl Parse<'_> {
         }
         if self.done < self.steps() {
             let pending = self.steps() - self.done;
-            let mut alts: Vec<Alt> = (0..self.shapes.len() as u8)
-                .filter(|&y| self.fits(0, y))
-                .map(Alt::Block)
-                .collect();
+            let mut alts = Vec::new();
+            for y in 0..self.shapes.len() as u8 {
+                alts.extend(self.cuts(y).into_iter().map(|c| Alt::Cut(y, c)));
+            }
             if !all_shapes {
                 // The last letter must make the levels shorter: not every
                 // successor one step.
@@ -357,10 +552,15 @@ impl Parse<'_> {
                 // A new successor of b steps writes at least b symbols.
                 let room = self.bound.saturating_sub(self.least_size() + 1);
                 let most = self.limits.block.min(pending).min(room);
-                alts.extend((2..=most).map(Alt::New));
+                let mut paths: Vec<u32> = self.paths_from_here(most).collect();
+                paths.sort_by_key(|&i| self.paths[i as usize].len);
                 // One step fits anywhere: the last thing tried.
-                if shrinks && self.limits.single && most >= 1 {
-                    alts.push(Alt::New(1));
+                let (one, more): (Vec<u32>, Vec<u32>) = paths
+                    .into_iter()
+                    .partition(|&i| self.paths[i as usize].len == 1);
+                alts.extend(more.into_iter().map(Alt::New));
+                if shrinks && self.limits.single {
+                    alts.extend(one.into_iter().map(Alt::New));
                 }
             }
             return if alts.is_empty() {
@@ -432,20 +632,11 @@ impl Parse<'_> {
         }
     }
 
-    /// Whether the next block of level `at` (0: the drawing, k: `levels[k-1]`)
-    /// could be letter `y`'s successor (a cheap look; `apply` checks it all).
+    /// Whether the next block of level `at` (k ≥ 1: `levels[k-1]`) could be
+    /// letter `y`'s successor (a cheap look; `apply` checks it all).
     fn fits(&self, at: usize, y: u8) -> bool {
         let shape = &self.shapes[y as usize];
         let size = shape.inner.len() + 1;
-        if at == 0 {
-            let p = self.done;
-            return p + size <= self.steps()
-                && shape
-                    .inner
-                    .iter()
-                    .zip(&self.turns[p..])
-                    .all(|(a, b)| a == b);
-        }
         let l = &self.levels[at - 1];
         let p = l.done;
         if p + size > l.letters.len() {
@@ -478,32 +669,29 @@ impl Parse<'_> {
                 l.frozen = true;
                 l.letters.len() <= self.limits.axiom.min(room)
             }
-            Alt::New(size) => {
-                let p = self.done;
-                let inner = self.turns[p..p + size - 1].to_vec();
+            Alt::New(node) => {
+                let path = self.path(node);
                 self.shapes.push(Shape {
-                    inner,
+                    inner: path[1..].to_vec(),
                     letters: None,
                 });
-                self.block(0, self.shapes.len() as u8 - 1)
+                self.block(0, self.shapes.len() as u8 - 1, path[0])
             }
-            Alt::Block(y) => self.block(at, y),
+            Alt::Cut(y, before) => self.block(0, y, before),
+            Alt::Block(y) => self.block(at, y, 0),
         }
     }
 
-    /// Cuts the next block of level `at` as `y`'s successor and hands `y`
-    /// down to the level above.
-    fn block(&mut self, at: usize, y: u8) -> bool {
+    /// Cuts the next block of level `at` as `y`'s successor (on the
+    /// drawing, after turning by `before`) and hands `y` down to the level
+    /// above.
+    fn block(&mut self, at: usize, y: u8, before: i32) -> bool {
         let size = self.shapes[y as usize].inner.len() + 1;
         self.work += size as u64;
         let p;
         if at == 0 {
             p = self.done;
-            if p + size > self.steps() {
-                return false;
-            }
-            let inner = &self.shapes[y as usize].inner;
-            if inner.iter().zip(&self.turns[p..]).any(|(a, b)| a != b) {
+            if !self.follow(before, y) {
                 return false;
             }
             self.done += size;
@@ -616,6 +804,7 @@ impl Parse<'_> {
             axiom,
             rules,
             depth: self.levels.len() as u32,
+            turns: self.turns.clone(),
             work: self.work,
         }
     }

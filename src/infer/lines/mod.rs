@@ -16,6 +16,7 @@
 
 pub mod blocks;
 pub mod emit;
+pub mod euler;
 pub mod grammar;
 pub mod graph;
 pub mod ideal;

@@ -21,7 +21,8 @@
 //! candidate (`grammar::matches`, the library's redraw).
 
 use super::graph::Graph;
-use super::{blocks, levels, turtle};
+use super::levels::Drawing as _;
+use super::{blocks, euler, levels, turtle};
 use glam::DVec2;
 use std::ops::RangeInclusive;
 use std::time::Instant;
@@ -1074,6 +1075,8 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
         if shared.exhausted() {
             return None;
         }
+    } else if let Some(found) = touching(&mut shared) {
+        return Some(found);
     }
     let starts = starts(g);
     // A curve's ends (a plant's root among its tips) are where a drawing
@@ -1266,6 +1269,17 @@ fn parse_turns(
     work: u64,
 ) -> Option<levels::Parsed> {
     let m = (360.0 / shared.delta).round() as i32;
+    parse_passes(shared, passes, work, |l| levels::parse(turns, m, l))
+}
+
+/// The level parse, as `parse` runs it with each pass's limits, in the
+/// passes given.
+fn parse_passes(
+    shared: &mut Shared,
+    passes: &[(usize, bool)],
+    work: u64,
+    mut parse: impl FnMut(&levels::Limits) -> Result<levels::Parsed, u64>,
+) -> Option<levels::Parsed> {
     let mut best: Option<levels::Parsed> = None;
     for &(letters, single) in passes {
         if shared.exhausted() {
@@ -1280,7 +1294,7 @@ fn parse_turns(
             work: work.min(shared.limits.total - shared.spent),
             bound: best.as_ref().map_or(usize::MAX, levels::Parsed::size),
         };
-        match levels::parse(turns, m, &limits) {
+        match parse(&limits) {
             Ok(p) => {
                 shared.spent += p.work;
                 best = Some(p);
@@ -1397,6 +1411,68 @@ fn around(shared: &mut Shared, chain: &[(u32, u32)]) -> Option<Found> {
     }
     shared.limits.total = total;
     found
+}
+
+/// A curve drawn in one stroke that touches or crosses itself, its steps
+/// in any order: the level parse walks its graph (`euler`) from each of its
+/// ends with every letter the limits allow, the smallest grammar of both;
+/// a closed one from every step, with a little work each (a wrong start
+/// fails within a few blocks), the first found. Within half the work left.
+fn touching(shared: &mut Shared) -> Option<Found> {
+    const EACH: u64 = 4_000;
+    let g = shared.g;
+    let delta = shared.delta;
+    let m = (360.0 / delta).round() as i32;
+    if (360.0 / delta - m as f64).abs() > 1e-6 || !g.one_stroke() {
+        return None;
+    }
+    let odd: Vec<u32> = (0..g.points.len() as u32)
+        .filter(|&v| g.adj[v as usize].len() % 2 == 1)
+        .collect();
+    let closed = odd.is_empty();
+    let starts: Vec<(u32, u32)> = if closed {
+        g.edges
+            .iter()
+            .enumerate()
+            .flat_map(|(e, &[a, b])| [(a, e as u32), (b, e as u32)])
+            .collect()
+    } else {
+        odd.iter()
+            .flat_map(|&v| g.adj[v as usize].iter().map(move |&(_, e)| (v, e)))
+            .collect()
+    };
+    let passes: Vec<(usize, bool)> = (1..=shared.limits.letters)
+        .flat_map(|k| [(k, false), (k, true)])
+        .collect();
+    let each = if closed { EACH } else { shared.limits.work };
+    let total = shared.limits.total;
+    shared.limits.total = shared.spent + (total - shared.spent.min(total)) / 2;
+    let mut best: Option<Found> = None;
+    for start in starts {
+        if shared.exhausted() {
+            break;
+        }
+        let parsed = parse_passes(shared, &passes, each, |l| {
+            levels::parse_drawing(&mut euler::Walk::new(g, delta, start), m, l)
+        });
+        let Some(p) = parsed else { continue };
+        let mut w = euler::Walk::new(g, delta, start);
+        if !std::iter::once(0)
+            .chain(p.turns.iter().copied())
+            .all(|t| w.take(t))
+        {
+            continue;
+        }
+        let f = found_of(shared, p, w.trail());
+        if best.as_ref().is_none_or(|b| f.size() < b.size()) {
+            best = Some(f);
+        }
+        if closed {
+            break;
+        }
+    }
+    shared.limits.total = total;
+    best
 }
 
 /// The most unit edges a drawing may have for this search (its work limit
