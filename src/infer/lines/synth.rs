@@ -1441,34 +1441,44 @@ fn touching(shared: &mut Shared) -> Option<Found> {
             .flat_map(|&v| g.adj[v as usize].iter().map(move |&(_, e)| (v, e)))
             .collect()
     };
+    // A closed curve's starts are tried with one letter each before any is
+    // tried with two (a wrong start fails fastest with one); an open
+    // curve's two ends with every pass.
     let passes: Vec<(usize, bool)> = (1..=shared.limits.letters)
         .flat_map(|k| [(k, false), (k, true)])
         .collect();
+    let rounds: Vec<&[(usize, bool)]> = if closed {
+        passes.chunks(2).collect()
+    } else {
+        vec![&passes]
+    };
     let each = if closed { EACH } else { shared.limits.work };
     let total = shared.limits.total;
     shared.limits.total = shared.spent + (total - shared.spent.min(total)) / 2;
     let mut best: Option<Found> = None;
-    for start in starts {
-        if shared.exhausted() {
-            break;
-        }
-        let parsed = parse_passes(shared, &passes, each, |l| {
-            levels::parse_drawing(&mut euler::Walk::new(g, delta, start), m, l)
-        });
-        let Some(p) = parsed else { continue };
-        let mut w = euler::Walk::new(g, delta, start);
-        if !std::iter::once(0)
-            .chain(p.turns.iter().copied())
-            .all(|t| w.take(t))
-        {
-            continue;
-        }
-        let f = found_of(shared, p, w.trail());
-        if best.as_ref().is_none_or(|b| f.size() < b.size()) {
-            best = Some(f);
-        }
-        if closed {
-            break;
+    'rounds: for round in rounds {
+        for &start in &starts {
+            if shared.exhausted() {
+                break 'rounds;
+            }
+            let parsed = parse_passes(shared, round, each, |l| {
+                levels::parse_drawing(&mut euler::Walk::new(g, delta, start), m, l)
+            });
+            let Some(p) = parsed else { continue };
+            let mut w = euler::Walk::new(g, delta, start);
+            if !std::iter::once(0)
+                .chain(p.turns.iter().copied())
+                .all(|t| w.take(t))
+            {
+                continue;
+            }
+            let f = found_of(shared, p, w.trail());
+            if best.as_ref().is_none_or(|b| f.size() < b.size()) {
+                best = Some(f);
+            }
+            if closed {
+                break 'rounds;
+            }
         }
     }
     shared.limits.total = total;
