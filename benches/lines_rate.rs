@@ -15,7 +15,7 @@
 //! program (`CLASS-SEED.lsy`) into DIR.
 //!
 //! Classes: edge-1 edge-2 edge-3 node bracketed moves. Variants: clean
-//! rotated jittered split shuffled.
+//! rotated jittered split shuffled noisy.
 
 #[path = "../tests/it/lines_gen/mod.rs"]
 mod lines_gen;

@@ -178,15 +178,22 @@ pub enum Variant {
     Split,
     /// Split, the paths in random order, about half of them reversed.
     Shuffled,
+    /// Jittered, but by at most a fifth of a step: the noise of a careful
+    /// tracing, which leaves every step and turn readable (0.2 % of the
+    /// diagonal is more than that for most drawings of a few hundred steps
+    /// across, up to a whole step). Last, so that the other variants'
+    /// random draws stay as they were.
+    Noisy,
 }
 
 impl Variant {
-    pub const ALL: [Variant; 5] = [
+    pub const ALL: [Variant; 6] = [
         Variant::Clean,
         Variant::Rotated,
         Variant::Jittered,
         Variant::Split,
         Variant::Shuffled,
+        Variant::Noisy,
     ];
 
     pub fn name(self) -> &'static str {
@@ -196,6 +203,7 @@ impl Variant {
             Variant::Jittered => "jittered",
             Variant::Split => "split",
             Variant::Shuffled => "shuffled",
+            Variant::Noisy => "noisy",
         }
     }
 
@@ -259,7 +267,7 @@ const STYLE: &str = "fill=\"none\" stroke=\"black\"";
 pub fn svg(d: &Drawing, variant: Variant, t: &Transform, rng: &mut Rng) -> String {
     let mut out = String::from(HEAD);
     match variant {
-        Variant::Clean | Variant::Rotated | Variant::Jittered => {
+        Variant::Clean | Variant::Rotated | Variant::Jittered | Variant::Noisy => {
             let (t, decimals) = match variant {
                 Variant::Clean => (Transform::IDENTITY, 6),
                 Variant::Rotated => (*t, 4),
@@ -270,8 +278,11 @@ pub fn svg(d: &Drawing, variant: Variant, t: &Transform, rng: &mut Rng) -> Strin
                 .iter()
                 .map(|l| l.iter().map(|&p| t.apply(p)).collect())
                 .collect();
-            if variant == Variant::Jittered {
-                jitter(&mut strokes, &d.strokes, rng);
+            match variant {
+                Variant::Jittered => jitter(&mut strokes, &d.strokes, f64::INFINITY, rng),
+                // A step is `t.scale` long.
+                Variant::Noisy => jitter(&mut strokes, &d.strokes, t.scale / 5.0, rng),
+                _ => {}
             }
             for l in &strokes {
                 let pts: Vec<String> = l.iter().map(|&p| point(p, decimals)).collect();
@@ -309,14 +320,14 @@ pub fn svg(d: &Drawing, variant: Variant, t: &Transform, rng: &mut Rng) -> Strin
 }
 
 /// Moves every vertex of `strokes` by up to 0.2 % of their bounding box's
-/// diagonal, uniform in a disc; vertices at the same place in the drawing
-/// (`clean`, unit steps) move together.
-fn jitter(strokes: &mut [Vec<DVec2>], clean: &[Vec<DVec2>], rng: &mut Rng) {
+/// diagonal or `most`, whichever is less, uniform in a disc; vertices at the
+/// same place in the drawing (`clean`, unit steps) move together.
+fn jitter(strokes: &mut [Vec<DVec2>], clean: &[Vec<DVec2>], most: f64, rng: &mut Rng) {
     let (lo, hi) = strokes.iter().flatten().fold(
         (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
         |(lo, hi), p| (lo.min(*p), hi.max(*p)),
     );
-    let radius = 0.002 * (hi - lo).length();
+    let radius = (0.002 * (hi - lo).length()).min(most);
     let mut moved: HashMap<[i64; 2], DVec2> = HashMap::new();
     for (line, orig) in strokes.iter_mut().zip(clean) {
         for (p, o) in line.iter_mut().zip(orig) {
