@@ -33,7 +33,7 @@ const FLOORS: &[(Class, [usize; 6])] = &[
     (Class::Edge2, [24, 23, 12, 23, 22, 14]),
     (Class::Edge3, [7, 7, 5, 7, 2, 5]),
     (Class::Node, [12, 12, 2, 11, 11, 5]),
-    (Class::Bracketed, [29, 29, 7, 28, 20, 11]),
+    (Class::Bracketed, [29, 29, 11, 28, 20, 17]),
     (Class::Moves, [7, 7, 3, 7, 1, 3]),
 ];
 

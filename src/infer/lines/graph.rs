@@ -37,6 +37,10 @@ pub struct Graph {
     pub edges: Vec<[u32; 2]>,
     /// Each vertex's (neighbour, edge).
     pub adj: Vec<Vec<(u32, u32)>>,
+    /// Each edge's piece: how many steps long the drawn segment it was cut
+    /// from is (a long segment says its steps' direction more surely than
+    /// a noisy one-step segment does).
+    pub runs: Vec<u32>,
     /// How far the drawing's points lie from their vertices: the root mean
     /// square, in steps.
     pub noise: f64,
@@ -492,7 +496,7 @@ pub fn build(lines: &[Vec<DVec2>], split: u32) -> Result<Graph, String> {
     // Cut every piece into unit steps; the points between steps join the
     // vertices (where strokes cross or touch at a lattice point).
     let mut all = points.clone();
-    let mut chains: Vec<Vec<u32>> = Vec::with_capacity(parts.len());
+    let mut chains: Vec<(Vec<u32>, u32)> = Vec::with_capacity(parts.len());
     let mut total = 0usize;
     let whole = whole_tolerance(&lengths, step);
     for (&(a, b), &len) in parts.iter().zip(&lengths) {
@@ -515,14 +519,15 @@ pub fn build(lines: &[Vec<DVec2>], split: u32) -> Result<Graph, String> {
             chain.push(all.len() as u32 - 1);
         }
         chain.push(b);
-        chains.push(chain);
+        chains.push((chain, r as u32));
     }
     let (of2, vertices) = cluster(&all, tol.min(0.3 * step));
     let mut edge_of: HashMap<(u32, u32), u32> = HashMap::new();
     let mut edges: Vec<[u32; 2]> = Vec::new();
     let mut adj: Vec<Vec<(u32, u32)>> = vec![Vec::new(); vertices.len()];
+    let mut runs = Vec::new();
     let mut order = Vec::with_capacity(total);
-    for chain in &chains {
+    for (chain, run) in &chains {
         for w in chain.windows(2) {
             let (a, b) = (of2[w[0] as usize], of2[w[1] as usize]);
             if a == b {
@@ -536,6 +541,7 @@ pub fn build(lines: &[Vec<DVec2>], split: u32) -> Result<Graph, String> {
             let e = edges.len() as u32;
             edge_of.insert(key, e);
             edges.push([a, b]);
+            runs.push(*run);
             adj[a as usize].push((b, e));
             adj[b as usize].push((a, e));
         }
@@ -562,6 +568,7 @@ pub fn build(lines: &[Vec<DVec2>], split: u32) -> Result<Graph, String> {
         points: vertices,
         edges,
         adj,
+        runs,
         noise,
         delta: 0.0,
         tol: tol.min(0.3 * step),
