@@ -159,13 +159,22 @@ impl Drawing for Walk<'_> {
             self.trail.push((e, v));
             return true;
         }
+        // (No list of the open edges: this is the parse's every step.)
         let v = self.at();
-        let open = self.open();
         let t = t.rem_euclid(self.m);
-        let Some(&(e, _)) = open.iter().find(|(_, u)| *u == Some(t)) else {
+        let (mut open, mut next) = (0, None);
+        for &(_, e) in &self.g.adj[v as usize] {
+            if !self.used[e as usize] {
+                open += 1;
+                if next.is_none() && self.turn_onto(e) == Some(t) {
+                    next = Some(e);
+                }
+            }
+        }
+        let Some(e) = next else {
             return false;
         };
-        if !self.may_take(v, e, open.len()) {
+        if !self.may_take(v, e, open) {
             return false;
         }
         self.used[e as usize] = true;
