@@ -469,7 +469,7 @@ pub fn build(lines: &[Vec<DVec2>], split: u32) -> Result<Graph, String> {
     // one `<use>` stacked in one place), counts twice: a turtle that goes
     // back over a step draws it twice (the paths' order keeps both), and
     // 90,000 copies of 46 segments would crowd the clustering.
-    let mut seen: HashMap<((u64, u64), (u64, u64)), u8> = HashMap::new();
+    let mut seen: HashMap<_, u8> = HashMap::new();
     let key = |p: DVec2| (p.x.to_bits(), p.y.to_bits());
     for l in lines {
         for w in l.windows(2) {
