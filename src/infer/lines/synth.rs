@@ -1212,9 +1212,7 @@ fn along(shared: &mut Shared, depths: RangeInclusive<u32>, order: &[(u32, u32)])
 /// An edge-rewriting grammar read level by level (`levels`) off a curve
 /// drawn in one stroke in `order`, with one letter, then two, then three.
 fn by_levels(shared: &mut Shared, order: &[(u32, u32)]) -> Option<Found> {
-    let passes: Vec<(usize, bool)> = (1..=shared.limits.letters)
-        .flat_map(|k| [(k, false), (k, true)])
-        .collect();
+    let passes = passes(shared.limits.letters);
     levels_with(shared, order, &passes, shared.limits.work)
 }
 
@@ -1270,6 +1268,14 @@ fn parse_turns(
 ) -> Option<levels::Parsed> {
     let m = (360.0 / shared.delta).round() as i32;
     parse_passes(shared, passes, work, |l| levels::parse(turns, m, l))
+}
+
+/// The level parse's passes: one letter, then two, then three, each first
+/// with no one-step successor.
+fn passes(letters: usize) -> Vec<(usize, bool)> {
+    (1..=letters)
+        .flat_map(|k| [(k, false), (k, true)])
+        .collect()
 }
 
 /// The level parse, as `parse` runs it with each pass's limits, in the
@@ -1444,9 +1450,7 @@ fn touching(shared: &mut Shared) -> Option<Found> {
     // A closed curve's starts are tried with one letter each before any is
     // tried with two (a wrong start fails fastest with one); an open
     // curve's two ends with every pass.
-    let passes: Vec<(usize, bool)> = (1..=shared.limits.letters)
-        .flat_map(|k| [(k, false), (k, true)])
-        .collect();
+    let passes = passes(shared.limits.letters);
     let rounds: Vec<&[(usize, bool)]> = if closed {
         passes.chunks(2).collect()
     } else {
