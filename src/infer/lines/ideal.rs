@@ -1,151 +1,564 @@
 //! A noisy line drawing redrawn as the turtle meant it: every step of the
-//! stroke graph, in the paths' order, turned to the nearest multiple of δ
-//! and one step long.
+//! stroke graph, in the paths' order, one step long along a multiple of δ.
 //!
 //! A jittered or hand-traced drawing in turtle order fails the exact
 //! reading (its turns are not whole multiples of one angle, its pieces not
-//! whole numbers of steps) though every step says plainly which multiple of
-//! δ it turns. Walking the graph's steps in order, each from the ideal
-//! position of its start vertex (a vertex keeps the position it got first,
-//! so a branch starts where its parent passed), along the nearest allowed
-//! direction, gives the drawing those steps stand for, placed where it
-//! fits the drawing best; it is refused when a vertex of it lies more than
-//! half a step from the drawing's. It is read and searched as a clean
-//! drawing, and the program must draw it exactly.
+//! whole numbers of steps). One step alone often does not say which
+//! multiple of δ it turns (at 22.5°, two vertices a fifth of a step off
+//! turn a step by half a δ), but the walk does: the turtle's vertices lie
+//! on its lattice, and a step read one δ wrong leaves every later vertex of
+//! the walk off the drawing's. So each path is decoded as a whole, by a
+//! beam over the lattice points the walk may reach:
+//!
+//! - roughly first, for every δ = 360/m (m ≤ 36): the walk's shape over
+//!   its last few steps against the drawing's (the frame, the drawing's
+//!   scale, turn and place, is only roughly known yet: a little off, it
+//!   moves far vertices far and near ones little), the frame then fitted
+//!   to the walk;
+//! - closely for the likeliest δ: every vertex against the drawing's, in a
+//!   frame fitted again as the walk goes (near its start a rough frame errs
+//!   little), then once more in the frame fitted to all of it.
+//!
+//! δ is the one whose walk is the shortest to say with the drawing's
+//! offsets from it (its turns' LZ78 phrases and the offsets' spread): a
+//! finer lattice fits the noise a little better but its walk repeats
+//! itself less, as a coarser one's fits worse. A vertex keeps the position
+//! it got first, so a branch starts where its parent passed and a curve
+//! that comes back to a vertex must come back to its lattice point. The
+//! redrawing is refused when a vertex of it lies more than half a step
+//! from the drawing's. It is read and searched as a clean drawing, and the
+//! program must draw it exactly.
 //!
 //! Owns: the redrawing. Must not search grammars.
 
 use super::graph::Graph;
 use super::synth;
 use glam::DVec2;
-use std::collections::HashMap;
+use std::collections::HashSet;
+use std::collections::hash_map::DefaultHasher;
+use std::f64::consts::TAU;
+use std::hash::{Hash, Hasher};
 
 /// How noisy (in steps) a drawing must be to be redrawn: a clean one is
 /// read as it is.
 pub const NOISY: f64 = 0.005;
 
-/// The graph's steps in order, each turned to the nearest multiple of δ
-/// (from the drawing's own phase) and one step long, as polylines, placed
-/// where they fit the drawing best (a similarity, least squares over the
-/// vertices); `None` when the drawing is not noisy, has no δ that divides a
-/// full turn, or when a vertex of the redrawing lies more than half a step
-/// from the drawing's (a step misread, or a drift).
+/// The most steps of δ a full turn is tried at.
+const MOST: u32 = 36;
+/// Walks kept per step (after those at one lattice point are merged).
+const BEAM: usize = 128;
+/// The same for a rough walk (merged only where their last steps agree).
+const ROUGH_BEAM: usize = 64;
+/// Steps back a rough walk's shape is compared with the drawing's over.
+const WINDOW: usize = 4;
+/// The δ walked closely, the likeliest after a rough walk.
+const SHORTLIST: usize = 4;
+/// Offsets (steps) that say nothing of δ: a lattice finer than the
+/// drawing's gains nothing by fitting its rounding (a δ such as 25.7°,
+/// not a whole part of a full turn, is as near 360/14 as a finer one).
+const FINEST: f64 = 0.08;
+/// Steps between fits of the frame as a walk goes.
+const REFIT: usize = 16;
+
+/// The graph's steps in order, each one step long along a multiple of δ,
+/// as polylines placed where they fit the drawing best (a similarity,
+/// least squares over the vertices); `None` when the drawing is not noisy,
+/// when no δ that divides a full turn walks it, or when a vertex of the
+/// redrawing lies more than half a step from the drawing's.
 pub fn redrawn(g: &Graph) -> Option<Vec<Vec<DVec2>>> {
     if g.noise < NOISY || g.order.is_empty() {
         return None;
     }
-    let m = turns_round(g)?;
-    let delta = 360.0 / f64::from(m);
-    let phase = synth::phase(g, delta).unwrap_or(0.0);
-    let d = delta.to_radians();
-    // Each vertex in whole steps along multiples of δ from the first.
-    // (Vertices in the order first reached, so that the fit sums alike on
-    // every run.)
-    let mut index: HashMap<u32, usize> = HashMap::new();
-    let mut lattice: Vec<(u32, DVec2)> = Vec::new();
-    let mut place_at = |v: u32, l: DVec2| -> DVec2 {
-        let i = *index.entry(v).or_insert_with(|| {
-            lattice.push((v, l));
-            lattice.len() - 1
-        });
-        lattice[i].1
-    };
-    let mut polylines: Vec<Vec<u32>> = Vec::new();
-    let mut last = u32::MAX;
-    let origin = g.points[g.order[0].0 as usize];
-    for &(a, b) in &g.order {
-        let e = g.edge(a, b)?;
-        let from = place_at(a, (g.points[a as usize] - origin) / g.step);
-        let k = ((g.direction(e, a) - phase) / d).round();
-        place_at(b, from + DVec2::new((k * d).cos(), (k * d).sin()));
-        if a != last {
-            polylines.push(vec![a]);
-        }
-        if let Some(l) = polylines.last_mut() {
-            l.push(b);
-        }
-        last = b;
-    }
-    let pairs: Vec<(DVec2, DVec2)> = lattice
-        .iter()
-        .map(|&(v, l)| (l, g.points[v as usize]))
+    let paths = paths(g);
+    // Every δ walked roughly, the likeliest few closely.
+    let mut rough: Vec<(Lattice, Walked)> = (2..=MOST)
+        .filter_map(|m| {
+            let lattice = Lattice::new(m);
+            let w = rough(g, &paths, &lattice)?;
+            Some((lattice, w))
+        })
         .collect();
-    let place = fit(&pairs)?;
+    rough.sort_by(|a, b| a.1.bits.total_cmp(&b.1.bits));
+    rough.truncate(SHORTLIST);
+    let walk = rough
+        .into_iter()
+        .filter_map(|(lattice, w)| close(g, &paths, &lattice, w))
+        .min_by(|a, b| a.bits.total_cmp(&b.bits))?;
+    let pairs: Vec<(DVec2, DVec2)> = walk
+        .at
+        .iter()
+        .enumerate()
+        .filter_map(|(v, l)| l.map(|l| (l, g.points[v])))
+        .collect();
+    let place = Similarity::fit(&pairs)?;
     let worst = pairs
         .iter()
-        .map(|&(l, p)| place(l).distance(p))
+        .map(|&(l, p)| place.apply(l).distance(p))
         .fold(0.0, f64::max);
     if worst > 0.5 * g.step {
         return None;
     }
     Some(
-        polylines
+        paths
             .iter()
-            .map(|l| l.iter().map(|v| place(lattice[index[v]].1)).collect())
+            .map(|l| {
+                l.iter()
+                    .filter_map(|&v| walk.at[v as usize])
+                    .map(|l| place.apply(l))
+                    .collect()
+            })
             .collect(),
     )
 }
 
-/// The similarity z ↦ c + s·z (s a complex number: a turn and a scale)
-/// that puts the first of each pair nearest the second, least squares.
-fn fit(pairs: &[(DVec2, DVec2)]) -> Option<impl Fn(DVec2) -> DVec2> {
-    let n = pairs.len() as f64;
-    if n < 2.0 {
-        return None;
+/// The graph's steps in order as paths of vertices (a new path wherever a
+/// step does not start where the last ended).
+fn paths(g: &Graph) -> Vec<Vec<u32>> {
+    let mut out: Vec<Vec<u32>> = Vec::new();
+    let mut last = u32::MAX;
+    for &(a, b) in &g.order {
+        if a != last {
+            out.push(vec![a]);
+        }
+        if let Some(l) = out.last_mut() {
+            l.push(b);
+        }
+        last = b;
     }
-    let (cz, cw) = pairs
-        .iter()
-        .fold((DVec2::ZERO, DVec2::ZERO), |(a, b), (z, w)| {
-            (a + *z, b + *w)
-        });
-    let (cz, cw) = (cz / n, cw / n);
-    let (mut num, mut den) = (DVec2::ZERO, 0.0);
-    for (z, w) in pairs {
-        let (z, w) = (*z - cz, *w - cw);
-        num += DVec2::new(w.x * z.x + w.y * z.y, w.y * z.x - w.x * z.y);
-        den += z.length_squared();
-    }
-    if den <= 0.0 {
-        return None;
-    }
-    let s = num / den;
-    Some(move |p: DVec2| {
-        let z = p - cz;
-        DVec2::new(s.x * z.x - s.y * z.y, s.x * z.y + s.y * z.x) + cw
-    })
+    out
 }
 
-/// The most steps of δ a full turn is tried at.
-const MOST: u32 = 36;
+/// A walk of the drawing on a lattice.
+struct Walked {
+    /// Each vertex's lattice point (in steps).
+    at: Vec<Option<DVec2>>,
+    /// From the drawing to the lattice.
+    frame: Similarity,
+    /// How long the walk and the drawing's offsets from it are to say.
+    bits: f64,
+}
 
-/// δ as 360/m from the directions of the drawing's edges, not its turns
-/// (one noisy step spoils two turns, and the smallest turn seen is as noisy
-/// as any): each edge's direction taken m times round points the same way
-/// for every edge when δ is 360/m. Each edge counts by how surely it says
-/// its direction (an edge cut from a segment of r steps errs r times less
-/// than a one-step segment: weight r²). The clearest m wins, or the
-/// smallest of its divisors nearly as clear (δ and its halves all line up,
-/// the halves a little less clearly, m times round turning the noise
-/// further; a drawing mostly in one direction lines up nearly as well at
-/// the m beside the right one, which are no divisors of it). `None` when
-/// no m lines them up.
-fn turns_round(g: &Graph) -> Option<u32> {
-    let weight = |e: usize| f64::from(g.runs.get(e).copied().unwrap_or(1).max(1)).powi(2);
-    let total: f64 = (0..g.edges.len()).map(weight).sum::<f64>().max(1e-300);
-    let clarity = |m: u32| {
-        let mut z = DVec2::ZERO;
-        for (e, [a, _]) in g.edges.iter().enumerate() {
-            let t = g.direction(e as u32, *a) * f64::from(m);
-            z += DVec2::new(t.cos(), t.sin()) * weight(e);
-        }
-        z.length() / total
+/// The drawing walked roughly on `lattice` (its shape followed step by
+/// step, the frame fitted to the walk), or `None` when no walk stays near
+/// it.
+fn rough(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice) -> Option<Walked> {
+    let m = lattice.units.len() as f64;
+    let phase = synth::phase(g, 360.0 / m).unwrap_or(0.0);
+    let origin = g.points[*paths.first()?.first()? as usize];
+    let mut pass = Pass {
+        lattice,
+        world: &g.points,
+        frame: Similarity {
+            from: origin,
+            turn: DVec2::new((-phase).cos(), (-phase).sin()) / g.step,
+            to: DVec2::ZERO,
+        },
+        window: WINDOW,
+        bound: 1.0,
+        refit: false,
+        beam: ROUGH_BEAM,
     };
-    let all: Vec<(u32, f64)> = (2..=MOST).map(|m| (m, clarity(m))).collect();
-    let &(best, clearest) = all.iter().max_by(|a, b| a.1.total_cmp(&b.1))?;
-    if clearest < 0.3 {
-        return None;
+    let at = pass.walk(paths, &[])?;
+    Walked::new(g, paths, lattice, at)
+}
+
+/// The rough walk `w` walked again with every vertex where the drawing has
+/// it: in a frame fitted as the walk goes (near its start a rough frame
+/// errs little), then once more in the frame fitted to all of it.
+fn close(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice, mut w: Walked) -> Option<Walked> {
+    let mut pass = Pass {
+        lattice,
+        world: &g.points,
+        frame: w.frame,
+        window: 0,
+        // A few times the drawing's own noise.
+        bound: (3.5 * g.noise).clamp(0.35, 1.0),
+        refit: true,
+        beam: BEAM,
+    };
+    for refit in [true, false] {
+        pass.refit = refit;
+        w = Walked::new(g, paths, lattice, pass.walk(paths, &w.at)?)?;
+        pass.frame = w.frame;
     }
-    all.iter()
-        .find(|&&(m, c)| best % m == 0 && c >= 0.97 * clearest)
-        .map(|&(m, _)| m)
+    Some(w)
+}
+
+impl Walked {
+    /// The walk `at`, the frame that fits it best, and its description's
+    /// length: its turns (LZ78 phrases, each an earlier phrase and a turn)
+    /// and the drawing's offsets from it (a normal spread of their root
+    /// mean square per coordinate, in bits less a constant).
+    fn new(
+        g: &Graph,
+        paths: &[Vec<u32>],
+        lattice: &Lattice,
+        at: Vec<Option<DVec2>>,
+    ) -> Option<Walked> {
+        let frame = fit_to(&g.points, &at)?;
+        let (mut sum, mut n) = (0.0, 0.0);
+        for (v, l) in at.iter().enumerate() {
+            if let Some(l) = l {
+                sum += frame.apply(g.points[v]).distance_squared(*l);
+                n += 1.0;
+            }
+        }
+        let phrases = phrases(&turns(paths, &at, lattice));
+        let m = lattice.units.len() as f64;
+        let rms = (sum / n).sqrt().max(FINEST);
+        let bits = phrases * ((phrases + 1.0).log2() + m.log2()) + 2.0 * n * rms.log2();
+        Some(Walked { at, frame, bits })
+    }
+}
+
+/// The turns (0..m) of the walk `at`, path by path.
+fn turns(paths: &[Vec<u32>], at: &[Option<DVec2>], lattice: &Lattice) -> Vec<i64> {
+    let m = lattice.units.len() as i64;
+    let mut out = Vec::new();
+    for path in paths {
+        let ways: Vec<i64> = path
+            .windows(2)
+            .filter_map(|w| Some(lattice.nearest(at[w[1] as usize]? - at[w[0] as usize]?)))
+            .collect();
+        out.extend(ways.windows(2).map(|w| (w[1] - w[0]).rem_euclid(m)));
+    }
+    out
+}
+
+/// How many phrases the LZ78 parse of `s` has (a repetitive sequence has
+/// few: how much a walk's turns say beyond their grammar).
+fn phrases(s: &[i64]) -> f64 {
+    let mut seen: HashSet<&[i64]> = HashSet::new();
+    let (mut start, mut count) = (0, 0.0);
+    for end in 1..=s.len() {
+        if seen.insert(&s[start..end]) {
+            count += 1.0;
+            start = end;
+        }
+    }
+    count + (start < s.len()) as u8 as f64
+}
+
+/// The similarity that puts the drawing's vertices (`world`) nearest their
+/// lattice points (`at`).
+fn fit_to(world: &[DVec2], at: &[Option<DVec2>]) -> Option<Similarity> {
+    let pairs: Vec<(DVec2, DVec2)> = at
+        .iter()
+        .zip(world)
+        .filter_map(|(l, &p)| l.map(|l| (p, l)))
+        .collect();
+    Similarity::fit(&pairs)
+}
+
+/// The unit steps of δ = 360/m.
+struct Lattice {
+    units: Vec<DVec2>,
+    delta: f64,
+}
+
+impl Lattice {
+    fn new(m: u32) -> Lattice {
+        let delta = TAU / f64::from(m);
+        let units = (0..m)
+            .map(|k| {
+                let a = f64::from(k) * delta;
+                DVec2::new(a.cos(), a.sin())
+            })
+            .collect();
+        Lattice { units, delta }
+    }
+
+    /// The multiple of δ nearest the way of `d`.
+    fn nearest(&self, d: DVec2) -> i64 {
+        (d.y.atan2(d.x) / self.delta).round() as i64
+    }
+}
+
+/// A walk in the beam: its cost so far, and its last point in the arena.
+#[derive(Clone, Copy)]
+struct Head {
+    cost: f64,
+    at: u32,
+}
+
+/// One decoding of the drawing's paths on a lattice.
+struct Pass<'a> {
+    lattice: &'a Lattice,
+    /// The drawing's vertices (user units).
+    world: &'a [DVec2],
+    /// From the drawing to the lattice.
+    frame: Similarity,
+    /// Steps back over which a walk's shape is compared with the
+    /// drawing's; 0: its every vertex with the drawing's.
+    window: usize,
+    /// How far (steps) a walk may stray and be kept.
+    bound: f64,
+    /// Whether the frame is fitted again as the walk goes.
+    refit: bool,
+    /// Walks kept per step.
+    beam: usize,
+}
+
+impl Pass<'_> {
+    fn seen(&self, v: u32) -> DVec2 {
+        self.frame.apply(self.world[v as usize])
+    }
+
+    /// Each path walked on the lattice from where it starts (a vertex
+    /// placed before, where `prior` placed it, or the drawing's own
+    /// point), each step among the three multiples of δ nearest the step
+    /// as drawn (and the way back to the drawing), the walks that stay
+    /// within `bound` kept, the nearest chosen.
+    fn walk(&mut self, paths: &[Vec<u32>], prior: &[Option<DVec2>]) -> Option<Vec<Option<DVec2>>> {
+        let mut at: Vec<Option<DVec2>> = vec![None; self.world.len()];
+        let mut next: Vec<(f64, DVec2, u32)> = Vec::new();
+        for path in paths {
+            let first = path[0] as usize;
+            let start = at[first]
+                .or(prior.get(first).copied().flatten())
+                .unwrap_or_else(|| self.seen(path[0]));
+            // Each walk's points, back to the path's start.
+            let mut arena: Vec<(DVec2, u32)> = vec![(start, u32::MAX)];
+            let mut beam = vec![Head { cost: 0.0, at: 0 }];
+            for i in 1..path.len() {
+                if self.refit && i % REFIT == 0 {
+                    let best = beam.iter().min_by(|a, b| a.cost.total_cmp(&b.cost))?;
+                    let mut so_far = at.clone();
+                    place(&mut so_far, &path[..=i - 1], &arena, best.at);
+                    self.frame = fit_to(self.world, &so_far)?;
+                }
+                next.clear();
+                for h in &beam {
+                    self.steps(path, i, &at, &arena, *h, &mut next);
+                }
+                if next.is_empty() {
+                    return None;
+                }
+                beam = keep(&mut next, &mut arena, self.window.max(1), self.beam);
+            }
+            let best = beam.iter().min_by(|a, b| a.cost.total_cmp(&b.cost))?;
+            place(&mut at, path, &arena, best.at);
+        }
+        Some(at)
+    }
+
+    /// The steps walk `h` may take to vertex `i` of `path`, into `next`.
+    fn steps(
+        &self,
+        path: &[u32],
+        i: usize,
+        at: &[Option<DVec2>],
+        arena: &[(DVec2, u32)],
+        h: Head,
+        next: &mut Vec<(f64, DVec2, u32)>,
+    ) {
+        let b = path[i];
+        let (from, seen) = (arena[h.at as usize].0, self.seen(b));
+        let drawn = self.lattice.nearest(seen - self.seen(path[i - 1]));
+        let back = self.lattice.nearest(seen - from);
+        let m = self.lattice.units.len() as i64;
+        let mut tried = [i64::MAX; 6];
+        let ways = [drawn, drawn - 1, drawn + 1, back, back - 1, back + 1];
+        // A walk compared by shape has no way back to take.
+        let ways = if self.window > 0 {
+            &ways[..3]
+        } else {
+            &ways[..]
+        };
+        for (j, k) in ways.iter().map(|k| k.rem_euclid(m)).enumerate() {
+            if tried.contains(&k) {
+                continue;
+            }
+            tried[j] = k;
+            let p = from + self.lattice.units[k as usize];
+            // A vertex placed before is where the walk must come back to.
+            if at[b as usize].is_some_and(|q| q.distance(p) > 1e-6) {
+                continue;
+            }
+            let off = if self.window > 0 {
+                let w = self.window.min(i);
+                let before = back_by(arena, h.at, w - 1);
+                (p - before).distance(seen - self.seen(path[i - w]))
+            } else {
+                p.distance(seen)
+            };
+            if off <= self.bound {
+                next.push((h.cost + off * off, p, h.at));
+            }
+        }
+    }
+}
+
+/// Places `path`'s vertices where the walk ending at arena entry `h` has
+/// them (a vertex placed before keeps its place).
+fn place(at: &mut [Option<DVec2>], path: &[u32], arena: &[(DVec2, u32)], mut h: u32) {
+    let mut points = Vec::with_capacity(path.len());
+    while h != u32::MAX {
+        points.push(arena[h as usize].0);
+        h = arena[h as usize].1;
+    }
+    for (&v, p) in path.iter().zip(points.into_iter().rev()) {
+        at[v as usize].get_or_insert(p);
+    }
+}
+
+/// The walk's point `n` steps before arena entry `h`.
+fn back_by(arena: &[(DVec2, u32)], mut h: u32, n: usize) -> DVec2 {
+    for _ in 0..n {
+        h = arena[h as usize].1;
+    }
+    arena[h as usize].0
+}
+
+/// The cheapest walk to each place in `next` (its point and the
+/// `depth − 1` before it: walks alike there cost alike from there on),
+/// the `beam` cheapest of them, entered in the arena.
+fn keep(
+    next: &mut [(f64, DVec2, u32)],
+    arena: &mut Vec<(DVec2, u32)>,
+    depth: usize,
+    beam: usize,
+) -> Vec<Head> {
+    let mut keyed: Vec<(u64, f64, DVec2, u32)> = next
+        .iter()
+        .map(|&(cost, p, parent)| {
+            let mut h = DefaultHasher::new();
+            let mut q = (p, parent);
+            for _ in 0..depth {
+                ((q.0.x * 1e6).round() as i64, (q.0.y * 1e6).round() as i64).hash(&mut h);
+                if q.1 == u32::MAX {
+                    break;
+                }
+                q = arena[q.1 as usize];
+            }
+            (h.finish(), cost, p, parent)
+        })
+        .collect();
+    keyed.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    keyed.dedup_by_key(|k| k.0);
+    keyed.sort_by(|a, b| a.1.total_cmp(&b.1));
+    keyed.truncate(beam);
+    keyed
+        .into_iter()
+        .map(|(_, cost, p, parent)| {
+            arena.push((p, parent));
+            Head {
+                cost,
+                at: arena.len() as u32 - 1,
+            }
+        })
+        .collect()
+}
+
+/// The similarity z ↦ to + turn·(z − from), `turn` a complex number (a
+/// turn and a scale).
+#[derive(Clone, Copy)]
+struct Similarity {
+    from: DVec2,
+    turn: DVec2,
+    to: DVec2,
+}
+
+impl Similarity {
+    fn apply(&self, p: DVec2) -> DVec2 {
+        let (z, s) = (p - self.from, self.turn);
+        DVec2::new(s.x * z.x - s.y * z.y, s.x * z.y + s.y * z.x) + self.to
+    }
+
+    /// The similarity that puts the first of each pair nearest the second,
+    /// least squares.
+    fn fit(pairs: &[(DVec2, DVec2)]) -> Option<Similarity> {
+        let n = pairs.len() as f64;
+        if n < 2.0 {
+            return None;
+        }
+        let (cz, cw) = pairs
+            .iter()
+            .fold((DVec2::ZERO, DVec2::ZERO), |(a, b), (z, w)| {
+                (a + *z, b + *w)
+            });
+        let (cz, cw) = (cz / n, cw / n);
+        let (mut num, mut den) = (DVec2::ZERO, 0.0);
+        for (z, w) in pairs {
+            let (z, w) = (*z - cz, *w - cw);
+            num += DVec2::new(w.x * z.x + w.y * z.y, w.y * z.x - w.x * z.y);
+            den += z.length_squared();
+        }
+        (den > 0.0).then(|| Similarity {
+            from: cz,
+            turn: num / den,
+            to: cw,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `F -> F+F-F` at 22.5° to `depth`, from the origin heading up: its
+    /// vertices.
+    fn curve(depth: u32) -> Vec<DVec2> {
+        let mut s = String::from("F");
+        for _ in 0..depth {
+            s = s.replace('F', "F+F-F");
+        }
+        let (mut at, mut heading) = (DVec2::ZERO, 90.0f64);
+        let mut out = vec![at];
+        for c in s.chars() {
+            match c {
+                '+' => heading += 22.5,
+                '-' => heading -= 22.5,
+                _ => {
+                    at += DVec2::new(heading.to_radians().cos(), heading.to_radians().sin());
+                    out.push(at);
+                }
+            }
+        }
+        out
+    }
+
+    /// The turns between the steps of `line`, in tenths of a degree.
+    fn turns(line: &[DVec2]) -> Vec<i64> {
+        line.windows(3)
+            .map(|w| {
+                let (a, b) = (w[1] - w[0], w[2] - w[1]);
+                (a.perp_dot(b).atan2(a.dot(b)).to_degrees() * 10.0).round() as i64
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_curve_jittered_by_a_seventh_of_a_step_at_22_5_degrees_is_walked_as_drawn() {
+        let clean = curve(5);
+        // Every vertex moved by up to 0.15 of a step (a fixed sequence);
+        // one-step directions are then misread by rounding alone.
+        let mut state = 12345u64;
+        let mut unit = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let noisy: Vec<DVec2> = clean
+            .iter()
+            .map(|&p| {
+                let (r, a) = (0.15 * unit().sqrt(), unit() * TAU);
+                (p + DVec2::new(a.cos(), a.sin()) * r) * 10.0
+            })
+            .collect();
+        let misread = clean
+            .windows(2)
+            .zip(noisy.windows(2))
+            .filter(|(c, n)| {
+                let (c, n) = (c[1] - c[0], n[1] - n[0]);
+                (c.angle_to(n).to_degrees().abs()) > 11.25
+            })
+            .count();
+        assert!(misread > 0, "the jitter misreads some steps on their own");
+        let g = super::super::graph::build(&[noisy], 1).expect("a stroke graph");
+        let walk = redrawn(&g).expect("a redrawing");
+        assert_eq!(walk.len(), 1);
+        assert_eq!(turns(&walk[0]), turns(&clean));
+    }
 }
