@@ -35,9 +35,7 @@ use super::graph::Graph;
 use super::synth;
 use glam::DVec2;
 use std::collections::HashSet;
-use std::collections::hash_map::DefaultHasher;
 use std::f64::consts::TAU;
-use std::hash::{Hash, Hasher};
 
 /// How noisy (in steps) a drawing must be to be redrawn: a clean one is
 /// read as it is.
@@ -51,6 +49,11 @@ const BEAM: usize = 128;
 const ROUGH_BEAM: usize = 64;
 /// Steps back a rough walk's shape is compared with the drawing's over.
 const WINDOW: usize = 4;
+/// Steps of a long drawing every δ is walked over roughly (its start);
+/// the `LIKELY` likeliest δ are then walked over all of it.
+const PREFIX: usize = 256;
+/// See `PREFIX`.
+const LIKELY: usize = 8;
 /// The δ walked closely, the likeliest after a rough walk.
 const SHORTLIST: usize = 4;
 /// Offsets (steps) that say nothing of δ: a lattice finer than the
@@ -70,9 +73,19 @@ pub fn redrawn(g: &Graph) -> Option<Vec<Vec<DVec2>>> {
         return None;
     }
     let paths = paths(g);
-    // Every δ walked roughly, the likeliest few closely.
-    let mut rough: Vec<(Lattice, Walked)> = (2..=MOST)
-        .filter_map(|m| {
+    // Every δ walked roughly over the drawing's first steps, the likeliest
+    // roughly over all of it, the likeliest of those closely.
+    let start = prefix(&paths, PREFIX);
+    let mut likely: Vec<(f64, u32)> = (2..=MOST)
+        .filter_map(|m| Some((rough(g, &start, &Lattice::new(m))?.bits, m)))
+        .collect();
+    likely.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if g.order.len() > PREFIX {
+        likely.truncate(LIKELY);
+    }
+    let mut rough: Vec<(Lattice, Walked)> = likely
+        .into_iter()
+        .filter_map(|(_, m)| {
             let lattice = Lattice::new(m);
             let w = rough(g, &paths, &lattice)?;
             Some((lattice, w))
@@ -109,6 +122,20 @@ pub fn redrawn(g: &Graph) -> Option<Vec<Vec<DVec2>>> {
             })
             .collect(),
     )
+}
+
+/// The first `n` steps of `paths` (all of them when there are fewer).
+fn prefix(paths: &[Vec<u32>], mut n: usize) -> Vec<Vec<u32>> {
+    let mut out = Vec::new();
+    for p in paths {
+        if n == 0 {
+            break;
+        }
+        let take = (p.len() - 1).min(n);
+        out.push(p[..=take].to_vec());
+        n -= take;
+    }
+    out
 }
 
 /// The graph's steps in order as paths of vertices (a new path wherever a
@@ -328,8 +355,11 @@ impl Pass<'_> {
                     self.frame = fit_to(self.world, &so_far)?;
                 }
                 next.clear();
+                let drawn = self
+                    .lattice
+                    .nearest(self.seen(path[i]) - self.seen(path[i - 1]));
                 for h in &beam {
-                    self.steps(path, i, &at, &arena, *h, &mut next);
+                    self.steps(path, i, drawn, &at, &arena, *h, &mut next);
                 }
                 if next.is_empty() {
                     return None;
@@ -342,11 +372,14 @@ impl Pass<'_> {
         Some(at)
     }
 
-    /// The steps walk `h` may take to vertex `i` of `path`, into `next`.
+    /// The steps walk `h` may take to vertex `i` of `path`, into `next`
+    /// (`drawn`: the multiple of δ nearest the step as drawn).
+    #[allow(clippy::too_many_arguments)]
     fn steps(
         &self,
         path: &[u32],
         i: usize,
+        drawn: i64,
         at: &[Option<DVec2>],
         arena: &[(DVec2, u32)],
         h: Head,
@@ -354,16 +387,14 @@ impl Pass<'_> {
     ) {
         let b = path[i];
         let (from, seen) = (arena[h.at as usize].0, self.seen(b));
-        let drawn = self.lattice.nearest(seen - self.seen(path[i - 1]));
-        let back = self.lattice.nearest(seen - from);
         let m = self.lattice.units.len() as i64;
         let mut tried = [i64::MAX; 6];
-        let ways = [drawn, drawn - 1, drawn + 1, back, back - 1, back + 1];
         // A walk compared by shape has no way back to take.
         let ways = if self.window > 0 {
-            &ways[..3]
+            &[drawn, drawn - 1, drawn + 1][..]
         } else {
-            &ways[..]
+            let back = self.lattice.nearest(seen - from);
+            &[drawn, drawn - 1, drawn + 1, back, back - 1, back + 1][..]
         };
         for (j, k) in ways.iter().map(|k| k.rem_euclid(m)).enumerate() {
             if tried.contains(&k) {
@@ -419,25 +450,54 @@ fn keep(
     depth: usize,
     beam: usize,
 ) -> Vec<Head> {
-    let mut keyed: Vec<(u64, f64, DVec2, u32)> = next
+    let keyed: Vec<(u64, f64, DVec2, u32)> = next
         .iter()
         .map(|&(cost, p, parent)| {
-            let mut h = DefaultHasher::new();
+            let mut key = 0u64;
             let mut q = (p, parent);
             for _ in 0..depth {
-                ((q.0.x * 1e6).round() as i64, (q.0.y * 1e6).round() as i64).hash(&mut h);
+                key = mix(mix(key, micro(q.0.x)), micro(q.0.y));
                 if q.1 == u32::MAX {
                     break;
                 }
                 q = arena[q.1 as usize];
             }
-            (h.finish(), cost, p, parent)
+            (key, cost, p, parent)
         })
         .collect();
-    keyed.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    keyed.dedup_by_key(|k| k.0);
-    keyed.sort_by(|a, b| a.1.total_cmp(&b.1));
-    keyed.truncate(beam);
+    // The cheapest of each key, in an open-addressed table.
+    let size = (2 * keyed.len()).next_power_of_two();
+    let mut table: Vec<u32> = vec![u32::MAX; size];
+    let mut kept: Vec<(u64, f64, DVec2, u32)> = Vec::with_capacity(keyed.len());
+    for k in keyed {
+        let mut slot = (k.0 as usize) & (size - 1);
+        loop {
+            match table[slot] {
+                u32::MAX => {
+                    table[slot] = kept.len() as u32;
+                    kept.push(k);
+                    break;
+                }
+                j if kept[j as usize].0 == k.0 => {
+                    let old = &mut kept[j as usize];
+                    if k.1.total_cmp(&old.1).then(k.3.cmp(&old.3)).is_lt() {
+                        *old = k;
+                    }
+                    break;
+                }
+                _ => slot = (slot + 1) & (size - 1),
+            }
+        }
+    }
+    let mut keyed = kept;
+    let by_cost = |a: &(u64, f64, DVec2, u32), b: &(u64, f64, DVec2, u32)| {
+        a.1.total_cmp(&b.1).then(a.0.cmp(&b.0))
+    };
+    if keyed.len() > beam {
+        keyed.select_nth_unstable_by(beam, by_cost);
+        keyed.truncate(beam);
+    }
+    keyed.sort_unstable_by(by_cost);
     keyed
         .into_iter()
         .map(|(_, cost, p, parent)| {
@@ -448,6 +508,17 @@ fn keep(
             }
         })
         .collect()
+}
+
+/// A coordinate in millionths of a step, rounded (a lattice point reached
+/// by two walks differs by rounding alone).
+fn micro(x: f64) -> u64 {
+    (x * 1e6 + 0.5f64.copysign(x)) as i64 as u64
+}
+
+/// `key` and `x` mixed into one hash (a multiply and a rotation).
+fn mix(key: u64, x: u64) -> u64 {
+    (key ^ x).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(29)
 }
 
 /// The similarity z ↦ to + turn·(z − from), `turn` a complex number (a
