@@ -19,10 +19,19 @@
 //!   frame fitted again as the walk goes (near its start a rough frame errs
 //!   little), then once more in the frame fitted to all of it.
 //!
+//! A walk's cost in the beam is in bits: its offsets from the drawing (a
+//! normal spread of the drawing's noise) and its turns, each said after
+//! the walk's turns so far (an adaptive code over their sizes). On a fine
+//! lattice many walks stay as near a noisy drawing as the turtle's; the
+//! turtle's turns are few kinds, and a walk that follows the noise pays
+//! for its turns.
+//!
 //! δ is the one whose walk is the shortest to say with the drawing's
 //! offsets from it (its turns' LZ78 phrases and the offsets' spread): a
 //! finer lattice fits the noise a little better but its walk repeats
-//! itself less, as a coarser one's fits worse. A vertex keeps the position
+//! itself less, as a coarser one's fits worse. LZ78 is a loose measure of
+//! a grammar's size, so the two shortest redrawings are given back, and
+//! the grammar search tells them apart. A vertex keeps the position
 //! it got first, so a branch starts where its parent passed and a curve
 //! that comes back to a vertex must come back to its lattice point. The
 //! redrawing is refused when a vertex of it lies more than half a step
@@ -54,6 +63,14 @@ const WINDOW: usize = 4;
 const PREFIX: usize = 256;
 /// See `PREFIX`.
 const LIKELY: usize = 8;
+/// Redrawings given back, the likeliest first: a finer δ whose walk
+/// follows the noise may say the drawing in fewer bits than the turtle's
+/// (its walk's turns are said by their LZ78 phrases, a loose bound on a
+/// grammar's), and only the grammar search can tell them apart.
+const ALTERNATIVES: usize = 2;
+/// Turns of the frame (parts of δ) a rough walk starts from: the
+/// drawing's mean direction says little of it at a small δ under noise.
+const PHASES: u32 = 2;
 /// The δ walked closely, the likeliest after a rough walk.
 const SHORTLIST: usize = 4;
 /// Offsets (steps) that say nothing of δ: a lattice finer than the
@@ -65,19 +82,29 @@ const REFIT: usize = 16;
 
 /// The graph's steps in order, each one step long along a multiple of δ,
 /// as polylines placed where they fit the drawing best (a similarity,
-/// least squares over the vertices); `None` when the drawing is not noisy,
-/// when no δ that divides a full turn walks it, or when a vertex of the
-/// redrawing lies more than half a step from the drawing's.
-pub fn redrawn(g: &Graph) -> Option<Vec<Vec<DVec2>>> {
+/// least squares over the vertices): the likeliest `ALTERNATIVES`
+/// redrawings, none when the drawing is not noisy, when no δ that divides
+/// a full turn walks it, or when a vertex of every redrawing lies more
+/// than half a step from the drawing's.
+pub fn redrawn(g: &Graph) -> Vec<Vec<Vec<DVec2>>> {
     if g.noise < NOISY || g.order.is_empty() {
-        return None;
+        return Vec::new();
     }
     let paths = paths(g);
     // Every δ walked roughly over the drawing's first steps, the likeliest
     // roughly over all of it, the likeliest of those closely.
     let start = prefix(&paths, PREFIX);
-    let mut likely: Vec<(f64, u32)> = (2..=MOST)
-        .filter_map(|m| Some((rough(g, &start, &Lattice::new(m))?.bits, m)))
+    let mut likely: Vec<(f64, u32, f64)> = (2..=MOST)
+        .filter_map(|m| {
+            let lattice = Lattice::new(m);
+            let phase = synth::phase(g, 360.0 / f64::from(m)).unwrap_or(0.0);
+            (0..PHASES)
+                .filter_map(|j| {
+                    let phase = phase + f64::from(j) * lattice.delta / f64::from(PHASES);
+                    Some((rough(g, &start, &lattice, phase)?.bits, m, phase))
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+        })
         .collect();
     likely.sort_by(|a, b| a.0.total_cmp(&b.0));
     if g.order.len() > PREFIX {
@@ -85,24 +112,35 @@ pub fn redrawn(g: &Graph) -> Option<Vec<Vec<DVec2>>> {
     }
     let mut rough: Vec<(Lattice, Walked)> = likely
         .into_iter()
-        .filter_map(|(_, m)| {
+        .filter_map(|(_, m, phase)| {
             let lattice = Lattice::new(m);
-            let w = rough(g, &paths, &lattice)?;
+            let w = rough(g, &paths, &lattice, phase)?;
             Some((lattice, w))
         })
         .collect();
     rough.sort_by(|a, b| a.1.bits.total_cmp(&b.1.bits));
     rough.truncate(SHORTLIST);
-    let walk = rough
+    let mut walks: Vec<Walked> = rough
         .into_iter()
         .filter_map(|(lattice, w)| close(g, &paths, &lattice, w))
-        .min_by(|a, b| a.bits.total_cmp(&b.bits))?;
-    let pairs: Vec<(DVec2, DVec2)> = walk
-        .at
-        .iter()
-        .enumerate()
-        .filter_map(|(v, l)| l.map(|l| (l, g.points[v])))
         .collect();
+    walks.sort_by(|a, b| a.bits.total_cmp(&b.bits));
+    walks
+        .iter()
+        .filter_map(|w| placed(g, &paths, w))
+        .take(ALTERNATIVES)
+        .collect()
+}
+
+/// The walk `w` placed where it fits the drawing best, as polylines;
+/// `None` when a vertex of it lies more than half a step from the
+/// drawing's.
+fn placed(g: &Graph, paths: &[Vec<u32>], w: &Walked) -> Option<Vec<Vec<DVec2>>> {
+    let pairs: Vec<(DVec2, DVec2)> =
+        w.at.iter()
+            .enumerate()
+            .filter_map(|(v, l)| l.map(|l| (l, g.points[v])))
+            .collect();
     let place = Similarity::fit(&pairs)?;
     let worst = pairs
         .iter()
@@ -116,12 +154,18 @@ pub fn redrawn(g: &Graph) -> Option<Vec<Vec<DVec2>>> {
             .iter()
             .map(|l| {
                 l.iter()
-                    .filter_map(|&v| walk.at[v as usize])
+                    .filter_map(|&v| w.at[v as usize])
                     .map(|l| place.apply(l))
                     .collect()
             })
             .collect(),
     )
+}
+
+/// The spread (steps) a walk's offsets from the drawing are costed at:
+/// the drawing's noise, but not below a twentieth of a step.
+fn sigma(g: &Graph) -> f64 {
+    g.noise.max(0.05)
 }
 
 /// The first `n` steps of `paths` (all of them when there are fewer).
@@ -168,9 +212,7 @@ struct Walked {
 /// The drawing walked roughly on `lattice` (its shape followed step by
 /// step, the frame fitted to the walk), or `None` when no walk stays near
 /// it.
-fn rough(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice) -> Option<Walked> {
-    let m = lattice.units.len() as f64;
-    let phase = synth::phase(g, 360.0 / m).unwrap_or(0.0);
+fn rough(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice, phase: f64) -> Option<Walked> {
     let origin = g.points[*paths.first()?.first()? as usize];
     let mut pass = Pass {
         lattice,
@@ -184,6 +226,7 @@ fn rough(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice) -> Option<Walked> {
         bound: 1.0,
         refit: false,
         beam: ROUGH_BEAM,
+        sigma: sigma(g),
     };
     let at = pass.walk(paths, &[])?;
     Walked::new(g, paths, lattice, at)
@@ -202,6 +245,7 @@ fn close(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice, mut w: Walked) -> Opt
         bound: (3.5 * g.noise).clamp(0.35, 1.0),
         refit: true,
         beam: BEAM,
+        sigma: sigma(g),
     };
     for refit in [true, false] {
         pass.refit = refit;
@@ -301,11 +345,55 @@ impl Lattice {
     }
 }
 
-/// A walk in the beam: its cost so far, and its last point in the arena.
+/// A walk in the beam: its cost so far (bits), its last point in the
+/// arena, the way (multiple of δ) of its last step and the count of its
+/// turns so far.
 #[derive(Clone, Copy)]
 struct Head {
     cost: f64,
     at: u32,
+    way: i64,
+    turns: Turns,
+}
+
+/// A walk's turns so far, counted by size (0, ±1, ±2, ±3, more).
+#[derive(Clone, Copy, Default)]
+struct Turns([u16; TURN_KINDS]);
+
+/// The kinds of turn a walk's turns are counted by.
+const TURN_KINDS: usize = 8;
+
+impl Turns {
+    fn kind(turn: i64) -> usize {
+        match turn {
+            -3..=3 => (turn + 3) as usize,
+            _ => TURN_KINDS - 1,
+        }
+    }
+
+    /// Bits to say a turn of kind `k` after these (an adaptive code: a
+    /// walk whose turns are few kinds says them in fewer bits).
+    fn bits(&self, k: usize) -> f64 {
+        let total: f64 = self.0.iter().map(|&c| f64::from(c)).sum();
+        let p = (f64::from(self.0[k]) + 0.5) / (total + 0.5 * TURN_KINDS as f64);
+        -p.log2()
+    }
+
+    fn with(mut self, k: usize) -> Turns {
+        self.0[k] = self.0[k].saturating_add(1);
+        self
+    }
+}
+
+/// A step a walk may take: its cost, point, parent in the arena, way and
+/// turns.
+#[derive(Clone, Copy)]
+struct Step {
+    cost: f64,
+    p: DVec2,
+    parent: u32,
+    way: i64,
+    turns: Turns,
 }
 
 /// One decoding of the drawing's paths on a lattice.
@@ -324,6 +412,9 @@ struct Pass<'a> {
     refit: bool,
     /// Walks kept per step.
     beam: usize,
+    /// The drawing's noise (steps): an offset `d` costs d²/2σ² nats, a
+    /// turn the bits to say it after the walk's turns so far.
+    sigma: f64,
 }
 
 impl Pass<'_> {
@@ -338,7 +429,7 @@ impl Pass<'_> {
     /// within `bound` kept, the nearest chosen.
     fn walk(&mut self, paths: &[Vec<u32>], prior: &[Option<DVec2>]) -> Option<Vec<Option<DVec2>>> {
         let mut at: Vec<Option<DVec2>> = vec![None; self.world.len()];
-        let mut next: Vec<(f64, DVec2, u32)> = Vec::new();
+        let mut next: Vec<Step> = Vec::new();
         for path in paths {
             let first = path[0] as usize;
             let start = at[first]
@@ -346,7 +437,12 @@ impl Pass<'_> {
                 .unwrap_or_else(|| self.seen(path[0]));
             // Each walk's points, back to the path's start.
             let mut arena: Vec<(DVec2, u32)> = vec![(start, u32::MAX)];
-            let mut beam = vec![Head { cost: 0.0, at: 0 }];
+            let mut beam = vec![Head {
+                cost: 0.0,
+                at: 0,
+                way: i64::MIN,
+                turns: Turns::default(),
+            }];
             for i in 1..path.len() {
                 if self.refit && i % REFIT == 0 {
                     let best = beam.iter().min_by(|a, b| a.cost.total_cmp(&b.cost))?;
@@ -383,7 +479,7 @@ impl Pass<'_> {
         at: &[Option<DVec2>],
         arena: &[(DVec2, u32)],
         h: Head,
-        next: &mut Vec<(f64, DVec2, u32)>,
+        next: &mut Vec<Step>,
     ) {
         let b = path[i];
         let (from, seen) = (arena[h.at as usize].0, self.seen(b));
@@ -414,7 +510,21 @@ impl Pass<'_> {
                 p.distance(seen)
             };
             if off <= self.bound {
-                next.push((h.cost + off * off, p, h.at));
+                let (turn, turns) = if h.way == i64::MIN {
+                    (0.0, h.turns)
+                } else {
+                    let t = (k - h.way + m / 2).rem_euclid(m) - m / 2;
+                    let kind = Turns::kind(t);
+                    (h.turns.bits(kind), h.turns.with(kind))
+                };
+                let nats = off * off / (2.0 * self.sigma * self.sigma);
+                next.push(Step {
+                    cost: h.cost + nats / std::f64::consts::LN_2 + turn,
+                    p,
+                    parent: h.at,
+                    way: k,
+                    turns,
+                });
             }
         }
     }
@@ -444,17 +554,12 @@ fn back_by(arena: &[(DVec2, u32)], mut h: u32, n: usize) -> DVec2 {
 /// The cheapest walk to each place in `next` (its point and the
 /// `depth − 1` before it: walks alike there cost alike from there on),
 /// the `beam` cheapest of them, entered in the arena.
-fn keep(
-    next: &mut [(f64, DVec2, u32)],
-    arena: &mut Vec<(DVec2, u32)>,
-    depth: usize,
-    beam: usize,
-) -> Vec<Head> {
-    let keyed: Vec<(u64, f64, DVec2, u32)> = next
+fn keep(next: &mut [Step], arena: &mut Vec<(DVec2, u32)>, depth: usize, beam: usize) -> Vec<Head> {
+    let keyed: Vec<(u64, Step)> = next
         .iter()
-        .map(|&(cost, p, parent)| {
+        .map(|&s| {
             let mut key = 0u64;
-            let mut q = (p, parent);
+            let mut q = (s.p, s.parent);
             for _ in 0..depth {
                 key = mix(mix(key, micro(q.0.x)), micro(q.0.y));
                 if q.1 == u32::MAX {
@@ -462,13 +567,13 @@ fn keep(
                 }
                 q = arena[q.1 as usize];
             }
-            (key, cost, p, parent)
+            (key, s)
         })
         .collect();
     // The cheapest of each key, in an open-addressed table.
     let size = (2 * keyed.len()).next_power_of_two();
     let mut table: Vec<u32> = vec![u32::MAX; size];
-    let mut kept: Vec<(u64, f64, DVec2, u32)> = Vec::with_capacity(keyed.len());
+    let mut kept: Vec<(u64, Step)> = Vec::with_capacity(keyed.len());
     for k in keyed {
         let mut slot = (k.0 as usize) & (size - 1);
         loop {
@@ -480,7 +585,12 @@ fn keep(
                 }
                 j if kept[j as usize].0 == k.0 => {
                     let old = &mut kept[j as usize];
-                    if k.1.total_cmp(&old.1).then(k.3.cmp(&old.3)).is_lt() {
+                    if k.1
+                        .cost
+                        .total_cmp(&old.1.cost)
+                        .then(k.1.parent.cmp(&old.1.parent))
+                        .is_lt()
+                    {
                         *old = k;
                     }
                     break;
@@ -490,9 +600,8 @@ fn keep(
         }
     }
     let mut keyed = kept;
-    let by_cost = |a: &(u64, f64, DVec2, u32), b: &(u64, f64, DVec2, u32)| {
-        a.1.total_cmp(&b.1).then(a.0.cmp(&b.0))
-    };
+    let by_cost =
+        |a: &(u64, Step), b: &(u64, Step)| a.1.cost.total_cmp(&b.1.cost).then(a.0.cmp(&b.0));
     if keyed.len() > beam {
         keyed.select_nth_unstable_by(beam, by_cost);
         keyed.truncate(beam);
@@ -500,11 +609,13 @@ fn keep(
     keyed.sort_unstable_by(by_cost);
     keyed
         .into_iter()
-        .map(|(_, cost, p, parent)| {
-            arena.push((p, parent));
+        .map(|(_, s)| {
+            arena.push((s.p, s.parent));
             Head {
-                cost,
+                cost: s.cost,
                 at: arena.len() as u32 - 1,
+                way: s.way,
+                turns: s.turns,
             }
         })
         .collect()
@@ -518,7 +629,9 @@ fn micro(x: f64) -> u64 {
 
 /// `key` and `x` mixed into one hash (a multiply and a rotation).
 fn mix(key: u64, x: u64) -> u64 {
-    (key ^ x).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(29)
+    (key ^ x)
+        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        .rotate_left(29)
 }
 
 /// The similarity z ↦ to + turn·(z − from), `turn` a complex number (a
@@ -628,7 +741,7 @@ mod tests {
             .count();
         assert!(misread > 0, "the jitter misreads some steps on their own");
         let g = super::super::graph::build(&[noisy], 1).expect("a stroke graph");
-        let walk = redrawn(&g).expect("a redrawing");
+        let walk = redrawn(&g).into_iter().next().expect("a redrawing");
         assert_eq!(walk.len(), 1);
         assert_eq!(turns(&walk[0]), turns(&clean));
     }

@@ -152,10 +152,10 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
     // walks a turtle could have drawn it in, from its likeliest roots; a
     // noisy one as the turtle meant it, checked against it as it is.
     let mut again: Vec<(Vec<Vec<DVec2>>, Option<f64>)> = Vec::new();
-    let ideal = graph.as_ref().and_then(ideal::redrawn);
+    let ideal = graph.as_ref().map(ideal::redrawn).unwrap_or_default();
     if let Some(g) = &graph {
         again.extend(walk::trees(g).into_iter().map(|w| (w, None)));
-        again.extend(ideal.clone().map(|w| (w, None)));
+        again.extend(ideal.iter().cloned().map(|w| (w, None)));
     }
     let as_drawn: Vec<(DVec2, DVec2)> = lines
         .iter()
@@ -193,13 +193,10 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
     // A noisy drawing as the turtle meant it first (its stroke graph is
     // clean), then as it is.
     let t = Instant::now();
-    let by_graph = match ideal
-        .as_deref()
-        .map(|w| from_graph(w, name, &opts.graph, &mut stats))
-    {
-        Some(Ok(found)) => Ok(found),
-        _ => from_graph(&lines, name, &opts.graph, &mut stats),
-    };
+    let by_graph = ideal
+        .iter()
+        .find_map(|w| from_graph(w, name, &opts.graph, &mut stats).ok())
+        .map_or_else(|| from_graph(&lines, name, &opts.graph, &mut stats), Ok);
     stats.search_ms += ms(t);
     match by_graph {
         Ok(found) => return Lines::Found(found),
