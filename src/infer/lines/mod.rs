@@ -192,11 +192,17 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
     // whatever the order, direction and splitting of its paths.
     // A noisy drawing as the turtle meant it first (its stroke graph is
     // clean), then as it is.
+    // One count of work for all of them (each redrawing, the drawing as
+    // it is): more redrawings do not make a failing drawing slower.
     let t = Instant::now();
+    let mut left = opts.graph.total;
     let by_graph = ideal
         .iter()
-        .find_map(|w| from_graph(w, name, &opts.graph, &mut stats).ok())
-        .map_or_else(|| from_graph(&lines, name, &opts.graph, &mut stats), Ok);
+        .find_map(|w| from_graph(w, name, &opts.graph, &mut left, &mut stats).ok())
+        .map_or_else(
+            || from_graph(&lines, name, &opts.graph, &mut left, &mut stats),
+            Ok,
+        );
     stats.search_ms += ms(t);
     match by_graph {
         Ok(found) => return Lines::Found(found),
@@ -322,11 +328,12 @@ fn by_reading(
 /// A grammar that draws every segment of the drawing's stroke graph once
 /// (`synth`), checked as every candidate is: its walk read as steps, the
 /// grammar matched against them and redrawn by the library. `Err(true)`
-/// when the budget ended the search.
+/// when the budget ended the search. The searches spend from `left`.
 fn from_graph(
     lines: &[Vec<DVec2>],
     name: &str,
     opts: &synth::Limits,
+    left: &mut u64,
     stats: &mut Stats,
 ) -> Result<Box<Inferred>, bool> {
     let deadline = opts.deadline;
@@ -347,11 +354,18 @@ fn from_graph(
         } else if noisy {
             continue;
         }
+        if *left == 0 {
+            return Err(true);
+        }
         let limits = synth::Limits {
             brackets: branches,
+            total: *left,
             ..*opts
         };
-        let Some(found) = synth::search(&g, &limits).map(|f| f.squared().unfolded()) else {
+        let mut spent = 0;
+        let found = synth::search_counted(&g, &limits, &mut spent);
+        *left = left.saturating_sub(spent);
+        let Some(found) = found.map(|f| f.squared().unfolded()) else {
             continue;
         };
         stats.candidates += 1;

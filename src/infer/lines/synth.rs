@@ -1039,6 +1039,12 @@ impl Shared<'_> {
 /// following the paths' order (forwards, then backwards), which a drawing
 /// saved in the order a turtle drew it allows, then over the graph alone.
 pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
+    search_counted(g, limits, &mut 0)
+}
+
+/// `search`, adding the work it spent to `spent` (each of its two stages
+/// may spend up to `limits.total`).
+pub fn search_counted(g: &Graph, limits: &Limits, spent: &mut u64) -> Option<Found> {
     if g.edges.is_empty() || g.edges.len() > MAX_EDGES || g.order.len() > MAX_EDGES {
         return None;
     }
@@ -1056,26 +1062,37 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
         used: vec![false; g.edges.len()],
     };
     let n_of = |steps: usize| ((steps as f64).log2().ceil() as u32 + 1).clamp(2, 14);
-    if let Some(found) = in_order(&mut shared, n_of(g.order.len())) {
-        return Some(found);
+    let found = in_order(&mut shared, n_of(g.order.len()));
+    *spent += shared.spent;
+    if found.is_some() {
+        return found;
     }
     // The search over the graph alone has a total of its own: a drawing
     // whose paths come in another order fails the first quickly, and one
     // that came in order but is not explained should not take the second's.
     shared.spent = 0;
+    let found = over_all(&mut shared, n_of);
+    *spent += shared.spent;
+    found
+}
+
+/// The search over the graph alone: along a curve, or out from where its
+/// paths touch, then from every start.
+fn over_all(shared: &mut Shared, n_of: impl Fn(usize) -> u32) -> Option<Found> {
+    let g = shared.g;
     let n_max = n_of(g.edges.len());
     if let Some((chain, closed)) = g.chain() {
         // One curve: its steps in order, from where its turns' blocks say
         // it starts.
         // An open curve drawn in one stroke was followed as drawn already.
         let followed = g.order.len() == chain.len() && g.order.windows(2).all(|w| w[0].1 == w[1].0);
-        if let Some(found) = along_chain(&mut shared, &chain, closed, n_max, followed) {
+        if let Some(found) = along_chain(shared, &chain, closed, n_max, followed) {
             return Some(found);
         }
         if shared.exhausted() {
             return None;
         }
-    } else if let Some(found) = touching(&mut shared) {
+    } else if let Some(found) = touching(shared) {
         return Some(found);
     }
     let starts = starts(g);
@@ -1102,13 +1119,13 @@ pub fn search(g: &Graph, limits: &Limits) -> Option<Found> {
         let total = shared.limits.total;
         shared.limits.brackets = false;
         shared.limits.total = total / 2;
-        if let Some(found) = over_graph(&mut shared, &plan, n_max) {
+        if let Some(found) = over_graph(shared, &plan, n_max) {
             return Some(found);
         }
         shared.limits.brackets = true;
         shared.limits.total = total;
     }
-    over_graph(&mut shared, &plan, n_max)
+    over_graph(shared, &plan, n_max)
 }
 
 /// The search over the graph alone, with one drawing letter, then two,
