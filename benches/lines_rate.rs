@@ -2,7 +2,7 @@
 //! the large run of `tests/it/lines_random.rs`, in release.
 //!
 //! `cargo bench --bench lines_rate -- [--per-class N] [--first SEED]
-//! [--class CLASS]… [--variant VARIANT]… [--show] [--write DIR]`
+//! [--class CLASS]… [--variant VARIANT]… [--threads N] [--show] [--write DIR]`
 //!
 //! Programs of each class (seeds SEED..SEED+N, default 0..200) are drawn
 //! by the tests' independent drawer in each variant and inferred; the table
@@ -12,7 +12,9 @@
 //! `FAIL class seed variant kind: detail | program | found`. `--show`
 //! prints each case's program text and the inferred one; `--write DIR`
 //! writes each drawing (`CLASS-SEED-VARIANT.svg`, for `lsyc infer`) and
-//! program (`CLASS-SEED.lsy`) into DIR.
+//! program (`CLASS-SEED.lsy`) into DIR. `--threads N` infers N programs at
+//! once (the counts do not change unless the time budget is reached; the
+//! times per inference then include the threads' contention).
 //!
 //! Classes: edge-1 edge-2 edge-3 node bracketed moves. Variants: clean
 //! rotated jittered split shuffled noisy.
@@ -30,6 +32,7 @@ fn main() {
     let mut classes = Vec::new();
     let mut variants = Vec::new();
     let mut show = false;
+    let mut threads = 1usize;
     let mut write: Option<std::path::PathBuf> = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -45,6 +48,7 @@ fn main() {
                 let v = value("a variant");
                 variants.push(Variant::parse(&v).unwrap_or_else(|| panic!("no variant {v}")));
             }
+            "--threads" => threads = value("a number").parse().expect("--threads N"),
             "--show" => show = true,
             "--write" => write = Some(value("a folder").into()),
             // What cargo bench passes on.
@@ -65,6 +69,7 @@ fn main() {
         first,
         per_class,
         budget: None,
+        threads,
     };
     let table = lines_gen::run(&run, &mut |case, v, o| {
         if let Some(dir) = &write {

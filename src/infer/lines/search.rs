@@ -22,7 +22,7 @@
 //! Owns: proposing candidates, within the work limits of `Limits`. Must not
 //! accept one: `grammar::matches` and the library's own derivation do.
 
-use super::grammar::{Action, Grammar, Letter, Sym, turn_syms};
+use super::grammar::{Action, Grammar, Letter, Outcome, Sym, matches, turn_syms};
 use super::turtle::{Angles, Kind, Node, ROOT, Tree};
 use std::collections::HashSet;
 use std::time::Instant;
@@ -38,7 +38,7 @@ pub struct Limits {
     pub max_x: usize,
     /// Largest number of F in a node-rewriting successor.
     pub max_f: usize,
-    /// Most candidates proposed.
+    /// Most candidates proposed by each family (edge, node rewriting).
     pub max_candidates: usize,
     /// Largest axiom, in steps.
     pub max_axiom: usize,
@@ -51,7 +51,7 @@ impl Default for Limits {
         Limits {
             max_block: 64,
             max_moves: 16,
-            max_x: 6,
+            max_x: 9,
             max_f: 24,
             max_candidates: 2_000,
             max_axiom: 256,
@@ -74,32 +74,47 @@ pub struct Proposals {
 }
 
 /// Candidates for `tree`, cheapest first (see `Grammar::cost`), no two alike.
+/// Each family proposes up to `max_candidates`.
 pub fn propose(tree: &Tree, angles: &Angles, limits: &Limits) -> Proposals {
     let mut out = Proposals::default();
+    if tree.nodes.len() < 2 {
+        return out;
+    }
     let mut seen = HashSet::new();
+    let mut room = limits.max_candidates;
     let mut add = |g: Grammar, out: &mut Proposals| {
-        if out.grammars.len() < limits.max_candidates && seen.insert(g.clone()) {
+        if room > 0 && seen.insert(g.clone()) {
+            room -= 1;
             out.grammars.push(g);
         }
     };
-    if tree.nodes.len() >= 2 {
-        edge_rewriting(
-            tree,
-            angles,
-            limits,
-            &mut |g, o: &mut Proposals| add(g, o),
-            &mut out,
-        );
-        node_rewriting(
-            tree,
-            angles,
-            limits,
-            &mut |g, o: &mut Proposals| add(g, o),
-            &mut out,
-        );
-    }
-    out.grammars.sort_by_cached_key(Grammar::cost);
+    edge_rewriting(tree, angles, limits, &mut add, &mut out);
+    let mut seen = out.grammars.iter().cloned().collect::<HashSet<_>>();
+    let mut room = limits.max_candidates;
+    let mut add = |g: Grammar, out: &mut Proposals| {
+        if room > 0 && seen.insert(g.clone()) {
+            room -= 1;
+            out.grammars.push(g);
+        }
+    };
+    node_rewriting(tree, angles, limits, &mut add, &mut out);
+    out.grammars.sort_by_cached_key(|g| {
+        let (size, rule_size, rules, text) = g.cost();
+        (size, rule_size, rules, turned_ends(g), text)
+    });
     out
+}
+
+/// How many successors start or end with a turn: of candidates as large,
+/// the one with the fewest (`F[+X]F[-X]+X`, not `+F[X]F[--X]X`; a shift of
+/// turns around every copy of a letter that level n cannot see).
+fn turned_ends(g: &Grammar) -> usize {
+    let turn = |s: Option<&Sym>| matches!(s, Some(Sym::Plus | Sym::Minus));
+    g.letters
+        .iter()
+        .filter_map(|l| l.rule.as_ref())
+        .map(|r| usize::from(turn(r.first())) + usize::from(turn(r.last())))
+        .sum()
 }
 
 type Sink<'a> = dyn FnMut(Grammar, &mut Proposals) + 'a;
@@ -852,13 +867,66 @@ fn node_rewriting(
             let Some(d1) = shape_of(nodes, s1, f1, angles) else {
                 continue;
             };
+            // The copy of X three steps down, when the drawing is deeper:
+            // it tells the turns a copy starts and ends with (which the
+            // parse two steps down tries over their range) at little cost.
+            let three = (h.depth > 3).then(|| {
+                let s3 = s2 - h.k * h.k * p;
+                let f3 = h.k * f2 + h.beta * h.alpha * h.alpha;
+                copy_of(nodes, s3, f3, angles)
+            });
             for pieces in parse_two_down(nodes, s2, f2, &h, p, &d1, angles) {
-                if let Some(g) = node_grammar(nodes, s2, f2, &h, &pieces, angles) {
-                    sink(g, out);
+                for g in node_grammar(nodes, s2, f2, &h, &pieces, angles) {
+                    let deeper = match &three {
+                        None => true,
+                        Some(None) => false,
+                        Some(Some(t)) => {
+                            let g3 = Grammar {
+                                depth: 3,
+                                ..g.clone()
+                            };
+                            matches(&g3, t, angles, 64 * t.nodes.len() as u64 + 1_000, None)
+                                == Outcome::Same
+                        }
+                    };
+                    if deeper {
+                        sink(g, out);
+                    }
                 }
             }
         }
     }
+}
+
+/// Steps `start..start + len` as a drawing of their own (its first step's
+/// turn 0, steps from outside it from where it starts), or `None` when they
+/// do not start from one place.
+fn copy_of(nodes: &[Node], start: usize, len: usize, angles: &Angles) -> Option<Tree> {
+    let first = *nodes.get(start)?;
+    let inside = |p: u32| p != ROOT && (start..start + len).contains(&(p as usize));
+    let part = nodes.get(start..start + len)?;
+    let mut out = Vec::with_capacity(len);
+    for (i, nd) in part.iter().enumerate() {
+        out.push(if inside(nd.parent) {
+            Node {
+                parent: nd.parent - start as u32,
+                ..*nd
+            }
+        } else if nd.parent == first.parent {
+            Node {
+                parent: ROOT,
+                turn: if i == 0 {
+                    0
+                } else {
+                    angles.norm(nd.turn - first.turn)
+                },
+                kind: nd.kind,
+            }
+        } else {
+            return None;
+        });
+    }
+    Some(Tree { nodes: out })
 }
 
 /// The ways (at most a few) to cut the drawing two steps down into F runs
@@ -914,7 +982,13 @@ fn parse_two_down(
     found
 }
 
-/// The node-rewriting grammar of a parse of the drawing two steps down.
+/// The node-rewriting grammars of a parse of the drawing two steps down.
+/// A copy of X one step down starts turned by the successor's turns before
+/// its first F outside brackets (`t_lead`), and is left from its exit, the
+/// last such F, turned by the turns after it (`t_end`): a drawing shows
+/// each only inside the turn of a piece that starts a copy or continues
+/// from one (`X -> F++X-F+F+`), so both are tried over the turn range, and
+/// the successor gets the leading and trailing turns that make them so.
 fn node_grammar(
     nodes: &[Node],
     s2: usize,
@@ -922,7 +996,90 @@ fn node_grammar(
     h: &NodeHypothesis,
     pieces: &[Piece],
     angles: &Angles,
-) -> Option<Grammar> {
+) -> Vec<Grammar> {
+    let Some(parse) = node_tree(nodes, s2, f2, h, pieces, angles) else {
+        return Vec::new();
+    };
+    let (f, x) = (0u8, 1u8);
+    let sym = |j: u32| Sym::Letter(if pieces[j as usize].x { x } else { f });
+    let range = |needed: bool| if needed { turn_range(angles) } else { vec![0] };
+    let lead_seen = pieces.iter().skip(1).any(|p| p.x);
+    let mut shifts: Vec<(i32, i32)> = range(lead_seen)
+        .into_iter()
+        .flat_map(|l| range(parse.exit.is_some()).into_iter().map(move |e| (l, e)))
+        .collect();
+    shifts.sort_by_key(|&(l, e)| (l.abs() + e.abs(), l.abs(), -l, -e));
+    let mut out = Vec::new();
+    for (t_lead, t_end) in shifts {
+        {
+            let turn = |j: u32| {
+                let j = j as usize;
+                if j == 0 {
+                    return 0;
+                }
+                let lead = if pieces[j].x { t_lead } else { 0 };
+                let end = if parse.after_x[j] { t_end } else { 0 };
+                angles.norm(parse.turns[j] - lead - end)
+            };
+            let Some(body) = write_tree(&parse.kids, None, &turn, &sym, angles) else {
+                continue;
+            };
+            let Some(ends) = outer_turns(&body, f) else {
+                continue;
+            };
+            if parse.exit.is_some_and(|e| e != ends.last) {
+                continue;
+            }
+            // Leading and trailing turns only where a copy shows them.
+            let mut succ = if lead_seen {
+                turn_syms(t_lead - ends.before, angles)
+            } else {
+                Vec::new()
+            };
+            succ.extend(body);
+            if parse.exit.is_some() {
+                succ.extend(turn_syms(t_end - ends.after, angles));
+            }
+            out.push(Grammar {
+                letters: vec![
+                    Letter {
+                        name: 'F',
+                        action: Action::Draw,
+                        rule: (h.k > 1).then(|| vec![Sym::Letter(f); h.k]),
+                    },
+                    Letter {
+                        name: 'X',
+                        action: Action::Nothing,
+                        rule: Some(succ),
+                    },
+                ],
+                axiom: vec![Sym::Letter(x)],
+                depth: h.depth,
+            });
+        }
+    }
+    out
+}
+
+/// The two-down parse as a tree of pieces: each piece's children, its turn
+/// (from its parent's heading as drawn), whether it continues from a copy
+/// of X, and where in a copy of X the turtle leaves it (when some piece
+/// continues from one).
+struct NodeTree {
+    kids: Vec<Vec<u32>>,
+    turns: Vec<i32>,
+    after_x: Vec<bool>,
+    exit: Option<usize>,
+}
+
+fn node_tree(
+    nodes: &[Node],
+    s2: usize,
+    f2: usize,
+    h: &NodeHypothesis,
+    pieces: &[Piece],
+    angles: &Angles,
+) -> Option<NodeTree> {
     let n = pieces.len();
     let len = |p: &Piece| if p.x { h.beta } else { h.k };
     // Which piece each step is in.
@@ -931,8 +1088,12 @@ fn node_grammar(
             .iter()
             .rposition(|p| p.start <= j && j < p.start + len(p))
     };
-    let mut kids: Vec<Vec<u32>> = vec![Vec::new(); n + 1];
-    let mut turns = vec![0i32; n];
+    let mut t = NodeTree {
+        kids: vec![Vec::new(); n + 1],
+        turns: vec![0i32; n],
+        after_x: vec![false; n],
+        exit: None,
+    };
     let first = nodes[s2];
     for (i, p) in pieces.iter().enumerate() {
         let nd = nodes[p.start];
@@ -942,42 +1103,79 @@ fn node_grammar(
             if nd.parent != first.parent {
                 return None;
             }
-            kids[n].push(i as u32);
-            turns[i] = if i == 0 {
+            t.kids[n].push(i as u32);
+            t.turns[i] = if i == 0 {
                 0
             } else {
                 angles.norm(nd.turn - first.turn)
             };
-        } else {
-            let q = piece_of(nd.parent as usize)?;
-            let qp = &pieces[q];
-            // Only the end of a run of F continues; copies of X end branches.
-            if qp.x || nd.parent as usize != qp.start + len(qp) - 1 {
+            continue;
+        }
+        let q = piece_of(nd.parent as usize)?;
+        let qp = &pieces[q];
+        let at = nd.parent as usize - qp.start;
+        if qp.x {
+            // Every copy of X is left from the same step.
+            if t.exit.is_some_and(|e| e != at) {
                 return None;
             }
-            kids[q].push(i as u32);
-            turns[i] = nd.turn;
+            t.exit = Some(at);
+            t.after_x[i] = true;
+        } else if at != len(qp) - 1 {
+            // Only the end of a run of F continues.
+            return None;
+        }
+        t.kids[q].push(i as u32);
+        t.turns[i] = nd.turn;
+    }
+    Some(t)
+}
+
+/// A successor's turns outside brackets before its first F and after its
+/// last F, and which F (counted among every F, in order) is that last one.
+struct OuterTurns {
+    before: i32,
+    after: i32,
+    last: usize,
+}
+
+fn outer_turns(succ: &[Sym], f: u8) -> Option<OuterTurns> {
+    let (mut depth, mut count, mut last) = (0usize, 0usize, None);
+    let (mut before, mut after) = (0i32, 0i32);
+    for s in succ {
+        let turn = match *s {
+            Sym::Push => {
+                depth += 1;
+                0
+            }
+            Sym::Pop => {
+                depth = depth.checked_sub(1)?;
+                0
+            }
+            Sym::Letter(k) if k == f => {
+                if depth == 0 {
+                    last = Some(count);
+                    after = 0;
+                }
+                count += 1;
+                0
+            }
+            Sym::Plus => 1,
+            Sym::Minus => -1,
+            Sym::Letter(_) => 0,
+        };
+        if depth == 0 {
+            if last.is_none() {
+                before += turn;
+            } else {
+                after += turn;
+            }
         }
     }
-    let (f, x) = (0u8, 1u8);
-    let turn = |j: u32| turns[j as usize];
-    let sym = |j: u32| Sym::Letter(if pieces[j as usize].x { x } else { f });
-    let succ = write_tree(&kids, None, &turn, &sym, angles)?;
-    Some(Grammar {
-        letters: vec![
-            Letter {
-                name: 'F',
-                action: Action::Draw,
-                rule: (h.k > 1).then(|| vec![Sym::Letter(f); h.k]),
-            },
-            Letter {
-                name: 'X',
-                action: Action::Nothing,
-                rule: Some(succ),
-            },
-        ],
-        axiom: vec![Sym::Letter(x)],
-        depth: h.depth,
+    Some(OuterTurns {
+        before,
+        after,
+        last: last?,
     })
 }
 
@@ -1114,5 +1312,33 @@ mod tests {
         );
         let found = finds(&g, &a);
         assert!(found.rule_size() <= g.rule_size(), "{}", found.describe());
+    }
+
+    /// Node letters whose copy the turtle goes on from, with turns before
+    /// the successor's first F and after its last (seven X's, one F).
+    #[test]
+    fn node_letters_that_continue() {
+        let a = Angles::new(120.0, Some(3), 1.0);
+        let g = grammar(
+            "X",
+            &[('X', Action::Nothing, "FFX+F-X"), ('F', Action::Draw, "FF")],
+            5,
+        );
+        assert_eq!(
+            finds(&g, &a).describe(),
+            "axiom X; F -> FF; X -> FFX+F-X; derive 5"
+        );
+        let a = Angles::new(36.0, Some(10), 1.0);
+        let g = grammar(
+            "X",
+            &[
+                ('X', Action::Nothing, "X-X--X++X++X+FX--X"),
+                ('F', Action::Draw, ""),
+            ],
+            4,
+        );
+        let found = finds(&g, &a);
+        assert_eq!(found.rule_size(), g.rule_size(), "{}", found.describe());
+        assert_eq!(found.letters.len(), 2, "{}", found.describe());
     }
 }

@@ -12,6 +12,8 @@ pub mod rng;
 use check::{Case, Table};
 use draw::Variant;
 use programs::{Class, Rejections};
+use std::collections::VecDeque;
+use std::sync::Mutex;
 use std::time::Duration;
 
 /// What to run.
@@ -24,26 +26,55 @@ pub struct Run<'a> {
     pub per_class: u64,
     /// Inference's time budget, if not its default.
     pub budget: Option<Duration>,
+    /// Programs inferred at once (each on a thread of its own).
+    pub threads: usize,
 }
 
 /// Infers `per_class` programs of each class (seeds `first..first +
-/// per_class`) in each variant; `each` sees every outcome as it comes.
+/// per_class`) in each variant; `each` sees every outcome, in the order of
+/// classes, seeds and variants, however many threads infer them.
 pub fn run(r: &Run, each: &mut dyn FnMut(&Case, Variant, &check::Outcome)) -> Table {
     let mut table = Table::default();
+    let mut queue = VecDeque::new();
     for &class in r.classes {
         let mut rejections = Rejections::default();
         for seed in r.first..r.first + r.per_class {
-            let Some(case) = Case::new(class, seed, &mut rejections) else {
-                *table.ungenerated.entry(class).or_default() += 1;
-                continue;
-            };
-            for &v in r.variants {
-                let o = check::check(&case, v, r.budget);
-                each(&case, v, &o);
-                table.add(&case, v, &o);
+            match Case::new(class, seed, &mut rejections) {
+                Some(case) => queue.push_back((queue.len(), case)),
+                None => *table.ungenerated.entry(class).or_default() += 1,
             }
         }
         table.rejections.insert(class, rejections);
+    }
+    let queue = Mutex::new(queue);
+    let done = Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..r.threads.max(1) {
+            s.spawn(|| {
+                loop {
+                    let next = queue.lock().map(|mut q| q.pop_front());
+                    let Ok(Some((at, case))) = next else {
+                        break;
+                    };
+                    let outcomes: Vec<_> = r
+                        .variants
+                        .iter()
+                        .map(|&v| (v, check::check(&case, v, r.budget)))
+                        .collect();
+                    if let Ok(mut d) = done.lock() {
+                        d.push((at, case, outcomes));
+                    }
+                }
+            });
+        }
+    });
+    let mut done = done.into_inner().unwrap_or_else(|e| e.into_inner());
+    done.sort_by_key(|d| d.0);
+    for (_, case, outcomes) in &done {
+        for (v, o) in outcomes {
+            each(case, *v, o);
+            table.add(case, *v, o);
+        }
     }
     table
 }

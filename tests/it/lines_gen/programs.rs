@@ -187,10 +187,17 @@ pub enum Reject {
     /// them: one letter's program at half the depth (`F -> F-F+F-F`) draws
     /// the same level n, and inference writes that one (fewer letters).
     Square,
+    /// The drawing grows polynomially with n, not exponentially: no
+    /// letter's successor holds two or more letters that derive it again
+    /// (`F -> F-` with `G -> F+G++F--F`, `G -> G` with `F -> G++GG--F`).
+    /// Such a program draws a hundred steps only at a depth of 20 to 40,
+    /// and smaller programs of other depths draw the same level n while
+    /// predicting another next level: level n does not say which is meant.
+    Slow,
 }
 
 impl Reject {
-    pub const ALL: [Reject; 9] = [
+    pub const ALL: [Reject; 10] = [
         Reject::Straight,
         Reject::Conjugate,
         Reject::Twins,
@@ -200,6 +207,7 @@ impl Reject {
         Reject::Overlap,
         Reject::OverlapNext,
         Reject::Square,
+        Reject::Slow,
     ];
 
     pub fn name(self) -> &'static str {
@@ -213,6 +221,7 @@ impl Reject {
             Reject::Overlap => "overlap",
             Reject::OverlapNext => "overlap-next",
             Reject::Square => "square",
+            Reject::Slow => "slow",
         }
     }
 }
@@ -528,6 +537,9 @@ fn filter(mut p: Program, rng: &mut Rng) -> Result<Program, Reject> {
         .iter()
         .map(|&l| count(p.successor(l).unwrap_or(&l.to_string())))
         .collect();
+    if !exponential(&p, &letters, &rows) {
+        return Err(Reject::Slow);
+    }
     let drawn = |v: &[u64]| -> u64 {
         letters
             .iter()
@@ -586,6 +598,38 @@ fn filter(mut p: Program, rng: &mut Rng) -> Result<Program, Reject> {
         }
     }
     Ok(p)
+}
+
+/// Whether the drawing grows exponentially with the depth (see
+/// `Reject::Slow`): some letter that draws, or derives a letter that
+/// draws, has a successor holding two or more letters of its own strongly
+/// connected component (letters that derive it and that it derives). A
+/// nonnegative integer matrix that cannot be split has spectral radius 1
+/// exactly when every row sums to 1; otherwise more than 1.
+fn exponential(p: &Program, letters: &[char], rows: &[Vec<u64>]) -> bool {
+    let n = letters.len();
+    // reach[i][j]: letter j occurs in some derivation from letter i.
+    let mut reach: Vec<Vec<bool>> = rows
+        .iter()
+        .map(|r| r.iter().map(|&c| c > 0).collect())
+        .collect();
+    for k in 0..n {
+        for i in 0..n {
+            for j in 0..n {
+                if reach[i][k] && reach[k][j] {
+                    reach[i][j] = true;
+                }
+            }
+        }
+    }
+    let draws = |i: usize| p.draws.contains(&letters[i]);
+    (0..n).any(|i| {
+        let own: u64 = (0..n)
+            .filter(|&j| reach[i][j] && reach[j][i])
+            .map(|j| rows[i][j])
+            .sum();
+        own >= 2 && (draws(i) || (0..n).any(|j| reach[i][j] && draws(j)))
+    })
 }
 
 /// Whether `p` has two drawing letters, each rewritten only to the other,
