@@ -144,9 +144,13 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
         },
         ..Tried::default()
     };
-    if let Some(found) = by_reading(&lines, name, opts, deadline, None, &mut tried) {
-        return Lines::Found(found);
-    }
+    // A grammar whose axiom says more than its rules explains little of
+    // the drawing: held while the stroke graph's search looks for a
+    // smaller one.
+    let held = match by_reading(&lines, name, opts, deadline, None, &mut tried) {
+        Some(found) if !axiom_heavy(&found.grammar) => return Lines::Found(found),
+        held => held,
+    };
     let graph = graph::build(&lines, 1).ok();
     // A branching drawing whose steps came in any order: read again as the
     // walks a turtle could have drawn it in, from its likeliest roots; a
@@ -164,6 +168,9 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
     // Together they may take half the budget, each an equal share.
     let share = opts.budget / (2 * again.len().max(1)) as u32;
     for (walk, noise) in again {
+        if held.is_some() {
+            break;
+        }
         if late() {
             tried.timed_out = true;
             break;
@@ -204,9 +211,13 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
             Ok,
         );
     stats.search_ms += ms(t);
-    match by_graph {
-        Ok(found) => return Lines::Found(found),
-        Err(late) => timed_out |= late,
+    match (by_graph, held) {
+        (Ok(found), Some(h)) if description(&h.grammar) <= description(&found.grammar) => {
+            return Lines::Found(h);
+        }
+        (Ok(found), _) => return Lines::Found(found),
+        (Err(_), Some(h)) => return Lines::Found(h),
+        (Err(late), None) => timed_out |= late,
     }
     // Read as steps but unexplained: say that, not why another reading failed.
     if why.is_empty() || steps > 0 {
@@ -441,6 +452,18 @@ fn to_grammar(f: &synth::Found, angles: &turtle::Angles) -> Option<Grammar> {
         axiom: syms(&f.axiom)?,
         depth: f.depth,
     })
+}
+
+/// A grammar's size as text: its axiom, and each rule its successor and
+/// two symbols more (the letter it rewrites and the arrow).
+fn description(g: &Grammar) -> usize {
+    let rules = g.letters.iter().filter(|l| l.rule.is_some()).count();
+    g.axiom.len() + g.rule_size() + 2 * rules
+}
+
+/// Whether a grammar's axiom is longer than its rules together.
+fn axiom_heavy(g: &Grammar) -> bool {
+    g.axiom.len() > g.rule_size()
 }
 
 /// Whether a grammar says more than the drawing itself: at most half its

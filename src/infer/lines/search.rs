@@ -24,7 +24,7 @@
 
 use super::grammar::{Action, Grammar, Letter, Outcome, Sym, matches, turn_syms};
 use super::turtle::{Angles, Kind, Node, ROOT, Tree};
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
 /// How far the search goes.
@@ -798,6 +798,25 @@ struct NodeHypothesis {
     alpha: usize,
     beta: usize,
     depth: u32,
+    /// Copies of X and F's in the axiom (1 and 0: the axiom `X`); a
+    /// longer axiom starts with X (`XF-XF-XF`).
+    axiom: (usize, usize),
+    /// Steps X draws at `depth`.
+    x_steps: usize,
+}
+
+/// The most X's, and F's beyond one per X, in an axiom other than `X`.
+const AXIOM_XS: usize = 16;
+
+/// What a drawing is cut into: runs of `f_len` straight steps (`fs` of
+/// them) and `xs` copies of X of `x_len` steps each, copy first at piece
+/// `p`.
+struct Spec {
+    f_len: usize,
+    x_len: usize,
+    fs: usize,
+    xs: usize,
+    p: usize,
 }
 
 fn node_rewriting(
@@ -812,7 +831,7 @@ fn node_rewriting(
         return;
     }
     let total = nodes.len() as u128;
-    let mut hyps = Vec::new();
+    let (mut hyps, mut longer) = (Vec::new(), Vec::new());
     for k in 1..=3usize {
         for alpha in 1..=limits.max_x {
             for beta in 1..=limits.max_f {
@@ -823,23 +842,43 @@ fn node_rewriting(
                     if f > total {
                         break;
                     }
-                    if f == total && depth >= 2 {
-                        hyps.push(NodeHypothesis {
-                            k,
-                            alpha,
-                            beta,
-                            depth,
-                        });
+                    if depth < 2 {
+                        continue;
+                    }
+                    let h = |axiom| NodeHypothesis {
+                        k,
+                        alpha,
+                        beta,
+                        depth,
+                        axiom,
+                        x_steps: f as usize,
+                    };
+                    if f == total {
+                        hyps.push(h((1, 0)));
+                    } else if k > 1 || alpha > 1 {
+                        longer.extend(axioms(total, f, (k as u128).pow(depth)).map(h));
                     }
                 }
             }
         }
     }
+    // The axiom X first: longer axioms multiply the hypotheses.
+    hyps.extend(longer);
     for h in hyps {
         if limits.late() {
             out.timed_out = true;
             return;
         }
+        // A longer axiom: the drawing cut into copies of X and runs of F
+        // once for the hypothesis.
+        let parses = match h.axiom {
+            (1, 0) => Vec::new(),
+            _ => axiom_parses(nodes, &h, h.x_steps, angles),
+        };
+        if h.axiom != (1, 0) && parses.is_empty() {
+            continue;
+        }
+        let mut axiom_of = HashMap::new();
         // f(1), f(2): drawn steps of X one and two steps down.
         let f1 = h.beta;
         let f2 = h.k * h.beta + h.beta * h.alpha;
@@ -875,8 +914,15 @@ fn node_rewriting(
                 let f3 = h.k * f2 + h.beta * h.alpha * h.alpha;
                 copy_of(nodes, s3, f3, angles)
             });
-            for pieces in parse_two_down(nodes, s2, f2, &h, p, &d1, angles) {
-                for g in node_grammar(nodes, s2, f2, &h, &pieces, angles) {
+            let spec = Spec {
+                f_len: h.k,
+                x_len: h.beta,
+                fs: h.beta,
+                xs: h.alpha,
+                p,
+            };
+            for pieces in parse_pieces(nodes, s2, f2, &spec, &d1, angles) {
+                for mut g in node_grammar(nodes, s2, f2, &h, &pieces, angles) {
                     let deeper = match &three {
                         None => true,
                         Some(None) => false,
@@ -889,9 +935,27 @@ fn node_rewriting(
                                 == Outcome::Same
                         }
                     };
-                    if deeper {
-                        sink(g, out);
+                    if !deeper {
+                        continue;
                     }
+                    if h.axiom != (1, 0) {
+                        if limits.late() {
+                            out.timed_out = true;
+                            return;
+                        }
+                        // The axiom depends on X's rule alone.
+                        let Some(w) = g.letters.get(1).and_then(|l| l.rule.clone()) else {
+                            continue;
+                        };
+                        let axiom = axiom_of
+                            .entry(w)
+                            .or_insert_with_key(|w| node_axiom(&parses, &h, w, angles));
+                        let Some(axiom) = axiom.clone() else {
+                            continue;
+                        };
+                        g.axiom = axiom;
+                    }
+                    sink(g, out);
                 }
             }
         }
@@ -929,22 +993,23 @@ fn copy_of(nodes: &[Node], start: usize, len: usize, angles: &Angles) -> Option<
     Some(Tree { nodes: out })
 }
 
-/// The ways (at most a few) to cut the drawing two steps down into F runs
-/// and X copies, the first `p` pieces runs and the next a copy.
-fn parse_two_down(
+/// The ways (at most a few) to cut steps `start..start + len` into runs of
+/// F and copies of X as `spec` says, the first `p` pieces runs and the next
+/// a copy.
+fn parse_pieces(
     nodes: &[Node],
-    s2: usize,
-    f2: usize,
-    h: &NodeHypothesis,
-    p: usize,
-    d1: &[Step],
+    start: usize,
+    len: usize,
+    spec: &Spec,
+    copy: &[Step],
     angles: &Angles,
 ) -> Vec<Vec<Piece>> {
     const MAX_PARSES: usize = 16;
-    let end = s2 + f2;
+    let end = start + len;
+    let p = spec.p;
     let mut found = Vec::new();
     // Depth-first over choices, with an explicit stack of (pieces so far, next choice).
-    let mut stack: Vec<(Vec<Piece>, usize, usize, u8)> = vec![(Vec::new(), s2, 0, 0)];
+    let mut stack: Vec<(Vec<Piece>, usize, usize, u8)> = vec![(Vec::new(), start, 0, 0)];
     let mut work = 0usize;
     while let Some((pieces, at, fs, choice)) = stack.pop() {
         work += 1;
@@ -952,7 +1017,7 @@ fn parse_two_down(
             break;
         }
         if at == end {
-            if fs == h.beta && pieces.len() == h.beta + h.alpha {
+            if fs == spec.fs && pieces.len() == spec.fs + spec.xs {
                 found.push(pieces);
             }
             continue;
@@ -962,20 +1027,25 @@ fn parse_two_down(
         if choice == 0 {
             stack.push((pieces.clone(), at, fs, 1));
             let must_x = pieces.len() == p;
-            if fs < h.beta && !must_x && at + h.k <= end && straight(nodes, at, h.k) {
+            if fs < spec.fs && !must_x && at + spec.f_len <= end && straight(nodes, at, spec.f_len)
+            {
                 let mut next = pieces;
                 next.push(Piece {
                     x: false,
                     start: at,
                 });
-                stack.push((next, at + h.k, fs + 1, 0));
+                stack.push((next, at + spec.f_len, fs + 1, 0));
             }
         } else {
             let must_f = pieces.len() < p;
-            if xs < h.alpha && !must_f && at + h.beta <= end && has_shape(nodes, at, d1, angles) {
+            if xs < spec.xs
+                && !must_f
+                && at + spec.x_len <= end
+                && has_shape(nodes, at, copy, angles)
+            {
                 let mut next = pieces;
                 next.push(Piece { x: true, start: at });
-                stack.push((next, at + h.beta, fs, 0));
+                stack.push((next, at + spec.x_len, fs, 0));
             }
         }
     }
@@ -997,7 +1067,7 @@ fn node_grammar(
     pieces: &[Piece],
     angles: &Angles,
 ) -> Vec<Grammar> {
-    let Some(parse) = node_tree(nodes, s2, f2, h, pieces, angles) else {
+    let Some(parse) = node_tree(nodes, s2, f2, (h.k, h.beta), pieces, angles) else {
         return Vec::new();
     };
     let (f, x) = (0u8, 1u8);
@@ -1076,12 +1146,12 @@ fn node_tree(
     nodes: &[Node],
     s2: usize,
     f2: usize,
-    h: &NodeHypothesis,
+    (f_len, x_len): (usize, usize),
     pieces: &[Piece],
     angles: &Angles,
 ) -> Option<NodeTree> {
     let n = pieces.len();
-    let len = |p: &Piece| if p.x { h.beta } else { h.k };
+    let len = |p: &Piece| if p.x { x_len } else { f_len };
     // Which piece each step is in.
     let piece_of = |j: usize| {
         pieces
@@ -1129,6 +1199,156 @@ fn node_tree(
         t.turns[i] = nd.turn;
     }
     Some(t)
+}
+
+/// The axioms of `c` X's and `e` F's that draw `total` steps at a depth
+/// where X draws `f` and F draws `kn` (see `AXIOM_XS`), the copies of X
+/// at least half the drawing.
+fn axioms(total: u128, f: u128, kn: u128) -> impl Iterator<Item = (usize, usize)> {
+    (1..=AXIOM_XS).filter_map(move |c| {
+        let rest = total.checked_sub(c as u128 * f)?;
+        let e = rest / kn.max(1);
+        (e * kn == rest && 2 * c as u128 * f >= total && e as usize <= c + 1)
+            .then_some((c, e as usize))
+    })
+}
+
+/// The ways to cut a drawing that holds several copies of X (`XF-XF-XF`)
+/// into copies of X at depth n (as the first one, which starts the
+/// drawing) and runs of F (k^n steps each): what every X rule of the
+/// hypothesis shares.
+fn axiom_parses(
+    nodes: &[Node],
+    h: &NodeHypothesis,
+    x_len: usize,
+    angles: &Angles,
+) -> Vec<(Vec<Piece>, NodeTree)> {
+    let (c, e) = h.axiom;
+    let Some(f_len) = h.k.checked_pow(h.depth) else {
+        return Vec::new();
+    };
+    let spec = Spec {
+        f_len,
+        x_len,
+        fs: e,
+        xs: c,
+        p: 0,
+    };
+    let Some(copy) = shape_of(nodes, 0, x_len, angles) else {
+        return Vec::new();
+    };
+    parse_pieces(nodes, 0, nodes.len(), &spec, &copy, angles)
+        .into_iter()
+        .filter_map(|pieces| {
+            let t = node_tree(nodes, 0, nodes.len(), (f_len, x_len), &pieces, angles)?;
+            Some((pieces, t))
+        })
+        .collect()
+}
+
+/// The axiom for X's rule `w` over one of `parses`: the turns between
+/// the pieces less the turns a copy of X starts and ends with.
+fn node_axiom(
+    parses: &[(Vec<Piece>, NodeTree)],
+    h: &NodeHypothesis,
+    w: &[Sym],
+    angles: &Angles,
+) -> Option<Vec<Sym>> {
+    let ends = level_ends(w, h.k, h.depth)?;
+    let (f, x) = (0u8, 1u8);
+    for (pieces, t) in parses {
+        if t.exit.is_some_and(|at| at != ends.turns.last) {
+            continue;
+        }
+        let turn = |j: u32| {
+            let j = j as usize;
+            if j == 0 {
+                return 0;
+            }
+            let lead = if pieces[j].x { ends.turns.before } else { 0 };
+            let end = if t.after_x[j] { ends.turns.after } else { 0 };
+            angles.norm(t.turns[j] - lead - end)
+        };
+        let sym = |j: u32| Sym::Letter(if pieces[j as usize].x { x } else { f });
+        if let Some(axiom) = write_tree(&t.kids, None, &turn, &sym, angles) {
+            return Some(axiom);
+        }
+    }
+    None
+}
+
+/// X derived `depth` times from successor `w` (F -> F^k): the steps it
+/// draws and its turns outside brackets before its first step and after its
+/// last, and which step is the last.
+struct LevelEnds {
+    steps: usize,
+    turns: OuterTurns,
+}
+
+fn level_ends(w: &[Sym], k: usize, depth: u32) -> Option<LevelEnds> {
+    let (f, x) = (0u8, 1u8);
+    // Level 0: X draws nothing.
+    let mut below = LevelEnds {
+        steps: 0,
+        turns: OuterTurns {
+            before: 0,
+            after: 0,
+            last: 0,
+        },
+    };
+    for j in 1..=depth {
+        let run = k.checked_pow(j - 1)?;
+        let (mut depth_b, mut steps) = (0usize, 0usize);
+        let (mut before, mut after, mut last) = (0i32, 0i32, None);
+        for s in w {
+            let (draws, lead, exit, end) = match *s {
+                Sym::Push => {
+                    depth_b += 1;
+                    continue;
+                }
+                Sym::Pop => {
+                    depth_b = depth_b.checked_sub(1)?;
+                    continue;
+                }
+                Sym::Plus | Sym::Minus => {
+                    let t = if *s == Sym::Plus { 1 } else { -1 };
+                    if depth_b == 0 {
+                        if last.is_none() {
+                            before += t;
+                        } else {
+                            after += t;
+                        }
+                    }
+                    continue;
+                }
+                Sym::Letter(l) if l == f => (run, 0, run - 1, 0),
+                Sym::Letter(l) if l == x => (
+                    below.steps,
+                    below.turns.before,
+                    below.turns.last,
+                    below.turns.after,
+                ),
+                Sym::Letter(_) => continue,
+            };
+            if draws > 0 && depth_b == 0 {
+                if last.is_none() {
+                    before += lead;
+                }
+                last = Some(steps + exit);
+                after = end;
+            }
+            steps = steps.checked_add(draws)?;
+        }
+        below = LevelEnds {
+            steps,
+            turns: OuterTurns {
+                before,
+                after,
+                last: last?,
+            },
+        };
+    }
+    Some(below)
 }
 
 /// A successor's turns outside brackets before its first F and after its
@@ -1340,5 +1560,38 @@ mod tests {
         let found = finds(&g, &a);
         assert_eq!(found.rule_size(), g.rule_size(), "{}", found.describe());
         assert_eq!(found.letters.len(), 2, "{}", found.describe());
+    }
+
+    /// Axioms of several copies of X and runs of F (`XF-XF-XF`), the turns
+    /// between them less the turns a copy starts and ends with.
+    #[test]
+    fn node_axioms_of_copies() {
+        let a = Angles::new(30.0, Some(12), 1.0);
+        let g = grammar(
+            "XF----XF----XF",
+            &[
+                ('X', Action::Nothing, "F-F++X+XX--X"),
+                ('F', Action::Draw, "FF"),
+            ],
+            3,
+        );
+        assert_eq!(
+            finds(&g, &a).describe(),
+            "axiom XF----XF----XF; F -> FF; X -> F-F++X+XX--X; derive 3"
+        );
+        let a = Angles::new(90.0, Some(4), 1.0);
+        let g = grammar(
+            "XF+XF+XF+XF",
+            &[
+                ('X', Action::Nothing, "-F+XF+X-"),
+                ('F', Action::Draw, "FF"),
+            ],
+            3,
+        );
+        // The same drawing by a smaller rule, its turns moved to the axiom.
+        assert_eq!(
+            finds(&g, &a).describe(),
+            "axiom X+FX+FX+FX+F; F -> FF; X -> FX+FX-; derive 3"
+        );
     }
 }
