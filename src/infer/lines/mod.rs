@@ -589,13 +589,18 @@ fn finish(
     } else {
         nice(r.angles.delta, (3.0 * r.delta_error).max(1e-6))
     };
-    let step = nice(r.step, (3.0 * r.step_error).max(1e-4 * r.step));
+    // The step as precise as the drawing says it (a step rounded within
+    // 10⁻⁴ draws level n but may drift by a step over a larger next level),
+    // and rounded within 10⁻⁴, as a person would write it when it draws as
+    // close (a drawing's coordinates, rounded, make its steps look shorter).
+    let step = nice(r.step, (3.0 * r.step_error).max(1e-6 * r.step));
+    let round_step = nice(r.step, (3.0 * r.step_error).max(1e-4 * r.step));
     let (p_c, k_c) = grammar::first_step(g, &r.angles, work)?;
     let tol = (3.0 * r.frame_error.1).max(2e-3 * step);
     // The frame for an angle: the first step's heading less its turns, and
     // where the turtle must start for its first step to start where the
     // drawing's does.
-    let frame = |angle: f64| {
+    let frame = |angle: f64, step: f64| {
         let phi = turtle::wrap_degrees(r.heading - f64::from(k_c) * angle);
         let heading = nice(phi, (3.0 * r.frame_error.0).max(1e-3));
         Frame {
@@ -606,18 +611,18 @@ fn finish(
     // As measured, and as a person would have written it: δ to a twentieth
     // of a degree, the heading to a multiple of δ or a whole degree, the
     // start at the origin, when they are that close.
-    let precise = (angle, frame(angle));
+    let precise = (angle, frame(angle, step), step);
     let round_angle = if r.angles.period.is_some() {
         angle
     } else {
         nice(angle, 0.05)
     };
-    let mut round = rounded(&frame(round_angle), round_angle, step);
+    let mut round = rounded(&frame(round_angle, round_step), round_angle, round_step);
     if !(round.start == DVec2::ZERO && p_c == DVec2::ZERO) {
-        round.start = place(r.start, p_c, round.heading, step);
+        round.start = place(r.start, p_c, round.heading, round_step);
     }
     let (source, system) = super::program::names(name);
-    let settings = |(angle, f): (f64, Frame)| emit::Settings {
+    let settings = |(angle, f, step): (f64, Frame, f64)| emit::Settings {
         source: &source,
         name: system.clone(),
         angle,
@@ -643,12 +648,15 @@ fn finish(
     };
     let mut best = settings(precise);
     let mut redraw = check(&best);
-    let person = settings((round_angle, round));
-    if person.frame != best.frame || person.angle != best.angle {
+    let person = settings((round_angle, round, round_step));
+    if person.frame != best.frame || person.angle != best.angle || person.step != best.step {
         let other = check(&person);
         let better = match (&other, &redraw) {
+            // As many steps matched, and as close: a heading rounded by a
+            // tenth of a degree still matches level n's steps, but not the
+            // next level's, which are further out.
             (Some(o), Some(p)) => {
-                o.matched >= p.matched || o.relative() <= 1.25 * p.relative() + 1e-9
+                o.matched >= p.matched && o.relative() <= 1.25 * p.relative() + 1e-9
             }
             (Some(_), None) => true,
             _ => false,
