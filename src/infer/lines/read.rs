@@ -512,10 +512,13 @@ pub(super) fn delta_from_turns(turns: &[f64]) -> Result<Angles, NotLines> {
                 .sum()
         })
         .collect();
-    let enough = if turns.len() < 20 {
+    // Counted among the turns that turn: a spiral of ten corners and two
+    // thousand straight steps has no stray turn.
+    let turning = turns.iter().filter(|t| **t >= 1.25).count();
+    let enough = if turning < 20 {
         1.0
     } else {
-        (turns.len() as f64 / 200.0).max(2.0)
+        (turning as f64 / 200.0).max(2.0)
     };
     let mut significant: Vec<f64> = Vec::new();
     let mut i = 0;
@@ -614,5 +617,24 @@ mod tests {
         assert!((rd.heading - 30.0).abs() < 1e-9);
         let rd2 = reading(&[rd.segments.iter().flat_map(|s| [s.0]).collect()], 2).expect("reads");
         assert_eq!(rd2.tree.nodes.len(), 6);
+    }
+
+    /// A spiral of few corners and many straight steps, one path a step
+    /// (`X -> X-FF`, `F -> FF`): its corners are not stray turns.
+    #[test]
+    fn few_corners_among_many_steps() {
+        let (mut p, mut heading) = (DVec2::ZERO, 90f64);
+        let mut paths = Vec::new();
+        for side in 0..10 {
+            for _ in 0..(2usize << side) {
+                let q = p + DVec2::from_angle(heading.to_radians());
+                paths.push(vec![p, q]);
+                p = q;
+            }
+            heading -= 60.0;
+        }
+        let rd = reading(&paths, 1).expect("reads");
+        assert_eq!(rd.steps, 2046);
+        assert!((rd.angles.delta - 60.0).abs() < 1e-6, "{}", rd.angles.delta);
     }
 }
