@@ -1094,7 +1094,8 @@ fn node_grammar(
             let Some(body) = write_tree(&parse.kids, None, &turn, &sym, angles) else {
                 continue;
             };
-            let Some(ends) = outer_turns(&body, f) else {
+            // X draws nothing one step down: the successor's own turns.
+            let Some(LevelEnds { turns: ends, .. }) = level_ends(&body, 1, 1) else {
                 continue;
             };
             if parse.exit.is_some_and(|e| e != ends.last) {
@@ -1351,52 +1352,12 @@ fn level_ends(w: &[Sym], k: usize, depth: u32) -> Option<LevelEnds> {
     Some(below)
 }
 
-/// A successor's turns outside brackets before its first F and after its
-/// last F, and which F (counted among every F, in order) is that last one.
+/// Turns outside brackets before the first drawn step and after the last,
+/// and which step (counted among every step, in order) is that last one.
 struct OuterTurns {
     before: i32,
     after: i32,
     last: usize,
-}
-
-fn outer_turns(succ: &[Sym], f: u8) -> Option<OuterTurns> {
-    let (mut depth, mut count, mut last) = (0usize, 0usize, None);
-    let (mut before, mut after) = (0i32, 0i32);
-    for s in succ {
-        let turn = match *s {
-            Sym::Push => {
-                depth += 1;
-                0
-            }
-            Sym::Pop => {
-                depth = depth.checked_sub(1)?;
-                0
-            }
-            Sym::Letter(k) if k == f => {
-                if depth == 0 {
-                    last = Some(count);
-                    after = 0;
-                }
-                count += 1;
-                0
-            }
-            Sym::Plus => 1,
-            Sym::Minus => -1,
-            Sym::Letter(_) => 0,
-        };
-        if depth == 0 {
-            if last.is_none() {
-                before += turn;
-            } else {
-                after += turn;
-            }
-        }
-    }
-    Some(OuterTurns {
-        before,
-        after,
-        last: last?,
-    })
 }
 
 #[cfg(test)]
