@@ -27,6 +27,8 @@ use super::turtle::{Angles, Kind, Node, ROOT, Tree};
 use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
+mod pair;
+
 /// How far the search goes.
 #[derive(Clone, Copy, Debug)]
 pub struct Limits {
@@ -98,6 +100,7 @@ pub fn propose(tree: &Tree, angles: &Angles, limits: &Limits) -> Proposals {
         }
     };
     node_rewriting(tree, angles, limits, &mut add, &mut out);
+    pair::node_pairs(tree, angles, limits, &mut add, &mut out);
     out.grammars.sort_by_cached_key(|g| {
         let (size, rule_size, rules, text) = g.cost();
         (size, rule_size, rules, turned_ends(g), text)
@@ -1521,6 +1524,37 @@ mod tests {
         let found = finds(&g, &a);
         assert_eq!(found.rule_size(), g.rule_size(), "{}", found.describe());
         assert_eq!(found.letters.len(), 2, "{}", found.describe());
+    }
+
+    /// Two node letters: Hilbert's curve, and a pair that is not one
+    /// letter's mirror.
+    #[test]
+    fn two_node_letters() {
+        let a = Angles::new(90.0, Some(4), 1.0);
+        let g = grammar(
+            "X",
+            &[
+                ('X', Action::Nothing, "+YF-XFX-FY+"),
+                ('Y', Action::Nothing, "-XF+YFY+FX-"),
+                ('F', Action::Draw, ""),
+            ],
+            4,
+        );
+        let found = finds(&g, &a);
+        assert_eq!(found.letters.len(), 3, "{}", found.describe());
+        assert!(found.rule_size() <= g.rule_size(), "{}", found.describe());
+        let a = Angles::new(60.0, Some(6), 1.0);
+        let g = grammar(
+            "X",
+            &[
+                ('X', Action::Nothing, "XF+YF-X"),
+                ('Y', Action::Nothing, "F-YF++X"),
+                ('F', Action::Draw, "FF"),
+            ],
+            4,
+        );
+        let found = finds(&g, &a);
+        assert!(found.rule_size() <= g.rule_size(), "{}", found.describe());
     }
 
     /// Axioms of several copies of X and runs of F (`XF-XF-XF`), the turns

@@ -1,0 +1,590 @@
+//! Node rewriting with two letters that draw nothing, X and Y (Hilbert's
+//! `X -> +YF-XFX-FY+`, `Y -> -XF+YFY+FX-`; Peano's; Moore's), for drawings
+//! that are one path.
+//!
+//! The counts of steps follow f_c(j) = β_c·k^(j−1) + Σ_d a_cd·f_d(j−1)
+//! (c, d ∈ {X, Y}, `F -> F^k`). For each solution whose f_X(n) is the
+//! drawing's steps, the drawing is cut top-down into runs of k^(n−1) steps
+//! and copies of X and Y one step down — the first copy of a letter says its
+//! shape, later ones must have it — which gives X's successor as letters; a
+//! copy of X cut one level lower must give the same letters, and a copy of Y
+//! gives Y's. The copies are then followed down to a copy of X and one of Y
+//! two steps down, whose pieces' turns give the successors' turns, less the
+//! turns a copy one step down starts and ends with: those the drawing does
+//! not show, so they are tried over the turn range and each candidate is
+//! matched against the drawing before it is proposed.
+
+use super::{Limits, Proposals, Sink, turn_range};
+use crate::infer::lines::grammar::{Action, Grammar, Letter, Outcome, Sym, matches, turn_syms};
+use crate::infer::lines::turtle::{Angles, Kind, Node, ROOT, Tree};
+
+const X: usize = 0;
+const Y: usize = 1;
+
+/// Deepest derivation tried.
+const MAX_DEPTH: u32 = 24;
+
+/// Most cuts kept of one copy.
+const MAX_CUTS: usize = 4;
+
+/// Most choices a cut tries before it gives up.
+const CUT_WORK: usize = 20_000;
+
+/// Most grammars proposed for one count hypothesis.
+const PER_HYPOTHESIS: usize = 16;
+
+/// A piece of a copy: a run of F, or a copy of X or Y one step down.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Part {
+    F,
+    Copy(usize),
+}
+
+/// Counts of each successor (`beta` F's, `a[c][d]` copies of letter d in
+/// c's successor), F's successor `F^k`, the depth, and the steps each
+/// letter draws at every depth up to it.
+struct Hypothesis {
+    k: usize,
+    beta: [usize; 2],
+    a: [[usize; 2]; 2],
+    depth: u32,
+    steps: Vec<[usize; 2]>,
+}
+
+impl Hypothesis {
+    /// Steps of a piece of a copy at depth `j`.
+    fn len(&self, p: Part, j: u32) -> usize {
+        match p {
+            Part::F => self.k.pow(j - 1),
+            Part::Copy(d) => self.steps[j as usize - 1][d],
+        }
+    }
+}
+
+/// Proposes grammars of two node letters for `tree`, each already matched
+/// against it.
+pub(super) fn node_pairs(
+    tree: &Tree,
+    angles: &Angles,
+    limits: &Limits,
+    sink: &mut Sink<'_>,
+    out: &mut Proposals,
+) {
+    let nodes = &tree.nodes;
+    if !is_path(nodes) {
+        return;
+    }
+    let work = 64 * nodes.len() as u64 + 1_000;
+    let shifts = shifts(angles);
+    for h in hypotheses(nodes.len(), limits) {
+        if limits.late() {
+            out.timed_out = true;
+            return;
+        }
+        let mut found = 0;
+        grammars(nodes, &h, angles, limits, &shifts, &mut |g| {
+            if matches(&g, tree, angles, work, limits.deadline) == Outcome::Same {
+                sink(g, out);
+                found += 1;
+            }
+            found >= PER_HYPOTHESIS
+        });
+    }
+}
+
+/// One path of drawn steps, each from the one before.
+fn is_path(nodes: &[Node]) -> bool {
+    nodes.first().is_some_and(|n| n.parent == ROOT)
+        && nodes
+            .iter()
+            .enumerate()
+            .all(|(i, n)| n.kind == Kind::Draw && (i == 0 || n.parent as usize == i - 1))
+}
+
+/// The count hypotheses under which X draws `total` steps at a depth of at
+/// least 3, both letters' successors with at least one F (at most
+/// `MAX_F`), Y's copies in X's successor, and the drawing growing
+/// exponentially (else smaller programs of other depths draw it as well).
+///
+/// The steps are linear in the F counts: f(n) = S(n)·β with
+/// S(n) = A·S(n−1) + k^(n−1)·I, so for each k, A and n the F counts are
+/// solved for rather than enumerated.
+fn hypotheses(total: usize, limits: &Limits) -> Vec<Hypothesis> {
+    let total = total as u64;
+    let max_x = limits.max_x as u64;
+    let max_f = limits.max_f.min(MAX_F) as u64;
+    let mut out = Vec::new();
+    for k in 1..=3u64 {
+        for a in matrices(max_x) {
+            if k == 1 && !grows(a) {
+                continue;
+            }
+            let mut s = [[1u64, 0], [0, 1]];
+            let mut run = 1u64;
+            for depth in 1..=MAX_DEPTH {
+                if depth > 1 {
+                    run *= k;
+                    s = [
+                        [
+                            a[X][X] * s[X][X] + a[X][Y] * s[Y][X] + run,
+                            a[X][X] * s[X][Y] + a[X][Y] * s[Y][Y],
+                        ],
+                        [
+                            a[Y][X] * s[X][X] + a[Y][Y] * s[Y][X],
+                            a[Y][X] * s[X][Y] + a[Y][Y] * s[Y][Y] + run,
+                        ],
+                    ];
+                }
+                let (u, v) = (s[X][X], s[X][Y]);
+                if u + v > total {
+                    break;
+                }
+                if depth < 3 || v == 0 {
+                    continue;
+                }
+                for bx in 1..=max_f {
+                    let Some(rest) = total.checked_sub(u * bx) else {
+                        break;
+                    };
+                    if rest % v != 0 || !(1..=max_f).contains(&(rest / v)) {
+                        continue;
+                    }
+                    let beta = [bx as usize, (rest / v) as usize];
+                    out.push(hypothesis(k as usize, beta, a, depth));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The most F's in a successor of the two-letter search.
+const MAX_F: usize = 12;
+
+/// Copies of X and Y in each successor, X's holding a Y, at most `max_x`
+/// copies a successor.
+fn matrices(max_x: u64) -> Vec<[[u64; 2]; 2]> {
+    let mut out = Vec::new();
+    for axx in 0..=max_x {
+        for axy in 1..=max_x - axx {
+            for ayx in 0..=max_x {
+                for ayy in 0..=max_x - ayx {
+                    out.push([[axx, axy], [ayx, ayy]]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Whether copies multiply: the matrix's largest eigenvalue exceeds 1.
+fn grows(a: [[u64; 2]; 2]) -> bool {
+    let [[p, q], [r, t]] = a.map(|row| row.map(|v| v as f64));
+    let tr = p + t;
+    let disc = (tr * tr - 4.0 * (p * t - q * r)).max(0.0);
+    (tr + disc.sqrt()) / 2.0 > 1.0 + 1e-9
+}
+
+/// The hypothesis with its steps at every depth.
+fn hypothesis(k: usize, beta: [usize; 2], a: [[u64; 2]; 2], depth: u32) -> Hypothesis {
+    let a = a.map(|row| row.map(|v| v as usize));
+    let mut steps = vec![[0usize; 2]];
+    let mut run = 1;
+    for _ in 1..=depth {
+        let f = steps[steps.len() - 1];
+        steps.push([
+            beta[X] * run + a[X][X] * f[X] + a[X][Y] * f[Y],
+            beta[Y] * run + a[Y][X] * f[X] + a[Y][Y] * f[Y],
+        ]);
+        run *= k;
+    }
+    Hypothesis {
+        k,
+        beta,
+        a,
+        depth,
+        steps,
+    }
+}
+
+/// The grammars of hypothesis `h` whose cuts the drawing has, before
+/// matching; `take` says when it has had enough.
+fn grammars(
+    nodes: &[Node],
+    h: &Hypothesis,
+    angles: &Angles,
+    limits: &Limits,
+    shifts: &[[i32; 4]],
+    take: &mut dyn FnMut(Grammar) -> bool,
+) {
+    let n = h.depth;
+    for px in cuts(nodes, 0, X, n, h) {
+        // A copy of X one step down has X's letters too.
+        if let Some(x1) = first_copy(&px, X, 0, n, h)
+            && !cuts(nodes, x1, X, n - 1, h).contains(&px)
+        {
+            continue;
+        }
+        let Some(y1) = first_copy(&px, Y, 0, n, h) else {
+            continue;
+        };
+        for py in cuts(nodes, y1, Y, n - 1, h) {
+            if limits.late() {
+                return;
+            }
+            let pats = [px.clone(), py];
+            let [Some(x2), Some(y2)] = copies_at(&pats, h, 2) else {
+                continue;
+            };
+            let twos = [x2, y2];
+            if with_turns(nodes, &pats, twos, h, angles, shifts, take) {
+                return;
+            }
+        }
+    }
+}
+
+/// Where the first copy of letter `d` starts in a copy of `pat` at `start`
+/// at depth `j`.
+fn first_copy(pat: &[Part], d: usize, start: usize, j: u32, h: &Hypothesis) -> Option<usize> {
+    let mut at = start;
+    for &p in pat {
+        if p == Part::Copy(d) {
+            return Some(at);
+        }
+        at += h.len(p, j);
+    }
+    None
+}
+
+/// Where a copy of X and one of Y `level` steps down start (when there
+/// is one), following the letters of `pats` from the drawing (a copy of X
+/// at depth n).
+fn copies_at(pats: &[Vec<Part>; 2], h: &Hypothesis, level: u32) -> [Option<usize>; 2] {
+    let mut at = [Some(0), None];
+    for j in (level + 1..=h.depth).rev() {
+        let mut next = [None, None];
+        for c in [X, Y] {
+            let Some(s) = at[c] else { continue };
+            for d in [X, Y] {
+                if next[d].is_none() {
+                    next[d] = first_copy(&pats[c], d, s, j, h);
+                }
+            }
+        }
+        at = next;
+    }
+    at
+}
+
+/// A cut under way: its pieces so far, where the next starts, the pieces
+/// of each kind (F, X, Y) so far, and where the first copy of X and of Y
+/// starts.
+struct State {
+    pat: Vec<Part>,
+    at: usize,
+    used: [usize; 3],
+    firsts: [Option<usize>; 2],
+}
+
+/// The ways (at most `MAX_CUTS`) to cut the copy of letter `c` at depth `j`
+/// that starts at `start` into the pieces its counts say: runs of F,
+/// straight, and copies of X and Y, each of one shape.
+fn cuts(nodes: &[Node], start: usize, c: usize, j: u32, h: &Hypothesis) -> Vec<Vec<Part>> {
+    let want = [h.beta[c], h.a[c][X], h.a[c][Y]];
+    let end = start + h.steps[j as usize][c];
+    if end > nodes.len() {
+        return Vec::new();
+    }
+    let lens = [
+        h.len(Part::F, j),
+        h.len(Part::Copy(X), j),
+        h.len(Part::Copy(Y), j),
+    ];
+    let parts = [Part::F, Part::Copy(X), Part::Copy(Y)];
+    let mut found = Vec::new();
+    let mut stack = vec![State {
+        pat: Vec::new(),
+        at: start,
+        used: [0; 3],
+        firsts: [None; 2],
+    }];
+    let mut work = 0;
+    while let Some(State {
+        pat,
+        at,
+        used,
+        firsts,
+    }) = stack.pop()
+    {
+        work += 1;
+        if work > CUT_WORK || found.len() >= MAX_CUTS {
+            break;
+        }
+        if at == end {
+            if used == want {
+                found.push(pat);
+            }
+            continue;
+        }
+        // Pushed in reverse: copies of X are tried first, runs last.
+        for kind in (0..3).rev() {
+            let len = lens[kind];
+            if used[kind] >= want[kind] || at + len > end || len == 0 {
+                continue;
+            }
+            let fits = match parts[kind] {
+                Part::F => straight(nodes, at, len),
+                Part::Copy(d) => firsts[d].is_none_or(|f| same_turns(nodes, f, at, len)),
+            };
+            if !fits {
+                continue;
+            }
+            let mut next = pat.clone();
+            next.push(parts[kind]);
+            let mut used = used;
+            used[kind] += 1;
+            let mut firsts = firsts;
+            if let Part::Copy(d) = parts[kind] {
+                firsts[d].get_or_insert(at);
+            }
+            stack.push(State {
+                pat: next,
+                at: at + len,
+                used,
+                firsts,
+            });
+        }
+    }
+    found
+}
+
+/// Whether steps `at..at + len` of a path go straight on.
+fn straight(nodes: &[Node], at: usize, len: usize) -> bool {
+    nodes[at + 1..at + len].iter().all(|n| n.turn == 0)
+}
+
+/// Whether the `len` steps of a path from `a` and from `b` turn alike
+/// (their first steps aside).
+fn same_turns(nodes: &[Node], a: usize, b: usize, len: usize) -> bool {
+    a == b
+        || nodes[a + 1..a + len]
+            .iter()
+            .zip(&nodes[b + 1..b + len])
+            .all(|(p, q)| p.turn == q.turn)
+}
+
+/// Grammars of the letters `pats` with the turns of the copies of X and Y
+/// two steps down at `twos`, over the turns a copy one step down starts
+/// and ends with (fewest turns first), each given to `take` until it has
+/// had enough (then `true`).
+fn with_turns(
+    nodes: &[Node],
+    pats: &[Vec<Part>; 2],
+    twos: [usize; 2],
+    h: &Hypothesis,
+    angles: &Angles,
+    shifts: &[[i32; 4]],
+    take: &mut dyn FnMut(Grammar) -> bool,
+) -> bool {
+    // The turn before each piece of the copies two steps down.
+    let mut seen = [Vec::new(), Vec::new()];
+    for c in [X, Y] {
+        let mut at = twos[c];
+        for &p in &pats[c] {
+            let Some(nd) = nodes.get(at) else {
+                return false;
+            };
+            seen[c].push(nd.turn);
+            at += h.len(p, 2);
+        }
+    }
+    // The turn before each piece of the copies three steps down.
+    let threes = copies_at(pats, h, 3);
+    let mut seen3 = [Vec::new(), Vec::new()];
+    for c in [X, Y] {
+        let Some(mut at) = threes[c] else { continue };
+        for &p in &pats[c] {
+            let Some(nd) = nodes.get(at) else {
+                return false;
+            };
+            seen3[c].push(nd.turn);
+            at += h.len(p, 3);
+        }
+    }
+    for &[lx, ex, ly, ey] in shifts {
+        let (lead, end) = ([lx, ly], [ex, ey]);
+        let succ = |c: usize| successor(&pats[c], &seen[c], lead, end, lead[c], end[c], angles);
+        if !three_down(pats, &seen, &seen3, lead, end, angles) {
+            continue;
+        }
+        let (Some(sx), Some(sy)) = (succ(X), succ(Y)) else {
+            continue;
+        };
+        let g = Grammar {
+            letters: vec![
+                Letter {
+                    name: 'F',
+                    action: Action::Draw,
+                    rule: (h.k > 1).then(|| vec![Sym::Letter(0); h.k]),
+                },
+                Letter {
+                    name: 'X',
+                    action: Action::Nothing,
+                    rule: Some(sx),
+                },
+                Letter {
+                    name: 'Y',
+                    action: Action::Nothing,
+                    rule: Some(sy),
+                },
+            ],
+            axiom: vec![Sym::Letter(1)],
+            depth: h.depth,
+        };
+        if take(g) {
+            return true;
+        }
+    }
+    false
+}
+
+/// A successor of letters `pat` whose pieces turn by `seen` two steps
+/// down, where copies of X and Y start turned by `lead` and are left
+/// turned by `end`; its own turns before its first F and after its last
+/// are then `own_lead` and `own_end`.
+fn successor(
+    pat: &[Part],
+    seen: &[i32],
+    lead: [i32; 2],
+    end: [i32; 2],
+    own_lead: i32,
+    own_end: i32,
+    angles: &Angles,
+) -> Option<Vec<Sym>> {
+    let sym = |p: Part| match p {
+        Part::F => Sym::Letter(0),
+        Part::Copy(d) => Sym::Letter(1 + d as u8),
+    };
+    let mut body = Vec::new();
+    for (i, &p) in pat.iter().enumerate() {
+        if i > 0 {
+            let before = match p {
+                Part::F => 0,
+                Part::Copy(d) => lead[d],
+            };
+            let after = match pat[i - 1] {
+                Part::F => 0,
+                Part::Copy(d) => end[d],
+            };
+            body.extend(turn_syms(seen[i] - before - after, angles));
+        }
+        body.push(sym(p));
+    }
+    // One step down, copies draw nothing: the body's own outer turns.
+    let first = body.iter().position(|s| *s == Sym::Letter(0))?;
+    let last = body.iter().rposition(|s| *s == Sym::Letter(0))?;
+    let count = |s: &[Sym]| {
+        s.iter()
+            .map(|s| match s {
+                Sym::Plus => 1,
+                Sym::Minus => -1,
+                _ => 0,
+            })
+            .sum::<i32>()
+    };
+    let (before, after) = (count(&body[..first]), count(&body[last..]));
+    let mut out = turn_syms(own_lead - before, angles);
+    out.extend(body);
+    out.extend(turn_syms(own_end - after, angles));
+    Some(out)
+}
+
+/// The turn between pieces `i - 1` and `i` of letter `c`'s successor, from
+/// the turn seen two steps down less the turns of copies one step down.
+fn between(
+    pats: &[Vec<Part>; 2],
+    seen: &[Vec<i32>; 2],
+    c: usize,
+    i: usize,
+    by: [[i32; 2]; 2],
+) -> i32 {
+    let [lead, end] = by;
+    let before = match pats[c][i] {
+        Part::F => 0,
+        Part::Copy(d) => lead[d],
+    };
+    let after = match pats[c][i - 1] {
+        Part::F => 0,
+        Part::Copy(d) => end[d],
+    };
+    seen[c][i] - before - after
+}
+
+/// Whether the successors written from `seen` turn as the copies three
+/// steps down are seen to (`seen3`, empty for a letter with no copy there),
+/// where a copy one step down starts turned by `lead` and is left turned
+/// by `end` — in counts of turns, before any successor is written.
+fn three_down(
+    pats: &[Vec<Part>; 2],
+    seen: &[Vec<i32>; 2],
+    seen3: &[Vec<i32>; 2],
+    lead: [i32; 2],
+    end: [i32; 2],
+    angles: &Angles,
+) -> bool {
+    let by = [lead, end];
+    let of = |p: Part, v: [i32; 2]| match p {
+        Part::F => 0,
+        Part::Copy(d) => v[d],
+    };
+    // Two steps down a copy starts turned by its successor's turns before
+    // its first piece (its own lead less the turns between pieces before
+    // its first F), and by that piece's lead if it is a copy; likewise at
+    // its end.
+    let mut lead2 = [0; 2];
+    let mut end2 = [0; 2];
+    for c in [X, Y] {
+        let pat = &pats[c];
+        let (Some(first), Some(last)) = (
+            pat.iter().position(|p| *p == Part::F),
+            pat.iter().rposition(|p| *p == Part::F),
+        ) else {
+            return false;
+        };
+        let inner_before: i32 = (1..=first).map(|i| between(pats, seen, c, i, by)).sum();
+        let inner_after: i32 = (last + 1..pat.len())
+            .map(|i| between(pats, seen, c, i, by))
+            .sum();
+        lead2[c] = lead[c] - inner_before + of(pat[0], lead);
+        end2[c] = end[c] - inner_after + of(pat[pat.len() - 1], end);
+    }
+    for c in [X, Y] {
+        for i in 1..seen3[c].len() {
+            let want =
+                between(pats, seen, c, i, by) + of(pats[c][i], lead2) + of(pats[c][i - 1], end2);
+            if angles.norm(want - seen3[c][i]) != 0 {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// The turns a copy of X and of Y one step down may start and end with,
+/// fewest turns first.
+fn shifts(angles: &Angles) -> Vec<[i32; 4]> {
+    let range = turn_range(angles);
+    let mut out = Vec::new();
+    for &lx in &range {
+        for &ex in &range {
+            for &ly in &range {
+                for &ey in &range {
+                    out.push([lx, ex, ly, ey]);
+                }
+            }
+        }
+    }
+    out.sort_by_key(|s| (s.iter().map(|v| v.abs()).sum::<i32>(), *s));
+    out
+}
