@@ -159,6 +159,10 @@ pub fn from_svg(data: &[u8], name: &str, opts: &Options) -> Lines {
     let ideal = graph.as_ref().map(ideal::redrawn).unwrap_or_default();
     if let Some(g) = &graph {
         again.extend(walk::trees(g).into_iter().map(|w| (w, None)));
+        // A path saved as several paths (a single one was read above).
+        if lines.len() > 1 {
+            again.extend(walk::paths(g).into_iter().map(|w| (w, None)));
+        }
         again.extend(ideal.iter().cloned().map(|w| (w, None)));
     }
     let as_drawn: Vec<(DVec2, DVec2)> = lines

@@ -1,5 +1,6 @@
-//! The walks a turtle could have drawn a branching stroke graph in, when
-//! the drawing's paths no longer say (one path per step, in any order).
+//! The walks a turtle could have drawn a branching stroke graph in, or a
+//! path, when the drawing's paths no longer say (one path per step, in any
+//! order).
 //!
 //! A bracketed L-system draws a tree: from its root, at every vertex, each
 //! branch in brackets first and the rest of the axis after them, in the
@@ -60,6 +61,22 @@ pub fn trees(g: &Graph) -> Vec<Vec<Vec<DVec2>>> {
         }
     }
     out
+}
+
+/// The drawing as one polyline from each end, when its graph is one path
+/// that does not touch itself (a Hilbert or Peano curve): the turtle drew
+/// it from one end to the other, whatever the order and direction its
+/// steps were saved in.
+pub fn paths(g: &Graph) -> Vec<Vec<Vec<DVec2>>> {
+    let ends: Vec<u32> = (0..g.points.len() as u32)
+        .filter(|&v| g.adj[v as usize].len() == 1)
+        .collect();
+    if ends.len() != 2 || g.adj.iter().any(|a| a.len() > 2) || !g.connected() {
+        return Vec::new();
+    }
+    ends.into_iter()
+        .map(|end| walk(g, end, Order::Left))
+        .collect()
 }
 
 /// Whether the edges are connected and some vertex has three or more (a
