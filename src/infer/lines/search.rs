@@ -1555,6 +1555,20 @@ mod tests {
         );
         let found = finds(&g, &a);
         assert!(found.rule_size() <= g.rule_size(), "{}", found.describe());
+        // Moore's curve: an axiom of four copies.
+        let a = Angles::new(90.0, Some(4), 1.0);
+        let g = grammar(
+            "LFL+F+LFL",
+            &[
+                ('L', Action::Nothing, "-RF+LFL+FR-"),
+                ('R', Action::Nothing, "+LF-RFR-FL+"),
+                ('F', Action::Draw, ""),
+            ],
+            3,
+        );
+        let found = finds(&g, &a);
+        assert_eq!(found.letters.len(), 3, "{}", found.describe());
+        assert!(found.rule_size() <= g.rule_size(), "{}", found.describe());
     }
 
     /// Axioms of several copies of X and runs of F (`XF-XF-XF`), the turns

@@ -55,7 +55,7 @@ impl Hypothesis {
     /// Steps of a piece of a copy at depth `j`.
     fn len(&self, p: Part, j: u32) -> usize {
         match p {
-            Part::F => self.k.pow(j - 1),
+            Part::F => self.k.saturating_pow(j - 1),
             Part::Copy(d) => self.steps[j as usize - 1][d],
         }
     }
@@ -76,19 +76,62 @@ pub(super) fn node_pairs(
     }
     let work = 64 * nodes.len() as u64 + 1_000;
     let shifts = shifts(angles);
-    for h in hypotheses(nodes.len(), limits) {
+    let single = hypotheses(nodes.len(), limits);
+    let axiom = [Part::Copy(X)];
+    for h in single {
         if limits.late() {
             out.timed_out = true;
             return;
         }
         let mut found = 0;
-        grammars(nodes, &h, angles, limits, &shifts, &mut |g| {
+        grammars(nodes, &h, &axiom, angles, limits, &shifts, &mut |g| {
             if matches(&g, tree, angles, work, limits.deadline) == Outcome::Same {
                 sink(g, out);
                 found += 1;
             }
             found >= PER_HYPOTHESIS
         });
+    }
+    // An axiom of several copies of X and runs of F (`LFL+F+LFL`): cut
+    // for each length of a run and of a copy that the drawing repeats from
+    // its start, then the hypotheses of that many steps.
+    let z = z_function(nodes);
+    let runs = straight_runs(nodes);
+    let total = nodes.len();
+    let mut lengths: Vec<usize> = (1..=3usize)
+        .flat_map(|k| (1..=MAX_DEPTH).map(move |n| k.saturating_pow(n)))
+        .filter(|&r| r < total)
+        .collect();
+    lengths.sort_unstable();
+    lengths.dedup();
+    let mut by_len = std::collections::HashMap::new();
+    for r in lengths {
+        for len in 2..total {
+            let cuts = axiom_cuts(&z, &runs, r, len);
+            if cuts.is_empty() {
+                continue;
+            }
+            let hs = by_len.entry(len).or_insert_with(|| hypotheses(len, limits));
+            for h in hs.iter() {
+                if h.len(Part::F, h.depth + 1) != r {
+                    continue;
+                }
+                for axiom in &cuts {
+                    if limits.late() {
+                        out.timed_out = true;
+                        return;
+                    }
+                    let mut found = 0;
+                    grammars(nodes, h, axiom, angles, limits, &shifts, &mut |g| {
+                        if matches(&g, tree, angles, work, limits.deadline) == Outcome::Same {
+                            sink(g, out);
+                            found += 1;
+                        }
+                        found >= PER_HYPOTHESIS
+                    });
+                }
+            }
+        }
     }
 }
 
@@ -100,6 +143,79 @@ fn is_path(nodes: &[Node]) -> bool {
             .enumerate()
             .all(|(i, n)| n.kind == Kind::Draw && (i == 0 || n.parent as usize == i - 1))
 }
+
+/// For each step p of a path, how many turns from step p + 1 on are those
+/// from step 1 on (a copy of the first L steps starts at p iff z[p] ≥
+/// L − 1), by the Z-function of its turns.
+fn z_function(nodes: &[Node]) -> Vec<usize> {
+    let t: Vec<i32> = nodes.iter().skip(1).map(|n| n.turn).collect();
+    let m = t.len();
+    let mut z = vec![0usize; nodes.len()];
+    let (mut l, mut r) = (0usize, 0usize);
+    for i in 1..m {
+        if i < r {
+            z[i] = (r - i).min(z[i - l]);
+        }
+        while i + z[i] < m && t[z[i]] == t[i + z[i]] {
+            z[i] += 1;
+        }
+        if i + z[i] > r {
+            (l, r) = (i, i + z[i]);
+        }
+    }
+    if m > 0 {
+        z[0] = m;
+    }
+    z
+}
+
+/// For each step p of a path, how many steps after it go straight on.
+fn straight_runs(nodes: &[Node]) -> Vec<usize> {
+    let mut out = vec![0usize; nodes.len()];
+    for p in (0..nodes.len().saturating_sub(1)).rev() {
+        if nodes[p + 1].turn == 0 {
+            out[p] = out[p + 1] + 1;
+        }
+    }
+    out
+}
+
+/// The ways (at most `MAX_CUTS`) to cut a path into an axiom of copies of
+/// X (`len` steps, turning as its first `len` steps do) and runs of F
+/// (`run` straight steps): X first, at least two pieces, at most
+/// `AXIOM_COPIES` copies and one run more than copies.
+fn axiom_cuts(z: &[usize], runs: &[usize], run: usize, len: usize) -> Vec<Vec<Part>> {
+    let end = z.len();
+    let mut found = Vec::new();
+    let mut stack = vec![(vec![Part::Copy(X)], len, 1usize, 0usize)];
+    let mut work = 0;
+    while let Some((pat, at, copies, fs)) = stack.pop() {
+        work += 1;
+        if work > CUT_WORK || found.len() >= MAX_CUTS {
+            break;
+        }
+        if at == end {
+            if pat.len() > 1 {
+                found.push(pat);
+            }
+            continue;
+        }
+        if fs <= copies && at + run <= end && runs[at] + 1 >= run {
+            let mut next = pat.clone();
+            next.push(Part::F);
+            stack.push((next, at + run, copies, fs + 1));
+        }
+        if copies < AXIOM_COPIES && at + len <= end && z[at] + 1 >= len {
+            let mut next = pat;
+            next.push(Part::Copy(X));
+            stack.push((next, at + len, copies + 1, fs));
+        }
+    }
+    found
+}
+
+/// The most copies in an axiom of several.
+const AXIOM_COPIES: usize = 16;
 
 /// The count hypotheses under which X draws `total` steps at a depth of at
 /// least 3, both letters' successors with at least one F (at most
@@ -139,7 +255,7 @@ fn hypotheses(total: usize, limits: &Limits) -> Vec<Hypothesis> {
                 if u + v > total {
                     break;
                 }
-                if depth < 3 || v == 0 {
+                if depth < 3 {
                     continue;
                 }
                 for bx in 1..=max_f {
@@ -150,7 +266,7 @@ fn hypotheses(total: usize, limits: &Limits) -> Vec<Hypothesis> {
                         continue;
                     }
                     let beta = [bx as usize, (rest / v) as usize];
-                    out.push(hypothesis(k as usize, beta, a, depth));
+                    out.push(hypothesis(k as usize, beta, a, depth, total as usize + 1));
                 }
             }
         }
@@ -185,18 +301,22 @@ fn grows(a: [[u64; 2]; 2]) -> bool {
     (tr + disc.sqrt()) / 2.0 > 1.0 + 1e-9
 }
 
-/// The hypothesis with its steps at every depth.
-fn hypothesis(k: usize, beta: [usize; 2], a: [[u64; 2]; 2], depth: u32) -> Hypothesis {
+/// The hypothesis with its steps at every depth (no more than `most`:
+/// more than a drawing holds).
+fn hypothesis(k: usize, beta: [usize; 2], a: [[u64; 2]; 2], depth: u32, most: usize) -> Hypothesis {
     let a = a.map(|row| row.map(|v| v as usize));
     let mut steps = vec![[0usize; 2]];
-    let mut run = 1;
+    let mut run = 1usize;
+    let count = |b: usize, run: usize, row: [usize; 2], f: [usize; 2]| {
+        b.saturating_mul(run)
+            .saturating_add(row[X].saturating_mul(f[X]))
+            .saturating_add(row[Y].saturating_mul(f[Y]))
+            .min(most)
+    };
     for _ in 1..=depth {
         let f = steps[steps.len() - 1];
-        steps.push([
-            beta[X] * run + a[X][X] * f[X] + a[X][Y] * f[Y],
-            beta[Y] * run + a[Y][X] * f[X] + a[Y][Y] * f[Y],
-        ]);
-        run *= k;
+        steps.push([count(beta[X], run, a[X], f), count(beta[Y], run, a[Y], f)]);
+        run = run.saturating_mul(k).min(most);
     }
     Hypothesis {
         k,
@@ -207,41 +327,65 @@ fn hypothesis(k: usize, beta: [usize; 2], a: [[u64; 2]; 2], depth: u32) -> Hypot
     }
 }
 
-/// The grammars of hypothesis `h` whose cuts the drawing has, before
-/// matching; `take` says when it has had enough.
+/// The grammars of hypothesis `h` and `axiom` (its pieces at depth n + 1:
+/// runs of k^n steps and copies at depth n) whose cuts the drawing has,
+/// before matching; `take` says when it has had enough.
 fn grammars(
     nodes: &[Node],
     h: &Hypothesis,
+    axiom: &[Part],
     angles: &Angles,
     limits: &Limits,
     shifts: &[[i32; 4]],
     take: &mut dyn FnMut(Grammar) -> bool,
 ) {
     let n = h.depth;
-    for px in cuts(nodes, 0, X, n, h) {
+    let top = [X, Y].map(|d| first_copy(axiom, d, 0, n + 1, h));
+    let Some(x0) = top[X] else {
+        return;
+    };
+    for px in cuts(nodes, x0, X, n, h) {
         // A copy of X one step down has X's letters too.
-        if let Some(x1) = first_copy(&px, X, 0, n, h)
-            && !cuts(nodes, x1, X, n - 1, h).contains(&px)
+        if let Some(x1) = first_copy(&px, X, x0, n, h)
+            && !has_cut(nodes, x1, &px, n - 1, h)
         {
             continue;
         }
-        let Some(y1) = first_copy(&px, Y, 0, n, h) else {
-            continue;
+        // Y's letters from a copy in the axiom, or one step down.
+        let ys = match (top[Y], first_copy(&px, Y, x0, n, h)) {
+            (Some(y0), _) => cuts(nodes, y0, Y, n, h),
+            (None, Some(y1)) => cuts(nodes, y1, Y, n - 1, h),
+            (None, None) => continue,
         };
-        for py in cuts(nodes, y1, Y, n - 1, h) {
+        for py in ys {
             if limits.late() {
                 return;
             }
             let pats = [px.clone(), py];
-            let [Some(x2), Some(y2)] = copies_at(&pats, h, 2) else {
+            let [Some(x2), Some(y2)] = copies_at(&pats, h, top, 2) else {
                 continue;
             };
-            let twos = [x2, y2];
-            if with_turns(nodes, &pats, twos, h, angles, shifts, take) {
+            let cut = Cut {
+                pats,
+                axiom,
+                top,
+                twos: [x2, y2],
+            };
+            if with_turns(nodes, &cut, h, angles, shifts, take) {
                 return;
             }
         }
     }
+}
+
+/// The drawing cut: each letter's pieces, the axiom's, where the axiom's
+/// first copy of each letter starts, and where a copy of each starts two
+/// steps down.
+struct Cut<'a> {
+    pats: [Vec<Part>; 2],
+    axiom: &'a [Part],
+    top: [Option<usize>; 2],
+    twos: [usize; 2],
 }
 
 /// Where the first copy of letter `d` starts in a copy of `pat` at `start`
@@ -258,10 +402,18 @@ fn first_copy(pat: &[Part], d: usize, start: usize, j: u32, h: &Hypothesis) -> O
 }
 
 /// Where a copy of X and one of Y `level` steps down start (when there
-/// is one), following the letters of `pats` from the drawing (a copy of X
-/// at depth n).
-fn copies_at(pats: &[Vec<Part>; 2], h: &Hypothesis, level: u32) -> [Option<usize>; 2] {
-    let mut at = [Some(0), None];
+/// is one), following the letters of `pats` from the axiom's copies at
+/// depth n (`top`).
+fn copies_at(
+    pats: &[Vec<Part>; 2],
+    h: &Hypothesis,
+    top: [Option<usize>; 2],
+    level: u32,
+) -> [Option<usize>; 2] {
+    if level > h.depth {
+        return [None, None];
+    }
+    let mut at = top;
     for j in (level + 1..=h.depth).rev() {
         let mut next = [None, None];
         for c in [X, Y] {
@@ -359,6 +511,28 @@ fn cuts(nodes: &[Node], start: usize, c: usize, j: u32, h: &Hypothesis) -> Vec<V
     found
 }
 
+/// Whether the steps from `start` cut into the pieces `pat` at depth `j`:
+/// runs straight, the copies of each letter turning alike.
+fn has_cut(nodes: &[Node], start: usize, pat: &[Part], j: u32, h: &Hypothesis) -> bool {
+    let mut firsts = [None; 2];
+    let mut at = start;
+    for &p in pat {
+        let len = h.len(p, j);
+        if len == 0 || at + len > nodes.len() {
+            return false;
+        }
+        let fits = match p {
+            Part::F => straight(nodes, at, len),
+            Part::Copy(d) => same_turns(nodes, *firsts[d].get_or_insert(at), at, len),
+        };
+        if !fits {
+            return false;
+        }
+        at += len;
+    }
+    true
+}
+
 /// Whether steps `at..at + len` of a path go straight on.
 fn straight(nodes: &[Node], at: usize, len: usize) -> bool {
     nodes[at + 1..at + len].iter().all(|n| n.turn == 0)
@@ -380,13 +554,13 @@ fn same_turns(nodes: &[Node], a: usize, b: usize, len: usize) -> bool {
 /// had enough (then `true`).
 fn with_turns(
     nodes: &[Node],
-    pats: &[Vec<Part>; 2],
-    twos: [usize; 2],
+    cut: &Cut<'_>,
     h: &Hypothesis,
     angles: &Angles,
     shifts: &[[i32; 4]],
     take: &mut dyn FnMut(Grammar) -> bool,
 ) -> bool {
+    let (pats, twos) = (&cut.pats, cut.twos);
     // The turn before each piece of the copies two steps down.
     let mut seen = [Vec::new(), Vec::new()];
     for c in [X, Y] {
@@ -400,7 +574,7 @@ fn with_turns(
         }
     }
     // The turn before each piece of the copies three steps down.
-    let threes = copies_at(pats, h, 3);
+    let threes = copies_at(pats, h, cut.top, 3);
     let mut seen3 = [Vec::new(), Vec::new()];
     for c in [X, Y] {
         let Some(mut at) = threes[c] else { continue };
@@ -412,10 +586,23 @@ fn with_turns(
             at += h.len(p, 3);
         }
     }
+    // The turn before each piece of the axiom.
+    let mut seen_axiom = Vec::new();
+    let mut at = 0;
+    for &p in cut.axiom {
+        let Some(nd) = nodes.get(at) else {
+            return false;
+        };
+        seen_axiom.push(nd.turn);
+        at += h.len(p, h.depth + 1);
+    }
+    let Some(three) = ThreeDown::new(pats, &seen, &seen3) else {
+        return false;
+    };
     for &[lx, ex, ly, ey] in shifts {
         let (lead, end) = ([lx, ly], [ex, ey]);
         let succ = |c: usize| successor(&pats[c], &seen[c], lead, end, lead[c], end[c], angles);
-        if !three_down(pats, &seen, &seen3, lead, end, angles) {
+        if !three.holds([lx, ex, ly, ey], angles) {
             continue;
         }
         let (Some(sx), Some(sy)) = (succ(X), succ(Y)) else {
@@ -439,7 +626,7 @@ fn with_turns(
                     rule: Some(sy),
                 },
             ],
-            axiom: vec![Sym::Letter(1)],
+            axiom: axiom_syms(cut, &seen, &seen_axiom, lead, end, h.depth, angles),
             depth: h.depth,
         };
         if take(g) {
@@ -521,54 +708,153 @@ fn between(
     seen[c][i] - before - after
 }
 
-/// Whether the successors written from `seen` turn as the copies three
-/// steps down are seen to (`seen3`, empty for a letter with no copy there),
-/// where a copy one step down starts turned by `lead` and is left turned
-/// by `end` — in counts of turns, before any successor is written.
-fn three_down(
+/// The turns a copy of X and of Y starts and ends with `level` steps down,
+/// for successors written from `seen` where a copy one step down starts
+/// turned by `lead` and is left turned by `end`: its successor's turns
+/// before its first piece (its own lead less the turns between pieces
+/// before its first F), and that piece's own if it is a copy; likewise at
+/// its end.
+fn ends_at(
     pats: &[Vec<Part>; 2],
     seen: &[Vec<i32>; 2],
-    seen3: &[Vec<i32>; 2],
     lead: [i32; 2],
     end: [i32; 2],
-    angles: &Angles,
-) -> bool {
+    level: u32,
+) -> Option<([i32; 2], [i32; 2])> {
     let by = [lead, end];
-    let of = |p: Part, v: [i32; 2]| match p {
-        Part::F => 0,
-        Part::Copy(d) => v[d],
-    };
-    // Two steps down a copy starts turned by its successor's turns before
-    // its first piece (its own lead less the turns between pieces before
-    // its first F), and by that piece's lead if it is a copy; likewise at
-    // its end.
-    let mut lead2 = [0; 2];
-    let mut end2 = [0; 2];
+    let (mut prefix, mut suffix) = ([0; 2], [0; 2]);
     for c in [X, Y] {
         let pat = &pats[c];
-        let (Some(first), Some(last)) = (
-            pat.iter().position(|p| *p == Part::F),
-            pat.iter().rposition(|p| *p == Part::F),
-        ) else {
-            return false;
-        };
+        let first = pat.iter().position(|p| *p == Part::F)?;
+        let last = pat.iter().rposition(|p| *p == Part::F)?;
         let inner_before: i32 = (1..=first).map(|i| between(pats, seen, c, i, by)).sum();
         let inner_after: i32 = (last + 1..pat.len())
             .map(|i| between(pats, seen, c, i, by))
             .sum();
-        lead2[c] = lead[c] - inner_before + of(pat[0], lead);
-        end2[c] = end[c] - inner_after + of(pat[pat.len() - 1], end);
+        prefix[c] = lead[c] - inner_before;
+        suffix[c] = end[c] - inner_after;
     }
-    for c in [X, Y] {
-        for i in 1..seen3[c].len() {
-            let want =
-                between(pats, seen, c, i, by) + of(pats[c][i], lead2) + of(pats[c][i - 1], end2);
-            if angles.norm(want - seen3[c][i]) != 0 {
-                return false;
-            }
+    let (mut l, mut e) = (lead, end);
+    for _ in 2..=level {
+        let (l0, e0) = (l, e);
+        for c in [X, Y] {
+            l[c] = prefix[c] + of(pats[c][0], l0);
+            e[c] = suffix[c] + of(pats[c][pats[c].len() - 1], e0);
         }
     }
-    true
+    Some((l, e))
+}
+
+/// A piece's value of `v`: 0 for a run of F.
+fn of(p: Part, v: [i32; 2]) -> i32 {
+    match p {
+        Part::F => 0,
+        Part::Copy(d) => v[d],
+    }
+}
+
+/// Whether the successors written from `seen` turn as the copies three
+/// steps down are seen to (`seen3`, empty for a letter with no copy there),
+/// where a copy one step down starts turned by `lead` and is left turned
+/// by `end` — in counts of turns, before any successor is written.
+///
+/// A piece of a copy three steps down turns as two steps down, plus how
+/// much more its copy starts turned there (`lead2 − lead`) and its
+/// predecessor's copy ends turned (`end2 − end`); those differences are
+/// sums of turns, affine in the four shifts, so they are found once for
+/// the cut and each shift is checked in a few additions.
+struct ThreeDown {
+    /// The differences (lead X, lead Y, end X, end Y) at no shift, and
+    /// what each shift (lead X, end X, lead Y, end Y) adds.
+    base: [i32; 4],
+    by: [[i32; 4]; 4],
+    /// Each piece boundary three steps down: the letter of the piece (if
+    /// a copy), of the one before it, and the turn it must add.
+    bounds: Vec<(Option<usize>, Option<usize>, i32)>,
+}
+
+impl ThreeDown {
+    fn new(pats: &[Vec<Part>; 2], seen: &[Vec<i32>; 2], seen3: &[Vec<i32>; 2]) -> Option<Self> {
+        let diff = |shift: [i32; 4]| {
+            let (lead, end) = ([shift[0], shift[2]], [shift[1], shift[3]]);
+            let (lead2, end2) = ends_at(pats, seen, lead, end, 2)?;
+            Some([
+                lead2[X] - lead[X],
+                lead2[Y] - lead[Y],
+                end2[X] - end[X],
+                end2[Y] - end[Y],
+            ])
+        };
+        let base = diff([0; 4])?;
+        let mut by = [[0; 4]; 4];
+        for (k, col) in by.iter_mut().enumerate() {
+            let mut unit = [0; 4];
+            unit[k] = 1;
+            let d = diff(unit)?;
+            *col = [0, 1, 2, 3].map(|i| d[i] - base[i]);
+        }
+        let letter = |p: Part| match p {
+            Part::F => None,
+            Part::Copy(d) => Some(d),
+        };
+        let mut bounds = Vec::new();
+        for c in [X, Y] {
+            for i in 1..seen3[c].len() {
+                bounds.push((
+                    letter(pats[c][i]),
+                    letter(pats[c][i - 1]),
+                    seen3[c][i] - seen[c][i],
+                ));
+            }
+        }
+        Some(ThreeDown { base, by, bounds })
+    }
+
+    /// Whether the shift (lead X, end X, lead Y, end Y) turns as seen.
+    fn holds(&self, shift: [i32; 4], angles: &Angles) -> bool {
+        let mut d = self.base;
+        for (k, col) in self.by.iter().enumerate() {
+            for i in 0..4 {
+                d[i] += shift[k] * col[i];
+            }
+        }
+        self.bounds.iter().all(|&(p, q, want)| {
+            let lead = p.map_or(0, |l| d[l]);
+            let end = q.map_or(0, |l| d[2 + l]);
+            angles.norm(lead + end - want) == 0
+        })
+    }
+}
+
+/// The axiom of `cut`: its pieces, the turns between them as drawn less
+/// the turns a copy at depth n starts and ends with.
+fn axiom_syms(
+    cut: &Cut<'_>,
+    seen: &[Vec<i32>; 2],
+    seen_axiom: &[i32],
+    lead: [i32; 2],
+    end: [i32; 2],
+    depth: u32,
+    angles: &Angles,
+) -> Vec<Sym> {
+    if cut.axiom == [Part::Copy(X)] {
+        return vec![Sym::Letter(1)];
+    }
+    let Some((lead_n, end_n)) = ends_at(&cut.pats, seen, lead, end, depth) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (i, &p) in cut.axiom.iter().enumerate() {
+        if i > 0 {
+            let t = seen_axiom[i] - of(p, lead_n) - of(cut.axiom[i - 1], end_n);
+            out.extend(turn_syms(t, angles));
+        }
+        out.push(match p {
+            Part::F => Sym::Letter(0),
+            Part::Copy(d) => Sym::Letter(1 + d as u8),
+        });
+    }
+    out
 }
 
 /// The turns a copy of X and of Y one step down may start and end with,
