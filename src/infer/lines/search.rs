@@ -100,7 +100,13 @@ pub fn propose(tree: &Tree, angles: &Angles, limits: &Limits) -> Proposals {
         }
     };
     node_rewriting(tree, angles, limits, &mut add, &mut out);
-    pair::node_pairs(tree, angles, limits, &mut add, &mut out);
+    // Two node letters only where one letter draws nothing of it: their
+    // search is the costliest, and a grammar of fewer letters is smaller.
+    let work = 64 * tree.nodes.len() as u64 + 100_000;
+    let drawn = |g: &Grammar| matches(g, tree, angles, work, limits.deadline) == Outcome::Same;
+    if !out.grammars.iter().any(drawn) {
+        pair::node_pairs(tree, angles, limits, &mut add, &mut out);
+    }
     out.grammars.sort_by_cached_key(|g| {
         let (size, rule_size, rules, text) = g.cost();
         (size, rule_size, rules, turned_ends(g), text)

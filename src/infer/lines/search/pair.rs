@@ -76,7 +76,8 @@ pub(super) fn node_pairs(
     }
     let work = 64 * nodes.len() as u64 + 1_000;
     let shifts = shifts(angles);
-    let single = hypotheses(nodes.len(), limits);
+    let table = growths(nodes.len(), limits);
+    let single = hypotheses(nodes.len(), &table, limits);
     let axiom = [Part::Copy(X)];
     for h in single {
         if limits.late() {
@@ -97,6 +98,13 @@ pub(super) fn node_pairs(
     // its start, then the hypotheses of that many steps.
     let z = z_function(nodes);
     let runs = straight_runs(nodes);
+    // Lengths of the drawing's start that it draws again further on.
+    let mut repeats = vec![false; nodes.len() + 1];
+    let mut best = 0;
+    for len in (1..nodes.len()).rev() {
+        best = best.max(z[len]);
+        repeats[len] = best + 1 >= len;
+    }
     let total = nodes.len();
     let mut lengths: Vec<usize> = (1..=3usize)
         .flat_map(|k| (1..=MAX_DEPTH).map(move |n| k.saturating_pow(n)))
@@ -106,12 +114,20 @@ pub(super) fn node_pairs(
     lengths.dedup();
     let mut by_len = std::collections::HashMap::new();
     for r in lengths {
-        for len in 2..total {
+        for (len, _) in repeats
+            .iter()
+            .enumerate()
+            .take(total)
+            .skip(2)
+            .filter(|r| *r.1)
+        {
             let cuts = axiom_cuts(&z, &runs, r, len);
             if cuts.is_empty() {
                 continue;
             }
-            let hs = by_len.entry(len).or_insert_with(|| hypotheses(len, limits));
+            let hs = by_len
+                .entry(len)
+                .or_insert_with(|| hypotheses(len, &table, limits));
             for h in hs.iter() {
                 if h.len(Part::F, h.depth + 1) != r {
                     continue;
@@ -191,7 +207,7 @@ fn axiom_cuts(z: &[usize], runs: &[usize], run: usize, len: usize) -> Vec<Vec<Pa
     let mut work = 0;
     while let Some((pat, at, copies, fs)) = stack.pop() {
         work += 1;
-        if work > CUT_WORK || found.len() >= MAX_CUTS {
+        if work > AXIOM_WORK || found.len() >= MAX_CUTS {
             break;
         }
         if at == end {
@@ -214,6 +230,9 @@ fn axiom_cuts(z: &[usize], runs: &[usize], run: usize, len: usize) -> Vec<Vec<Pa
     found
 }
 
+/// Most choices an axiom's cut tries before it gives up.
+const AXIOM_WORK: usize = 1_000;
+
 /// The most copies in an axiom of several.
 const AXIOM_COPIES: usize = 16;
 
@@ -225,13 +244,45 @@ const AXIOM_COPIES: usize = 16;
 /// The steps are linear in the F counts: f(n) = S(n)·β with
 /// S(n) = A·S(n−1) + k^(n−1)·I, so for each k, A and n the F counts are
 /// solved for rather than enumerated.
-fn hypotheses(total: usize, limits: &Limits) -> Vec<Hypothesis> {
+fn hypotheses(total: usize, table: &[Growth], limits: &Limits) -> Vec<Hypothesis> {
     let total = total as u64;
-    let max_x = limits.max_x as u64;
     let max_f = limits.max_f.min(MAX_F) as u64;
     let mut out = Vec::new();
+    for g in table {
+        let [u, v] = g.x;
+        if u + v > total {
+            continue;
+        }
+        for bx in 1..=max_f {
+            let Some(rest) = total.checked_sub(u * bx) else {
+                break;
+            };
+            if rest % v != 0 || !(1..=max_f).contains(&(rest / v)) {
+                continue;
+            }
+            let beta = [bx as usize, (rest / v) as usize];
+            out.push(hypothesis(g.k, beta, g.a, g.depth, total as usize + 1));
+        }
+    }
+    out
+}
+
+/// How X's steps grow under F -> F^k and copies `a`: at `depth` X draws
+/// x[0]·β_X + x[1]·β_Y steps.
+struct Growth {
+    k: usize,
+    a: [[u64; 2]; 2],
+    depth: u32,
+    x: [u64; 2],
+}
+
+/// Every growth (depth at least 3) under which X may draw no more than
+/// `total` steps, computed once for a drawing and each of its parts.
+fn growths(total: usize, limits: &Limits) -> Vec<Growth> {
+    let total = total as u64;
+    let mut out = Vec::new();
     for k in 1..=3u64 {
-        for a in matrices(max_x) {
+        for a in matrices(limits.max_x as u64) {
             if k == 1 && !grows(a) {
                 continue;
             }
@@ -251,22 +302,16 @@ fn hypotheses(total: usize, limits: &Limits) -> Vec<Hypothesis> {
                         ],
                     ];
                 }
-                let (u, v) = (s[X][X], s[X][Y]);
-                if u + v > total {
+                if s[X][X] + s[X][Y] > total {
                     break;
                 }
-                if depth < 3 {
-                    continue;
-                }
-                for bx in 1..=max_f {
-                    let Some(rest) = total.checked_sub(u * bx) else {
-                        break;
-                    };
-                    if rest % v != 0 || !(1..=max_f).contains(&(rest / v)) {
-                        continue;
-                    }
-                    let beta = [bx as usize, (rest / v) as usize];
-                    out.push(hypothesis(k as usize, beta, a, depth, total as usize + 1));
+                if depth >= 3 {
+                    out.push(Growth {
+                        k: k as usize,
+                        a,
+                        depth,
+                        x: s[X],
+                    });
                 }
             }
         }
@@ -810,19 +855,34 @@ impl ThreeDown {
         Some(ThreeDown { base, by, bounds })
     }
 
-    /// Whether the shift (lead X, end X, lead Y, end Y) turns as seen.
+    /// Whether the shift (lead X, end X, lead Y, end Y) turns as seen
+    /// (plain loops: this runs for every shift of every cut).
     fn holds(&self, shift: [i32; 4], angles: &Angles) -> bool {
         let mut d = self.base;
-        for (k, col) in self.by.iter().enumerate() {
-            for i in 0..4 {
-                d[i] += shift[k] * col[i];
+        for (&v, col) in shift.iter().zip(&self.by) {
+            if v != 0 {
+                for (di, c) in d.iter_mut().zip(col) {
+                    *di += v * c;
+                }
             }
         }
-        self.bounds.iter().all(|&(p, q, want)| {
-            let lead = p.map_or(0, |l| d[l]);
-            let end = q.map_or(0, |l| d[2 + l]);
-            angles.norm(lead + end - want) == 0
-        })
+        for &(p, q, want) in &self.bounds {
+            let mut t = -want;
+            if let Some(l) = p {
+                t += d[l];
+            }
+            if let Some(l) = q {
+                t += d[2 + l];
+            }
+            let off = match angles.period {
+                Some(m) if m > 0 => t % m != 0,
+                _ => t != 0,
+            };
+            if off {
+                return false;
+            }
+        }
+        true
     }
 }
 
