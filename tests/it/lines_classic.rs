@@ -19,13 +19,14 @@ use crate::support::root;
 use glam::DVec2;
 use lsyc::infer::lines::{self, Lines};
 
-/// Exact drawings so far, per variant (of 15), in a debug build.
+/// Exact drawings so far, per variant (of 15), in a debug build, less one
+/// for the shared machines' timing (a debug build counted 10, 10, 6, 10, 7).
 const FLOORS: [(&str, usize); 5] = [
-    ("clean", 6),
-    ("rotated", 6),
-    ("jittered", 1),
-    ("split", 6),
-    ("shuffled", 1),
+    ("clean", 9),
+    ("rotated", 9),
+    ("jittered", 5),
+    ("split", 9),
+    ("shuffled", 6),
 ];
 
 fn segments(svg: &[u8]) -> Vec<(DVec2, DVec2)> {

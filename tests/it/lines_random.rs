@@ -40,7 +40,7 @@ const FLOORS: &[(Class, [usize; 6])] = &[
     (Class::Edge1, [29, 29, 20, 29, 23, 27]),
     (Class::Edge2, [25, 25, 15, 25, 21, 19]),
     (Class::Edge3, [7, 7, 4, 7, 1, 4]),
-    (Class::Node, [21, 21, 8, 22, 11, 12]),
+    (Class::Node, [26, 26, 10, 27, 21, 16]),
     (Class::Bracketed, [30, 30, 12, 30, 19, 16]),
     (Class::Moves, [7, 7, 2, 7, 1, 2]),
 ];

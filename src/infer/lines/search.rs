@@ -18,6 +18,8 @@
 //!   drawing of X one and two steps down is found nested at the place of
 //!   the first X of the successor, and the drawing two steps down is parsed
 //!   into runs of k^1 steps (F) and copies of the drawing one step down (X).
+//! - **Two node letters** (`pair`: Hilbert, Peano, Moore), for a drawing that
+//!   is one path and only when no candidate of fewer letters draws it.
 //!
 //! Owns: proposing candidates, within the work limits of `Limits`. Must not
 //! accept one: `grammar::matches` and the library's own derivation do.
