@@ -74,7 +74,6 @@ pub(super) fn node_pairs(
     if !is_path(nodes) {
         return;
     }
-    let work = 64 * nodes.len() as u64 + 1_000;
     let shifts = shifts(angles);
     let table = growths(nodes.len(), limits);
     let single = hypotheses(nodes.len(), &table, limits);
@@ -84,14 +83,7 @@ pub(super) fn node_pairs(
             out.timed_out = true;
             return;
         }
-        let mut found = 0;
-        grammars(nodes, &h, &axiom, angles, limits, &shifts, &mut |g| {
-            if matches(&g, tree, angles, work, limits.deadline) == Outcome::Same {
-                sink(g, out);
-                found += 1;
-            }
-            found >= PER_HYPOTHESIS
-        });
+        propose_matched(tree, &h, &axiom, angles, limits, &shifts, sink, out);
     }
     // An axiom of several copies of X and runs of F (`LFL+F+LFL`): cut
     // for each length of a run and of a copy that the drawing repeats from
@@ -137,18 +129,35 @@ pub(super) fn node_pairs(
                         out.timed_out = true;
                         return;
                     }
-                    let mut found = 0;
-                    grammars(nodes, h, axiom, angles, limits, &shifts, &mut |g| {
-                        if matches(&g, tree, angles, work, limits.deadline) == Outcome::Same {
-                            sink(g, out);
-                            found += 1;
-                        }
-                        found >= PER_HYPOTHESIS
-                    });
+                    propose_matched(tree, h, axiom, angles, limits, &shifts, sink, out);
                 }
             }
         }
     }
+}
+
+/// Proposes the grammars of hypothesis `h` and `axiom` that draw `tree`
+/// (at most `PER_HYPOTHESIS`).
+#[allow(clippy::too_many_arguments)]
+fn propose_matched(
+    tree: &Tree,
+    h: &Hypothesis,
+    axiom: &[Part],
+    angles: &Angles,
+    limits: &Limits,
+    shifts: &[[i32; 4]],
+    sink: &mut Sink<'_>,
+    out: &mut Proposals,
+) {
+    let work = 64 * tree.nodes.len() as u64 + 1_000;
+    let mut found = 0;
+    grammars(&tree.nodes, h, axiom, angles, limits, shifts, &mut |g| {
+        if matches(&g, tree, angles, work, limits.deadline) == Outcome::Same {
+            sink(g, out);
+            found += 1;
+        }
+        found >= PER_HYPOTHESIS
+    });
 }
 
 /// One path of drawn steps, each from the one before.
