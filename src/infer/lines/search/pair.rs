@@ -13,6 +13,11 @@
 //! turns a copy one step down starts and ends with: those the drawing does
 //! not show, so they are tried over the turn range and each candidate is
 //! matched against the drawing before it is proposed.
+//!
+//! An axiom of several copies of X and runs of F (Moore's `LFL+F+LFL`) is
+//! cut first, for each copy length the drawing draws again from its start
+//! (the Z-function of its turns); f_X(n) is then that length. Axioms that
+//! mix copies of X and Y are not searched yet.
 
 use super::{Limits, Proposals, Sink, turn_range};
 use crate::infer::lines::grammar::{Action, Grammar, Letter, Outcome, Sym, matches, turn_syms};
