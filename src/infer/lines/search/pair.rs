@@ -620,41 +620,22 @@ fn with_turns(
     take: &mut dyn FnMut(Grammar) -> bool,
 ) -> bool {
     let (pats, twos) = (&cut.pats, cut.twos);
-    // The turn before each piece of the copies two steps down.
-    let mut seen = [Vec::new(), Vec::new()];
-    for c in [X, Y] {
-        let mut at = twos[c];
-        for &p in &pats[c] {
-            let Some(nd) = nodes.get(at) else {
-                return false;
-            };
-            seen[c].push(nd.turn);
-            at += h.len(p, 2);
-        }
-    }
-    // The turn before each piece of the copies three steps down.
+    // The turn before each piece of the copies two and three steps down,
+    // and of the axiom.
+    let turns = |start: Option<usize>, pat: &[Part], j: u32| {
+        start.map_or(Some(Vec::new()), |s| piece_turns(nodes, s, pat, j, h))
+    };
     let threes = copies_at(pats, h, cut.top, 3);
-    let mut seen3 = [Vec::new(), Vec::new()];
-    for c in [X, Y] {
-        let Some(mut at) = threes[c] else { continue };
-        for &p in &pats[c] {
-            let Some(nd) = nodes.get(at) else {
-                return false;
-            };
-            seen3[c].push(nd.turn);
-            at += h.len(p, 3);
-        }
-    }
-    // The turn before each piece of the axiom.
-    let mut seen_axiom = Vec::new();
-    let mut at = 0;
-    for &p in cut.axiom {
-        let Some(nd) = nodes.get(at) else {
-            return false;
-        };
-        seen_axiom.push(nd.turn);
-        at += h.len(p, h.depth + 1);
-    }
+    let (Some(sx), Some(sy), Some(tx), Some(ty), Some(seen_axiom)) = (
+        turns(Some(twos[X]), &pats[X], 2),
+        turns(Some(twos[Y]), &pats[Y], 2),
+        turns(threes[X], &pats[X], 3),
+        turns(threes[Y], &pats[Y], 3),
+        turns(Some(0), cut.axiom, h.depth + 1),
+    ) else {
+        return false;
+    };
+    let (seen, seen3) = ([sx, sy], [tx, ty]);
     let Some(three) = ThreeDown::new(pats, &seen, &seen3) else {
         return false;
     };
@@ -695,6 +676,32 @@ fn with_turns(
     false
 }
 
+/// The turn before each piece of a copy of `pat` at depth `j` that starts
+/// at `start` (its first from the step before the copy).
+fn piece_turns(
+    nodes: &[Node],
+    start: usize,
+    pat: &[Part],
+    j: u32,
+    h: &Hypothesis,
+) -> Option<Vec<i32>> {
+    let mut at = start;
+    let mut out = Vec::with_capacity(pat.len());
+    for &p in pat {
+        out.push(nodes.get(at)?.turn);
+        at += h.len(p, j);
+    }
+    Some(out)
+}
+
+/// The symbol of a piece: F, or the letter X or Y.
+fn sym(p: Part) -> Sym {
+    match p {
+        Part::F => Sym::Letter(0),
+        Part::Copy(d) => Sym::Letter(1 + d as u8),
+    }
+}
+
 /// A successor of letters `pat` whose pieces turn by `seen` two steps
 /// down, where copies of X and Y start turned by `lead` and are left
 /// turned by `end`; its own turns before its first F and after its last
@@ -708,10 +715,6 @@ fn successor(
     own_end: i32,
     angles: &Angles,
 ) -> Option<Vec<Sym>> {
-    let sym = |p: Part| match p {
-        Part::F => Sym::Letter(0),
-        Part::Copy(d) => Sym::Letter(1 + d as u8),
-    };
     let mut body = Vec::new();
     for (i, &p) in pat.iter().enumerate() {
         if i > 0 {
@@ -923,10 +926,7 @@ fn axiom_syms(
             let t = seen_axiom[i] - of(p, lead_n) - of(cut.axiom[i - 1], end_n);
             out.extend(turn_syms(t, angles));
         }
-        out.push(match p {
-            Part::F => Sym::Letter(0),
-            Part::Copy(d) => Sym::Letter(1 + d as u8),
-        });
+        out.push(sym(p));
     }
     out
 }
