@@ -287,6 +287,140 @@ pub fn first_step(g: &Grammar, angles: &Angles, work: u64) -> Option<(DVec2, i32
     None
 }
 
+/// Where `w` ends, drawn from the origin heading +y, with steps of 1 for
+/// letters that draw or move (branches come back where they started).
+fn chord(g: &Grammar, w: &[Sym], dirs: &Directions) -> DVec2 {
+    let (mut pos, mut heading) = (DVec2::ZERO, 0i32);
+    let mut saved = Vec::new();
+    for &s in w {
+        match s {
+            Sym::Plus => heading += 1,
+            Sym::Minus => heading -= 1,
+            Sym::Push => saved.push((pos, heading)),
+            Sym::Pop => (pos, heading) = saved.pop().unwrap_or((pos, heading)),
+            Sym::Letter(k) => {
+                if g.letters
+                    .get(k as usize)
+                    .is_some_and(|l| l.action != Action::Nothing)
+                {
+                    pos += dirs.get(heading);
+                }
+            }
+        }
+    }
+    pos
+}
+
+/// The turns `c` for which every successor that ends away from its start
+/// ends `c` turns of δ to its left: modulo the period, or within a few
+/// turns without one.
+fn straight_ahead(g: &Grammar, angles: &Angles) -> Option<i32> {
+    let dirs = Directions::new(angles);
+    let chords: Vec<DVec2> = g
+        .letters
+        .iter()
+        .filter_map(|l| l.rule.as_ref())
+        .map(|w| chord(g, w, &dirs))
+        .filter(|v| v.length() > 1e-6)
+        .collect();
+    if chords.is_empty() {
+        return None;
+    }
+    let cs: Vec<i32> = match angles.period {
+        Some(m) if m > 0 => (0..m).collect(),
+        _ => (-4..=4).collect(),
+    };
+    cs.into_iter().find(|&c| {
+        let ahead = dirs.get(c);
+        chords
+            .iter()
+            .all(|v| v.perp_dot(ahead).abs() < 1e-6 * v.length() && v.dot(ahead) > 0.0)
+    })
+}
+
+/// The conjugate a person writes of an edge-rewriting grammar (every
+/// letter draws or moves and is rewritten), and its angles: every
+/// successor's leading turns less c·δ and its trailing turns more c·δ draw
+/// the same level n from a start turned by n·c·δ, so level n cannot tell
+/// them apart. The one whose successors each end straight ahead of where
+/// they start (as the Koch construction draws a generator over the edge it
+/// replaces) is written when there is one, at δ or, when only a finer
+/// angle has one, at δ/2 or δ/3: Lévy's C curve `F -> +F--F+` at 45° draws
+/// every step at a multiple of 90° from its start, where the smallest
+/// grammar is `F -> F-F+`. `g` as it is otherwise (the search's smallest).
+/// The axiom is the same word: only the heading it starts at changes, which
+/// the frame puts right.
+pub fn aligned(g: &Grammar, angles: &Angles) -> (Grammar, Angles) {
+    let edges = g
+        .letters
+        .iter()
+        .all(|l| l.action != Action::Nothing && l.rule.is_some());
+    if !edges {
+        return (g.clone(), *angles);
+    }
+    for k in 1..=3 {
+        let finer = Angles::new(
+            angles.delta / f64::from(k),
+            angles.period.map(|m| m * k),
+            angles.tolerance / f64::from(k),
+        );
+        let gk = finer_turns(g, k as usize);
+        match straight_ahead(&gk, &finer) {
+            Some(0) => return (g.clone(), *angles),
+            Some(c) => {
+                if let Some(out) = conjugate(&gk, c, &finer) {
+                    return (out, finer);
+                }
+            }
+            None => {}
+        }
+    }
+    (g.clone(), *angles)
+}
+
+/// `g` with every turn written as `k` turns (of δ/k).
+fn finer_turns(g: &Grammar, k: usize) -> Grammar {
+    let finer = |w: &[Sym]| -> Vec<Sym> {
+        w.iter()
+            .flat_map(|&s| match s {
+                Sym::Plus | Sym::Minus => vec![s; k],
+                _ => vec![s],
+            })
+            .collect()
+    };
+    let mut out = g.clone();
+    out.axiom = finer(&g.axiom);
+    for l in &mut out.letters {
+        l.rule = l.rule.as_deref().map(finer);
+    }
+    out
+}
+
+/// `g` with every successor's leading turns less `c` and its trailing
+/// turns more `c`; `None` when a successor is only turns.
+fn conjugate(g: &Grammar, c: i32, angles: &Angles) -> Option<Grammar> {
+    let is_turn = |s: &Sym| matches!(s, Sym::Plus | Sym::Minus);
+    let net = |t: &[Sym]| {
+        t.iter()
+            .map(|s| if *s == Sym::Plus { 1 } else { -1 })
+            .sum::<i32>()
+    };
+    let mut out = g.clone();
+    for l in &mut out.letters {
+        let Some(w) = &l.rule else { continue };
+        let lead = w.iter().take_while(|s| is_turn(s)).count();
+        if lead == w.len() {
+            return None;
+        }
+        let trail = w.iter().rev().take_while(|s| is_turn(s)).count();
+        let mut v = turn_syms(net(&w[..lead]) - c, angles);
+        v.extend_from_slice(&w[lead..w.len() - trail]);
+        v.extend(turn_syms(net(&w[w.len() - trail..]) + c, angles));
+        l.rule = Some(v);
+    }
+    Some(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -346,6 +480,37 @@ mod tests {
         assert_eq!(g.rule_size(), 14);
         assert_eq!(g.describe(), "axiom F-F-F-F; F -> F-F+F+FF-F-F+F; derive 1");
         assert_eq!(first_step(&g, &angles, 100), Some((DVec2::ZERO, 0)));
+    }
+
+    #[test]
+    fn the_conjugate_written_ends_straight_ahead() {
+        use Sym::*;
+        let f = Letter(0);
+        // Lévy's C curve as the search's smallest finds it, F -> F--F++ at
+        // 45°, is written F -> +F--F+.
+        let mut g = Grammar {
+            letters: vec![super::Letter {
+                name: 'F',
+                action: Action::Draw,
+                rule: Some(vec![f, Minus, Minus, f, Plus, Plus]),
+            }],
+            axiom: vec![f],
+            depth: 10,
+        };
+        let a = Angles::new(45.0, Some(8), 1.0);
+        let (c, at) = aligned(&g, &a);
+        assert_eq!(c.describe(), "axiom F; F -> +F--F+; derive 10");
+        assert_eq!(at, a);
+        // Drawn from a start turned by 45° per level, its steps all turn by
+        // multiples of 90°, where the smallest grammar is F -> F-F+.
+        g.letters[0].rule = Some(vec![f, Minus, f, Plus]);
+        let (c, at) = aligned(&g, &Angles::new(90.0, Some(4), 1.0));
+        assert_eq!(c.describe(), "axiom F; F -> +F--F+; derive 10");
+        assert_eq!((at.delta, at.period), (45.0, Some(8)));
+        // Already straight ahead: as it is.
+        let koch = koch();
+        let a = Angles::new(90.0, Some(4), 1.0);
+        assert_eq!(aligned(&koch, &a), (koch, a));
     }
 
     #[test]

@@ -320,6 +320,8 @@ fn by_reading(
             }
             tried.stats.search_ms += ms(t);
             let tv = Instant::now();
+            let (g, angles) = grammar::aligned(&g, &reading.angles);
+            let reading = in_angles(&reading, angles);
             if let Some(found) = finish(&g, &reading, name, work, noise) {
                 tried.stats.verify_ms = ms(tv);
                 tried.stats.rules = g.letters.iter().filter(|l| l.rule.is_some()).count();
@@ -402,6 +404,8 @@ fn from_graph(
             continue;
         }
         let tv = Instant::now();
+        let (gr, angles) = grammar::aligned(&gr, &reading.angles);
+        let reading = in_angles(&reading, angles);
         if let Some((file, text, redraw)) = finish(&gr, &reading, name, work, g.noise) {
             stats.verify_ms = ms(tv);
             stats.rules = gr.letters.iter().filter(|l| l.rule.is_some()).count();
@@ -417,6 +421,19 @@ fn from_graph(
         }
     }
     Err(late())
+}
+
+/// `r` counted in `angles` (δ or a whole fraction of it, see
+/// `grammar::aligned`).
+fn in_angles(r: &Reading, angles: turtle::Angles) -> std::borrow::Cow<'_, Reading> {
+    if angles == r.angles {
+        return std::borrow::Cow::Borrowed(r);
+    }
+    let k = r.angles.delta / angles.delta;
+    let mut out = r.clone();
+    out.angles = angles;
+    out.delta_error /= k;
+    std::borrow::Cow::Owned(out)
 }
 
 /// A found grammar in the symbols of the candidates, its turns counted in

@@ -521,6 +521,7 @@ pub(super) fn delta_from_turns(turns: &[f64]) -> Result<Angles, NotLines> {
         (turning as f64 / 200.0).max(2.0)
     };
     let mut significant: Vec<f64> = Vec::new();
+    let mut stray: Vec<f64> = Vec::new();
     let mut i = 0;
     while i < BINS {
         if smooth[i] == 0.0 {
@@ -537,13 +538,15 @@ pub(super) fn delta_from_turns(turns: &[f64]) -> Result<Angles, NotLines> {
             .copied()
             .filter(|t| *t >= lo && *t < hi)
             .collect();
-        if start == 0 || lump.len() as f64 <= enough.max(1.0) - 1.0 {
+        if start == 0 || lump.is_empty() {
             continue;
         }
+        let mean = lump.iter().sum::<f64>() / lump.len() as f64;
         if (lump.len() as f64) < enough {
+            stray.extend(lump);
             continue;
         }
-        significant.push(lump.iter().sum::<f64>() / lump.len() as f64);
+        significant.push(mean);
     }
     let Some(&smallest) = significant.first() else {
         // Straight lines only: any angle will do.
@@ -570,7 +573,37 @@ pub(super) fn delta_from_turns(turns: &[f64]) -> Result<Angles, NotLines> {
             "its turns are not multiples of one angle".into(),
         ));
     };
+    let d0 = finer_for_strays(&turns, d0, &stray);
     Ok(Angles::new(d0, None, tol_of(d0)))
+}
+
+/// δ or a half, third or quarter of it, when the turns too few to count
+/// as a cluster are all multiples of that within the drawing's own noise
+/// (a square's corners at 90° among 900 turns of ±60°: δ is 30°); δ when
+/// they fit it or nothing finer (stray turns of a noisy drawing).
+fn finer_for_strays(turns: &[f64], d0: f64, stray: &[f64]) -> f64 {
+    // How far the turns that turn lie from multiples of δ (those near one).
+    let noise = turns
+        .iter()
+        .filter(|t| **t >= 0.5 * d0)
+        .map(|t| (t - (t / d0).round() * d0).abs())
+        .filter(|e| *e <= 0.2 * d0)
+        .fold(0.0f64, f64::max);
+    let off = |d: f64| {
+        stray
+            .iter()
+            .map(|t| (t - (t / d).round() * d).abs())
+            .fold(0.0f64, f64::max)
+    };
+    let tight = (3.0 * noise).max(1e-3);
+    if stray.is_empty() || off(d0) <= tight {
+        return d0;
+    }
+    (2..=4)
+        .map(|q| d0 / f64::from(q))
+        .take_while(|&d| d >= MIN_DELTA)
+        .find(|&d| off(d) <= tight)
+        .unwrap_or(d0)
 }
 
 #[cfg(test)]

@@ -18,6 +18,9 @@
 //!   drawing of X one and two steps down is found nested at the place of
 //!   the first X of the successor, and the drawing two steps down is parsed
 //!   into runs of k^1 steps (F) and copies of the drawing one step down (X).
+//! - **Drawing apices** (`apex`: `G -> F[+G]-G`, `F -> FF`): node rewriting
+//!   on the drawing less its tips, the node letter then drawing a step at
+//!   each; only when no candidate above draws the drawing.
 //! - **Two node letters** (`pair`: Hilbert, Peano, Moore), for a drawing that
 //!   is one path and only when no candidate of fewer letters draws it.
 //!
@@ -29,6 +32,7 @@ use super::turtle::{Angles, Kind, Node, ROOT, Tree};
 use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
+mod apex;
 mod pair;
 
 /// How far the search goes.
@@ -106,6 +110,9 @@ pub fn propose(tree: &Tree, angles: &Angles, limits: &Limits) -> Proposals {
     // search is the costliest, and a grammar of fewer letters is smaller.
     let work = 64 * tree.nodes.len() as u64 + 100_000;
     let drawn = |g: &Grammar| matches(g, tree, angles, work, limits.deadline) == Outcome::Same;
+    if !out.grammars.iter().any(drawn) {
+        apex::apex_plants(tree, angles, limits, &mut add, &mut out);
+    }
     if !out.grammars.iter().any(drawn) {
         pair::node_pairs(tree, angles, limits, &mut add, &mut out);
     }

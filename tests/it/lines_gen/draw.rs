@@ -90,6 +90,25 @@ pub fn span(w: &str, delta: f64) -> Option<usize> {
         .then_some(along as usize)
 }
 
+/// Where the successor `w` ends, drawn from the origin heading +y with
+/// steps and moves of 1 (branches come back where they started).
+pub fn chord(w: &str, delta: f64) -> DVec2 {
+    let h = Headings::new(delta);
+    let (mut pos, mut k) = (DVec2::ZERO, 0i64);
+    let mut stack = Vec::new();
+    for c in w.chars() {
+        match c {
+            '+' => k += 1,
+            '-' => k -= 1,
+            '[' => stack.push((pos, k)),
+            ']' => (pos, k) = stack.pop().unwrap_or((pos, k)),
+            'F' | 'G' | 'H' | 'f' => pos += h.get(k),
+            _ => {}
+        }
+    }
+    pos
+}
+
 /// A drawing: strokes (polylines in drawing order, a new one after `]`
 /// and after a move, collinear steps merged) and its unit steps.
 #[derive(Clone, Debug, Default)]

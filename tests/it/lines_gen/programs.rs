@@ -38,7 +38,8 @@ pub enum Class {
     Edge3,
     /// Node rewriting: X (and Y) draw nothing (Hilbert, Peano).
     Node,
-    /// Bracketed plants, by edge or node rewriting.
+    /// Bracketed plants, by edge or node rewriting (a node X that draws
+    /// nothing, or an apex G that draws a step at every tip).
     Bracketed,
     /// Edge rewriting with moves `f` (islands and lakes).
     Moves,
@@ -156,12 +157,16 @@ pub enum Reject {
     /// turning only where the axiom turns, which `F -> F^k` explains as
     /// well; or the drawing at depth n is one straight line.
     Straight,
-    /// (Edge rewriting, every letter rewritten) A conjugate program is no
-    /// larger: every successor's leading turn less c·δ and its trailing
-    /// turn more c·δ (`F -> ++F--FF` and `F -> F+FF-` at 120°) draws the
-    /// same level n from another start heading, and its next level is
-    /// this one's turned by c·δ: level n cannot tell which is meant, and
-    /// inference takes the smallest.
+    /// (Edge rewriting, every letter rewritten) Another conjugate is the
+    /// one inference writes: every successor's leading turn less c·δ and
+    /// its trailing turn more c·δ (`F -> ++F--FF` and `F -> F+FF-` at
+    /// 120°) draws the same level n from another start heading, and its
+    /// next level is this one's turned by c·δ, so level n cannot tell
+    /// which is meant. Inference writes the conjugate whose successors
+    /// each end straight ahead of where they start (`F -> +F--F+`, Lévy's
+    /// C curve, as the Koch construction draws a generator over its
+    /// edge) when one exists, at δ or else at δ/2 or δ/3, and the
+    /// smallest otherwise.
     Conjugate,
     /// Two letters have the same successor and the same action: one letter
     /// would do, so the program is not the smallest that draws its drawing.
@@ -259,6 +264,8 @@ pub fn generate(class: Class, rng: &mut Rng, rejections: &mut Rejections) -> Opt
     };
     let delta = rng.pick(angles);
     let edge_plants = rng.chance(0.5);
+    // Node plants whose apex draws, half of them.
+    let apices = class == Class::Bracketed && !edge_plants && rng.chance(0.5);
     for _ in 0..MAX_TRIES {
         let candidate = match class {
             Class::Edge1 => edge(rng, delta, 1),
@@ -266,6 +273,7 @@ pub fn generate(class: Class, rng: &mut Rng, rejections: &mut Rejections) -> Opt
             Class::Edge3 => edge(rng, delta, 3),
             Class::Node => node(rng, delta),
             Class::Bracketed if edge_plants => edge_plant(rng, delta),
+            Class::Bracketed if apices => apex_plant(rng, delta),
             Class::Bracketed => node_plant(rng, delta),
             Class::Moves => moves(rng, delta),
         };
@@ -425,6 +433,33 @@ fn edge_plant(rng: &mut Rng, delta: f64) -> Result<Program, Reject> {
         axiom: one('F'),
         rules: vec![('F', w)],
         draws: vec!['F'],
+        depth: 0,
+    })
+}
+
+/// bracketed, node rewriting with an apex that draws: every G ends its
+/// branch (`G -> F[+G]-G`, `F -> FF`: the binary tree;
+/// `G -> F[-FG]F[+G]+G`).
+fn apex_plant(rng: &mut Rng, delta: f64) -> Result<Program, Reject> {
+    let mut w = "F".repeat(rng.range(1, 2) as usize);
+    for _ in 0..rng.range(1, 3) {
+        w.push('[');
+        w.push_str(&turn(nonzero(rng, 2)));
+        w.push_str(&"F".repeat(rng.range(0, 1) as usize));
+        w.push_str("G]");
+        w.push_str(&"F".repeat(rng.range(0, 2) as usize));
+    }
+    w.push_str(&turn(rng.range(-2, 2)));
+    w.push('G');
+    let mut rules = vec![('G', w)];
+    if rng.chance(0.7) {
+        rules.push(('F', "FF".to_string()));
+    }
+    Ok(Program {
+        angle: delta,
+        axiom: one('G'),
+        rules,
+        draws: vec!['F', 'G'],
         depth: 0,
     })
 }
@@ -662,10 +697,11 @@ fn net(turns: &str) -> i64 {
     turns.chars().map(|c| if c == '+' { 1 } else { -1 }).sum()
 }
 
-/// Whether a conjugate of `p` (see `Reject::Conjugate`) is no larger than
-/// `p`: only for edge rewriting, where every letter is a drawing letter or
-/// a move (node letters sit between unrewritten steps, whose turns a
-/// conjugate would change).
+/// Whether inference writes another conjugate of `p` (see
+/// `Reject::Conjugate`): the one whose successors end straight ahead, or
+/// else one no larger than `p`. Only for edge rewriting, where every
+/// letter is a drawing letter or a move (node letters sit between
+/// unrewritten steps, whose turns a conjugate would change).
 fn conjugate(p: &Program) -> bool {
     let letters = p.letters();
     if letters.iter().any(|c| !p.draws.contains(c) && *c != 'f') {
@@ -673,6 +709,27 @@ fn conjugate(p: &Program) -> bool {
     }
     let m = 360.0 / p.angle;
     let period = ((m - m.round()).abs() < 1e-9).then_some(m.round() as i64);
+    // A letter left as it is would need a rule to turn.
+    let rewritten = letters.iter().all(|&c| p.successor(c).is_some());
+    if let Some(c) = straight_ahead(p, period).filter(|_| rewritten) {
+        return c != 0;
+    }
+    // Ends straight ahead only at δ/2 or δ/3: inference writes that one.
+    for k in [2, 3] {
+        let finer = Program {
+            angle: p.angle / k as f64,
+            axiom: finer_turns(&p.axiom, k),
+            rules: p
+                .rules
+                .iter()
+                .map(|(c, w)| (*c, finer_turns(w, k)))
+                .collect(),
+            ..p.clone()
+        };
+        if rewritten && straight_ahead(&finer, period.map(|m| m * k)).is_some() {
+            return true;
+        }
+    }
     // A turn's size in symbols (modulo a full turn; half a turn either way).
     let size = |k: i64| match period {
         Some(m) => {
@@ -696,4 +753,41 @@ fn conjugate(p: &Program) -> bool {
         None => (-4..=4).filter(|&c| c != 0).collect(),
     };
     others.into_iter().any(|c| cost(c) <= cost(0))
+}
+
+/// The c (turns of δ, modulo the period, or in −4..=4 without one) for
+/// which every successor of `p` that ends away from its start ends
+/// straight ahead once turned by −c·δ; `None` when no c does (or no
+/// successor ends away from its start).
+fn straight_ahead(p: &Program, period: Option<i64>) -> Option<i64> {
+    let chords: Vec<glam::DVec2> = p
+        .rules
+        .iter()
+        .map(|(_, w)| draw::chord(w, p.angle))
+        .filter(|v| v.length() > 1e-6)
+        .collect();
+    if chords.is_empty() {
+        return None;
+    }
+    let cs: Vec<i64> = match period {
+        Some(m) => (0..m).collect(),
+        None => (-4..=4).collect(),
+    };
+    cs.into_iter().find(|&c| {
+        let a = (p.angle * c as f64).to_radians();
+        let ahead = glam::DVec2::new(-a.sin(), a.cos());
+        chords
+            .iter()
+            .all(|v| v.perp_dot(ahead).abs() < 1e-6 * v.length() && v.dot(ahead) > 0.0)
+    })
+}
+
+/// `w` with every turn written `k` times.
+fn finer_turns(w: &str, k: i64) -> String {
+    w.chars()
+        .flat_map(|c| {
+            let n = if c == '+' || c == '-' { k as usize } else { 1 };
+            std::iter::repeat_n(c, n)
+        })
+        .collect()
 }
