@@ -580,7 +580,8 @@ pub(super) fn delta_from_turns(turns: &[f64]) -> Result<Angles, NotLines> {
 /// δ or a half, third or quarter of it, when the turns too few to count
 /// as a cluster are all multiples of that within the drawing's own noise
 /// (a square's corners at 90° among 900 turns of ±60°: δ is 30°); δ when
-/// they fit it or nothing finer (stray turns of a noisy drawing).
+/// they fit it or nothing finer, or the drawing is too noisy to tell
+/// (stray turns of a noisy drawing).
 fn finer_for_strays(turns: &[f64], d0: f64, stray: &[f64]) -> f64 {
     // How far the turns that turn lie from multiples of δ (those near one).
     let noise = turns
@@ -602,7 +603,9 @@ fn finer_for_strays(turns: &[f64], d0: f64, stray: &[f64]) -> f64 {
     (2..=4)
         .map(|q| d0 / f64::from(q))
         .take_while(|&d| d >= MIN_DELTA)
-        .find(|&d| off(d) <= tight)
+        // Where a stray turn would fit by chance once in 18 or more (a noisy
+        // drawing), they say nothing.
+        .find(|&d| tight <= d / 36.0 && off(d) <= tight)
         .unwrap_or(d0)
 }
 
