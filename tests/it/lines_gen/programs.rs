@@ -191,6 +191,8 @@ pub enum Reject {
     /// (`F -> G+G`, `G -> F-F`), drawn an even number of times from one of
     /// them: one letter's program at half the depth (`F -> F-F+F-F`) draws
     /// the same level n, and inference writes that one (fewer letters).
+    /// The same from an axiom of both when two steps rewrite each alike
+    /// (`F -> G`, `G -> F--FF`: `F -> F--FF` from `G+G+F`).
     Square,
     /// The drawing grows polynomially with n, not exponentially: no
     /// letter's successor holds two or more letters that derive it again
@@ -678,7 +680,22 @@ fn square(p: &Program) -> bool {
     let crossed = letters(wa).iter().all(|c| c == b) && letters(wb).iter().all(|c| c == a);
     let axiom = letters(&p.axiom);
     let one = axiom.iter().all(|c| c == a) || axiom.iter().all(|c| c == b);
-    drawn && crossed && one
+    // Two steps of each, every letter written X: the same word makes the
+    // squared program one letter's, whatever the axiom.
+    let twice = |w: &str, other: &str| -> String {
+        w.chars()
+            .flat_map(|c| {
+                if c.is_alphabetic() {
+                    other.chars().collect::<Vec<_>>()
+                } else {
+                    vec![c]
+                }
+            })
+            .map(|c| if c.is_alphabetic() { 'X' } else { c })
+            .collect()
+    };
+    let twins = twice(wa, wb) == twice(wb, wa);
+    drawn && crossed && (one || twins)
 }
 
 /// Whether every step of `d` is on one line.
