@@ -103,13 +103,45 @@ fn drawing_apex(g: &Grammar) -> Option<Grammar> {
         })
     };
     let rule = g.letters[x].rule.as_deref()?;
-    if !ends_branches(rule) || !ends_branches(&g.axiom) {
+    if !ends_branches(rule) || !ends_branches(&g.axiom) || halves(g, x, rule) {
         return None;
     }
     let mut out = g.clone();
     out.letters[x].action = Action::Draw;
     out.letters[x].name = 'G';
     Some(out)
+}
+
+/// Whether X's successor `w` less its X's draws k steps on one line, as
+/// many as F's successor has: then X drawing nothing one level deeper at
+/// half the step draws the same (ABOP's `X -> F[+X]F[-X]+X`, whose last
+/// level's `F[+X]F[-X]+X` draws `FF`), and that is the grammar written.
+fn halves(g: &Grammar, x: usize, w: &[Sym]) -> bool {
+    let k = g
+        .letters
+        .iter()
+        .find(|l| l.action == Action::Draw && l.rule.is_some() && !std::ptr::eq(*l, &g.letters[x]))
+        .and_then(|l| l.rule.as_ref())
+        .map_or(1, Vec::len);
+    let (mut depth, mut heading, mut steps) = (0i32, 0i32, 0usize);
+    let mut first: Option<i32> = None;
+    for &s in w {
+        match s {
+            Sym::Push => depth += 1,
+            Sym::Pop => depth -= 1,
+            Sym::Plus if depth == 0 => heading += 1,
+            Sym::Minus if depth == 0 => heading -= 1,
+            Sym::Letter(l) if l as usize != x => {
+                if depth > 0 || first.is_some_and(|h| h != heading) {
+                    return false;
+                }
+                first = Some(heading);
+                steps += 1;
+            }
+            _ => {}
+        }
+    }
+    steps == k
 }
 
 #[cfg(test)]
@@ -140,6 +172,13 @@ mod tests {
         };
         let apex = drawing_apex(&g).expect("X ends its branches");
         assert_eq!(apex.describe(), "axiom G; F -> FF; G -> F[+G]-G; derive 3");
+        // ABOP's plant d less its X's draws FF: X one level deeper at half
+        // the step draws the same, and is what is written.
+        let mut d = g.clone();
+        d.letters[1].rule = Some(vec![
+            f, Push, Plus, x, Pop, f, Push, Minus, x, Pop, Plus, x,
+        ]);
+        assert!(drawing_apex(&d).is_none());
         let mut inner = g.clone();
         inner.letters[1].rule = Some(vec![f, Push, Plus, x, Pop, x, f]);
         assert!(drawing_apex(&inner).is_none());
