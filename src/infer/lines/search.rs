@@ -110,10 +110,15 @@ pub fn propose(tree: &Tree, angles: &Angles, limits: &Limits) -> Proposals {
     // search is the costliest, and a grammar of fewer letters is smaller.
     let work = 64 * tree.nodes.len() as u64 + 100_000;
     let drawn = |g: &Grammar| matches(g, tree, angles, work, limits.deadline) == Outcome::Same;
-    if !out.grammars.iter().any(drawn) {
+    // Each candidate is matched once; the apices' are matched before they
+    // are proposed.
+    let mut any_drawn = out.grammars.iter().any(drawn);
+    if !any_drawn {
+        let before = out.grammars.len();
         apex::apex_plants(tree, angles, limits, &mut add, &mut out);
+        any_drawn = out.grammars.len() > before;
     }
-    if !out.grammars.iter().any(drawn) {
+    if !any_drawn {
         pair::node_pairs(tree, angles, limits, &mut add, &mut out);
     }
     out.grammars.sort_by_cached_key(|g| {

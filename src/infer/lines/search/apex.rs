@@ -175,9 +175,7 @@ mod tests {
         // ABOP's plant d less its X's draws FF: X one level deeper at half
         // the step draws the same, and is what is written.
         let mut d = g.clone();
-        d.letters[1].rule = Some(vec![
-            f, Push, Plus, x, Pop, f, Push, Minus, x, Pop, Plus, x,
-        ]);
+        d.letters[1].rule = Some(vec![f, Push, Plus, x, Pop, f, Push, Minus, x, Pop, Plus, x]);
         assert!(drawing_apex(&d).is_none());
         let mut inner = g.clone();
         inner.letters[1].rule = Some(vec![f, Push, Plus, x, Pop, x, f]);
