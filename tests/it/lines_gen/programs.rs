@@ -439,18 +439,26 @@ fn edge_plant(rng: &mut Rng, delta: f64) -> Result<Program, Reject> {
     })
 }
 
-/// bracketed, node rewriting with an apex that draws: every G ends its
-/// branch (`G -> F[+G]-G`, `F -> FF`: the binary tree;
-/// `G -> F[-FG]F[+G]+G`).
-fn apex_plant(rng: &mut Rng, delta: f64) -> Result<Program, Reject> {
+/// A node plant's successor up to its last apex: 1–2 F's, then 1–3
+/// branches `[±turns F? apex]` each followed by 0–2 F's.
+fn trunk_with_branches(rng: &mut Rng, apex: char) -> String {
     let mut w = "F".repeat(rng.range(1, 2) as usize);
     for _ in 0..rng.range(1, 3) {
         w.push('[');
         w.push_str(&turn(nonzero(rng, 2)));
         w.push_str(&"F".repeat(rng.range(0, 1) as usize));
-        w.push_str("G]");
+        w.push(apex);
+        w.push(']');
         w.push_str(&"F".repeat(rng.range(0, 2) as usize));
     }
+    w
+}
+
+/// bracketed, node rewriting with an apex that draws: every G ends its
+/// branch (`G -> F[+G]-G`, `F -> FF`: the binary tree;
+/// `G -> F[-FG]F[+G]+G`).
+fn apex_plant(rng: &mut Rng, delta: f64) -> Result<Program, Reject> {
+    let mut w = trunk_with_branches(rng, 'G');
     w.push_str(&turn(rng.range(-2, 2)));
     w.push('G');
     let mut rules = vec![('G', w)];
@@ -468,14 +476,7 @@ fn apex_plant(rng: &mut Rng, delta: f64) -> Result<Program, Reject> {
 
 /// bracketed, node rewriting: `X -> F[+X]F[-X]+X`, `F -> FF`-like.
 fn node_plant(rng: &mut Rng, delta: f64) -> Result<Program, Reject> {
-    let mut w = "F".repeat(rng.range(1, 2) as usize);
-    for _ in 0..rng.range(1, 3) {
-        w.push('[');
-        w.push_str(&turn(nonzero(rng, 2)));
-        w.push_str(&"F".repeat(rng.range(0, 1) as usize));
-        w.push_str("X]");
-        w.push_str(&"F".repeat(rng.range(0, 2) as usize));
-    }
+    let mut w = trunk_with_branches(rng, 'X');
     if rng.chance(0.6) {
         w.push_str(&turn(rng.range(-2, 2)));
         w.push('X');
