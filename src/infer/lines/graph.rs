@@ -41,6 +41,9 @@ pub struct Graph {
     /// from is (a long segment says its steps' direction more surely than
     /// a noisy one-step segment does).
     pub runs: Vec<u32>,
+    /// Each edge's piece: which drawn segment (after cutting where others
+    /// meet it) it was cut from. The steps of one piece go one way.
+    pub piece: Vec<u32>,
     /// How far the drawing's points lie from their vertices: the root mean
     /// square, in steps.
     pub noise: f64,
@@ -535,8 +538,9 @@ pub fn build(lines: &[Vec<DVec2>], split: u32) -> Result<Graph, String> {
     let mut edges: Vec<[u32; 2]> = Vec::new();
     let mut adj: Vec<Vec<(u32, u32)>> = vec![Vec::new(); vertices.len()];
     let mut runs = Vec::new();
+    let mut piece = Vec::new();
     let mut order = Vec::with_capacity(total);
-    for (chain, run) in &chains {
+    for (i, (chain, run)) in chains.iter().enumerate() {
         for w in chain.windows(2) {
             let (a, b) = (of2[w[0] as usize], of2[w[1] as usize]);
             if a == b {
@@ -551,6 +555,7 @@ pub fn build(lines: &[Vec<DVec2>], split: u32) -> Result<Graph, String> {
             edge_of.insert(key, e);
             edges.push([a, b]);
             runs.push(*run);
+            piece.push(i as u32);
             adj[a as usize].push((b, e));
             adj[b as usize].push((a, e));
         }
@@ -578,6 +583,7 @@ pub fn build(lines: &[Vec<DVec2>], split: u32) -> Result<Graph, String> {
         edges,
         adj,
         runs,
+        piece,
         noise,
         delta: 0.0,
         tol: tol.min(0.3 * step),

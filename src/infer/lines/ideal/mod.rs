@@ -17,7 +17,14 @@
 //!   to the walk;
 //! - closely for the likeliest δ: every vertex against the drawing's, in a
 //!   frame fitted again as the walk goes (near its start a rough frame errs
-//!   little), then once more in the frame fitted to all of it.
+//!   little), then once more in the frame fitted to all of it; the rough
+//!   walk stays when it says the drawing in fewer bits. A step that no way
+//!   keeps within the bound (both its vertices off, each its own way)
+//!   takes the nearest ways, unbounded, rather than end the walk.
+//!
+//! The steps cut from one drawn segment go its one way: its points between
+//! the drawn ends were not drawn and carry their ends' noise, so reading
+//! them one by one would bend a straight segment.
 //!
 //! A walk's cost in the beam is in bits: its offsets from the drawing (a
 //! normal spread of the drawing's noise) and its turns, each said after
@@ -31,7 +38,9 @@
 //! finer lattice fits the noise a little better but its walk repeats
 //! itself less, as a coarser one's fits worse. LZ78 is a loose measure of
 //! a grammar's size, so the two shortest redrawings are given back, and
-//! the grammar search tells them apart. A vertex keeps the position
+//! the grammar search tells them apart. Before that the small subtrees
+//! at a branching walk's ends are read again as its other subtrees say
+//! (`agree`). A vertex keeps the position
 //! it got first, so a branch starts where its parent passed and a curve
 //! that comes back to a vertex must come back to its lattice point. The
 //! redrawing is refused when a vertex of it lies more than half a step
@@ -39,6 +48,8 @@
 //! program must draw it exactly.
 //!
 //! Owns: the redrawing. Must not search grammars.
+
+mod agree;
 
 use super::graph::Graph;
 use super::synth;
@@ -122,7 +133,10 @@ pub fn redrawn(g: &Graph) -> Vec<Vec<Vec<DVec2>>> {
     rough.truncate(SHORTLIST);
     let mut walks: Vec<Walked> = rough
         .into_iter()
-        .filter_map(|(lattice, w)| close(g, &paths, &lattice, w))
+        .filter_map(|(lattice, w)| {
+            let w = agree::agreed(g, &paths, &lattice, close(g, &paths, &lattice, w)?);
+            Walked::new(g, &paths, &lattice, w.at)
+        })
         .collect();
     walks.sort_by(|a, b| a.bits.total_cmp(&b.bits));
     walks
@@ -200,6 +214,7 @@ fn paths(g: &Graph) -> Vec<Vec<u32>> {
 }
 
 /// A walk of the drawing on a lattice.
+#[derive(Clone)]
 struct Walked {
     /// Each vertex's lattice point (in steps).
     at: Vec<Option<DVec2>>,
@@ -217,6 +232,7 @@ fn rough(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice, phase: f64) -> Option
     let mut pass = Pass {
         lattice,
         world: &g.points,
+        graph: g,
         frame: Similarity {
             from: origin,
             turn: DVec2::new((-phase).cos(), (-phase).sin()) / g.step,
@@ -239,6 +255,7 @@ fn close(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice, mut w: Walked) -> Opt
     let mut pass = Pass {
         lattice,
         world: &g.points,
+        graph: g,
         frame: w.frame,
         window: 0,
         // A few times the drawing's own noise.
@@ -247,12 +264,21 @@ fn close(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice, mut w: Walked) -> Opt
         beam: BEAM,
         sigma: sigma(g),
     };
+    // The rough walk when it says the drawing in fewer bits (a close pass
+    // too may read a step one δ off) or no close walk stays near it.
+    let rough = w.clone();
     for refit in [true, false] {
         pass.refit = refit;
-        w = Walked::new(g, paths, lattice, pass.walk(paths, &w.at)?)?;
+        let Some(closer) = pass
+            .walk(paths, &w.at)
+            .and_then(|at| Walked::new(g, paths, lattice, at))
+        else {
+            return Some(rough);
+        };
+        w = closer;
         pass.frame = w.frame;
     }
-    Some(w)
+    Some(if rough.bits < w.bits { rough } else { w })
 }
 
 impl Walked {
@@ -401,6 +427,8 @@ struct Pass<'a> {
     lattice: &'a Lattice,
     /// The drawing's vertices (user units).
     world: &'a [DVec2],
+    /// The drawing's stroke graph (which steps one drawn segment holds).
+    graph: &'a Graph,
     /// From the drawing to the lattice.
     frame: Similarity,
     /// Steps back over which a walk's shape is compared with the
@@ -454,8 +482,24 @@ impl Pass<'_> {
                 let drawn = self
                     .lattice
                     .nearest(self.seen(path[i]) - self.seen(path[i - 1]));
+                // Steps cut from one drawn segment go its one way.
+                let along =
+                    |a: u32, b: u32| self.graph.edge(a, b).map(|e| self.graph.piece[e as usize]);
+                let straight = i >= 2
+                    && along(path[i - 2], path[i - 1])
+                        .is_some_and(|e| along(path[i - 1], path[i]) == Some(e));
                 for h in &beam {
-                    self.steps(path, i, drawn, &at, &arena, *h, &mut next);
+                    self.steps(path, (i, straight), drawn, &at, &arena, *h, &mut next);
+                }
+                if next.is_empty() && self.window == 0 {
+                    // No way stays within the bound (a step between two
+                    // vertices each off the other way): the nearest ways,
+                    // unbounded, rather than no walk.
+                    let bound = std::mem::replace(&mut self.bound, f64::INFINITY);
+                    for h in &beam {
+                        self.steps(path, (i, straight), drawn, &at, &arena, *h, &mut next);
+                    }
+                    self.bound = bound;
                 }
                 if next.is_empty() {
                     return None;
@@ -474,7 +518,7 @@ impl Pass<'_> {
     fn steps(
         &self,
         path: &[u32],
-        i: usize,
+        (i, straight): (usize, bool),
         drawn: i64,
         at: &[Option<DVec2>],
         arena: &[(DVec2, u32)],
@@ -486,7 +530,9 @@ impl Pass<'_> {
         let m = self.lattice.units.len() as i64;
         let mut tried = [i64::MAX; 6];
         // A walk compared by shape has no way back to take.
-        let ways = if self.window > 0 {
+        let ways = if straight && h.way != i64::MIN {
+            &[h.way][..]
+        } else if self.window > 0 {
             &[drawn, drawn - 1, drawn + 1][..]
         } else {
             let back = self.lattice.nearest(seen - from);
@@ -744,5 +790,114 @@ mod tests {
         let walk = redrawn(&g).into_iter().next().expect("a redrawing");
         assert_eq!(walk.len(), 1);
         assert_eq!(turns(&walk[0]), turns(&clean));
+    }
+
+    /// `X -> FF[-X]F[--FX][-X]F-X`, `F -> FF` at 20° to `depth`, drawn as
+    /// a turtle draws it: one polyline per stroke, a straight run one
+    /// segment, a branch a new polyline from where it starts.
+    fn plant(depth: u32) -> Vec<Vec<DVec2>> {
+        let mut s = String::from("X");
+        for _ in 0..depth {
+            s = s
+                .chars()
+                .map(|c| match c {
+                    'X' => "FF[-X]F[--FX][-X]F-X".to_string(),
+                    'F' => "FF".to_string(),
+                    c => c.to_string(),
+                })
+                .collect();
+        }
+        let (mut at, mut heading) = (DVec2::ZERO, 90.0f64);
+        let mut stack = Vec::new();
+        let mut lines: Vec<Vec<DVec2>> = vec![vec![at]];
+        let mut last_heading = f64::NAN;
+        for c in s.chars() {
+            match c {
+                '+' => heading += 20.0,
+                '-' => heading -= 20.0,
+                '[' => stack.push((at, heading)),
+                ']' => {
+                    (at, heading) = stack.pop().expect("balanced");
+                    lines.push(vec![at]);
+                    last_heading = f64::NAN;
+                }
+                'F' => {
+                    at += DVec2::new(heading.to_radians().cos(), heading.to_radians().sin());
+                    let line = lines.last_mut().expect("a line");
+                    if heading == last_heading {
+                        *line.last_mut().expect("a point") = at;
+                    } else {
+                        line.push(at);
+                    }
+                    last_heading = heading;
+                }
+                _ => {}
+            }
+        }
+        lines.retain(|l| l.len() > 1);
+        lines
+    }
+
+    #[test]
+    fn a_plant_jittered_by_a_fifth_of_a_step_is_walked_as_drawn_to_its_tips() {
+        let clean = plant(3);
+        // Every drawn point moved by up to a fifth of a step (one point,
+        // one move), in a fixed sequence.
+        let mut state = 7u64;
+        let mut unit = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut moved: std::collections::HashMap<[i64; 2], DVec2> = Default::default();
+        let noisy: Vec<Vec<DVec2>> = clean
+            .iter()
+            .map(|l| {
+                l.iter()
+                    .map(|&p| {
+                        let key = [(p.x * 1e6).round() as i64, (p.y * 1e6).round() as i64];
+                        let by = *moved.entry(key).or_insert_with(|| {
+                            let (r, a) = (0.2 * unit().sqrt(), unit() * TAU);
+                            DVec2::new(a.cos(), a.sin()) * r
+                        });
+                        (p + by) * 10.0
+                    })
+                    .collect()
+            })
+            .collect();
+        let g = super::super::graph::build(&noisy, 1).expect("a stroke graph");
+        let walk = redrawn(&g).into_iter().next().expect("a redrawing");
+        // Every step of the redrawing is a step of the plant, the same way
+        // (a tip read one δ off turns by 20°).
+        let steps = |lines: &[Vec<DVec2>], scale: f64| -> Vec<(DVec2, DVec2)> {
+            lines
+                .iter()
+                .flat_map(|l| l.windows(2).map(|w| (w[0], w[1])))
+                .flat_map(|(a, b)| {
+                    let n = (a.distance(b) / scale).round().max(1.0) as usize;
+                    (0..n).map(move |k| {
+                        let (p, q) = (
+                            a.lerp(b, k as f64 / n as f64),
+                            a.lerp(b, (k + 1) as f64 / n as f64),
+                        );
+                        ((p + q) / (2.0 * scale), (q - p) / scale)
+                    })
+                })
+                .collect()
+        };
+        let truth = steps(&clean, 1.0);
+        let read = steps(&walk, g.step);
+        assert_eq!(read.len(), truth.len());
+        let off = read
+            .iter()
+            .filter(|(mid, way)| {
+                let m = *mid * g.step / 10.0;
+                !truth
+                    .iter()
+                    .any(|(tm, tw)| tm.distance(m) < 0.3 && tw.angle_to(*way).abs() < 0.05)
+            })
+            .count();
+        assert_eq!(off, 0, "steps of the redrawing not in the plant");
     }
 }
