@@ -73,7 +73,7 @@ pub(super) fn agreed(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice, w: Walked
     let mut best_turn = |f: &mut Forest, at: &[Option<DVec2>], v: u32| {
         let mut best: Option<(f64, Move)> = None;
         for dk in [-1, 1] {
-            let mv = f.turned(v, dk, at, &seen, lattice)?;
+            let mv = f.turned(v, dk, at, seen, lattice)?;
             let mut cost = 0.0;
             for &(u, there) in &mv.points {
                 if seen(u).distance(there) > worst || f.taken_by_other(there, &mv.points, at) {
