@@ -248,8 +248,10 @@ pub fn reading(lines: &[Vec<DVec2>], split: u32) -> Result<Reading, NotLines> {
     let coarse = find_delta(&b, &edge_of)?;
     let loose = Angles::new(coarse.delta, None, 0.5 * coarse.delta + 1e-9);
     let first = headings(&b.tree(&loose).map_err(unfit)?);
-    let (_, theta, _) = refine(&coarse, &segments, &firsts, &first);
-    let (k, mut tree) = requantize(&b, theta, &coarse).map_err(unfit)?;
+    // Read again with the fitted δ: a curve that winds round and round
+    // turns by hundreds of δ in all, and the rough δ's error with them.
+    let (fitted, theta, _) = refine(&coarse, &segments, &firsts, &first);
+    let (k, mut tree) = requantize(&b, theta, &fitted).map_err(unfit)?;
     let (angles, theta, delta_error) = refine(&coarse, &segments, &firsts, &k);
     for n in &mut tree.nodes {
         n.turn = angles.norm(n.turn);
