@@ -675,4 +675,29 @@ mod tests {
         assert_eq!(rd.steps, 2046);
         assert!((rd.angles.delta - 60.0).abs() < 1e-6, "{}", rd.angles.delta);
     }
+
+    /// A curve that winds round and round (turns of 2, 4, 2 and 5 times
+    /// 22.5°, 64 steps: some 200 δ in all), every vertex a hundredth of a
+    /// step off: the rough δ's error, times 200, would be a turn.
+    #[test]
+    fn a_winding_curve_is_read_with_its_fitted_delta() {
+        let (mut p, mut heading) = (DVec2::ZERO, 90f64);
+        let mut line = vec![p];
+        let mut state = 3u64;
+        let mut unit = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for i in 0..64 {
+            p += DVec2::from_angle(heading.to_radians());
+            heading += 22.5 * [2.0, 4.0, 2.0, 5.0][i % 4];
+            let (r, a) = (0.01 * unit().sqrt(), unit() * std::f64::consts::TAU);
+            line.push((p + DVec2::from_angle(a) * r) * 5.4);
+        }
+        let rd = reading(&[line], 1).expect("reads");
+        assert_eq!(rd.steps, 64);
+        assert!((rd.angles.delta - 22.5).abs() < 1e-6, "{}", rd.angles.delta);
+    }
 }
