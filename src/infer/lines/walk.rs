@@ -12,6 +12,16 @@
 //! plant's trunk is its longest straight run, so the ends are tried by the
 //! length of their straight run.
 //!
+//! One order of turns does not fit every grammar: at a vertex the turtle
+//! finishes the innermost successor it is in before the one around it, and
+//! which of the edges leaving a vertex belongs to which depends on the
+//! successor (`F -> FF+[-FFF]F-[++F-F]` leaves one vertex straight on into
+//! a branch before it turns left to go on). But the innermost successor's
+//! branches are the last level's, a few steps; the one around it draws a
+//! branch expanded once more, and the axis the rest. So the edges are also
+//! tried smaller subtree first, equal ones by their turns.
+
+//!
 //! Owns: which roots and orders are tried. Must not search grammars.
 
 use super::graph::Graph;
@@ -36,13 +46,19 @@ enum Order {
     Left,
     /// Right turns first.
     Right,
+    /// The smaller subtree first, left turns first among equals.
+    SmallerLeft,
+    /// The smaller subtree first, right turns first among equals.
+    SmallerRight,
 }
 
-const ORDERS: [Order; 4] = [
+const ORDERS: [Order; 6] = [
     Order::LeftStraightLast,
     Order::RightStraightLast,
     Order::Left,
     Order::Right,
+    Order::SmallerLeft,
+    Order::SmallerRight,
 ];
 
 /// The drawing as the polylines of each walk worth trying, when its graph
@@ -51,9 +67,13 @@ pub fn trees(g: &Graph) -> Vec<Vec<Vec<DVec2>>> {
     if !branches(g) {
         return Vec::new();
     }
+    // Subtrees have sizes only in a tree (a graph whose branches touch has
+    // cycles, and walks enough for its four orders of turns).
+    let tree = g.edges.len() + 1 == g.points.len();
+    let orders = if tree { &ORDERS[..] } else { &ORDERS[..4] };
     let mut out = Vec::new();
     for root in roots(g) {
-        for order in ORDERS {
+        for &order in orders {
             let w = walk(g, root, order);
             if !out.contains(&w) {
                 out.push(w);
@@ -138,6 +158,10 @@ fn walk(g: &Graph, root: u32, order: Order) -> Vec<Vec<DVec2>> {
     let Some(&(_, first)) = g.adj[root as usize].first() else {
         return Vec::new();
     };
+    let size = match order {
+        Order::SmallerLeft | Order::SmallerRight => sizes(g, root),
+        _ => Vec::new(),
+    };
     let mut used = vec![false; g.edges.len()];
     let mut stack: Vec<(u32, u32, f64)> = vec![(root, u32::MAX, g.direction(first, root))];
     while let Some((v, from, heading)) = stack.pop() {
@@ -155,6 +179,10 @@ fn walk(g: &Graph, root: u32, order: Order) -> Vec<Vec<DVec2>> {
             .map(|&(to, e)| (turn(g.direction(e, v), heading), to, e))
             .collect();
         sort(&mut next, order);
+        if !size.is_empty() {
+            // Stable: equal subtrees keep the order of their turns.
+            next.sort_by_key(|&(_, to, _)| size[to as usize]);
+        }
         // Pushed last to first, so the first is walked first.
         for &(_, to, e) in next.iter().rev() {
             stack.push((to, e, g.direction(e, v)));
@@ -163,12 +191,47 @@ fn walk(g: &Graph, root: u32, order: Order) -> Vec<Vec<DVec2>> {
     g.polylines(steps.into_iter())
 }
 
+/// Each vertex's count of edges below it, the graph walked depth first
+/// from `root` (an edge that closes a cycle counts where it is first met).
+fn sizes(g: &Graph, root: u32) -> Vec<usize> {
+    let n = g.points.len();
+    let mut size = vec![0usize; n];
+    let mut seen = vec![false; n];
+    let mut used = vec![false; g.edges.len()];
+    let mut order = Vec::with_capacity(n);
+    let mut parent = vec![u32::MAX; n];
+    let mut stack = vec![root];
+    seen[root as usize] = true;
+    while let Some(v) = stack.pop() {
+        order.push(v);
+        for &(to, e) in &g.adj[v as usize] {
+            if used[e as usize] {
+                continue;
+            }
+            used[e as usize] = true;
+            size[v as usize] += 1;
+            if !seen[to as usize] {
+                seen[to as usize] = true;
+                parent[to as usize] = v;
+                stack.push(to);
+            }
+        }
+    }
+    for &v in order.iter().rev() {
+        let p = parent[v as usize];
+        if p != u32::MAX {
+            size[p as usize] += size[v as usize];
+        }
+    }
+    size
+}
+
 /// Orders a vertex's edges (turn, to, edge).
 fn sort(next: &mut [(f64, u32, u32)], order: Order) {
     let left = |a: &(f64, u32, u32), b: &(f64, u32, u32)| b.0.total_cmp(&a.0).then(a.2.cmp(&b.2));
     match order {
-        Order::Left => next.sort_by(left),
-        Order::Right => next.sort_by(|a, b| left(b, a)),
+        Order::Left | Order::SmallerLeft => next.sort_by(left),
+        Order::Right | Order::SmallerRight => next.sort_by(|a, b| left(b, a)),
         Order::LeftStraightLast | Order::RightStraightLast => {
             if matches!(order, Order::LeftStraightLast) {
                 next.sort_by(left);
