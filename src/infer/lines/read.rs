@@ -683,13 +683,8 @@ mod tests {
     fn a_winding_curve_is_read_with_its_fitted_delta() {
         let (mut p, mut heading) = (DVec2::ZERO, 90f64);
         let mut line = vec![p];
-        let mut state = 3u64;
-        let mut unit = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::geometry::index::Lcg(3);
+        let mut unit = || rng.next();
         for i in 0..64 {
             p += DVec2::from_angle(heading.to_radians());
             heading += 22.5 * [2.0, 4.0, 2.0, 5.0][i % 4];

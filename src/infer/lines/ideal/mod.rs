@@ -763,13 +763,8 @@ mod tests {
         let clean = curve(5);
         // Every vertex moved by up to 0.15 of a step (a fixed sequence);
         // one-step directions are then misread by rounding alone.
-        let mut state = 12345u64;
-        let mut unit = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::geometry::index::Lcg(12345);
+        let mut unit = || rng.next();
         let noisy: Vec<DVec2> = clean
             .iter()
             .map(|&p| {
@@ -843,13 +838,8 @@ mod tests {
         let clean = plant(3);
         // Every drawn point moved by up to a fifth of a step (one point,
         // one move), in a fixed sequence.
-        let mut state = 7u64;
-        let mut unit = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::geometry::index::Lcg(7);
+        let mut unit = || rng.next();
         let mut moved: std::collections::HashMap<[i64; 2], DVec2> = Default::default();
         let noisy: Vec<Vec<DVec2>> = clean
             .iter()
