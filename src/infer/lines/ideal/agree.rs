@@ -7,11 +7,13 @@
 //! grammar from a search that matches step by step. The drawing's other
 //! tips say which way it goes: a tree a D0L system draws repeats its
 //! subtrees, so the wrong tip makes its parent's subtree (and its
-//! ancestors') one of a kind. A tip is turned by one δ when that makes the
-//! tree's distinct subtrees (its size as a DAG) fewer by more than the
-//! turn costs in the drawing's offsets from the walk (both in bits: a
-//! subtree said once, an offset as a normal spread of the walk's own
-//! offsets).
+//! ancestors') one of a kind. A small subtree at the drawing's ends (a tip,
+//! a fork, a stalk of a few steps; or the first step from an end) is turned
+//! by one δ, its steps placed again nearest the drawing, when that makes the
+//! tree's distinct subtrees (its size as a DAG) fewer by more than the move
+//! costs in the drawing's offsets from the walk and in its turns (all in
+//! bits: a subtree said once, an offset as a normal spread of the walk's
+//! own offsets, a turn as often as the tree turns it).
 //!
 //! Owns: the tips' second reading. Must not search grammars.
 
@@ -30,84 +32,30 @@ const SMALL: usize = 8;
 /// Passes over the tips (a turned tip can make another worth turning).
 const PASSES: usize = 3;
 
-/// `w` with its tips turned where the drawing's other tips agree (see the
-/// module's text); `w` as it is when the drawing has a cycle or a vertex
-/// the walk did not place.
+/// `w` with the small subtrees at its ends turned where the drawing's
+/// other subtrees agree (see the module's text); `w` as it is when the
+/// drawing has a cycle or a vertex the walk did not place.
 pub(super) fn agreed(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice, w: Walked) -> Walked {
     let Some(mut f) = Forest::new(g, paths, lattice, &w.at) else {
         return w;
     };
-    let offsets: Vec<f64> = (0..g.points.len())
-        .filter_map(|v| Some(w.frame.apply(g.points[v]).distance_squared(w.at[v]?)))
-        .collect();
-    if offsets.is_empty() {
+    let Some(mut weigh) = Weigh::new(g, lattice, &w, &f) else {
         return w;
-    }
-    // Per coordinate, as the walk's own offsets spread.
-    let var = (offsets.iter().sum::<f64>() / (2.0 * offsets.len() as f64)).max(1e-6);
-    let m = lattice.units.len() as i64;
-    // A subtree said once: its children's turns and subtrees.
-    let node_bits = (f.live.max(2) as f64).log2() + (m as f64).log2();
-    // No tip goes farther from the drawing than an inner vertex, pinned
-    // by what is drawn after it, already is.
-    let worst = (0..g.points.len())
-        .filter(|&v| g.adj[v].len() > 1)
-        .filter_map(|v| Some(w.frame.apply(g.points[v]).distance(w.at[v]?)))
-        .fold(0.0, f64::max);
-    let mut at = w.at.clone();
-    let mut work = 0usize;
-    let turn_bits = f.turn_bits();
-    // The small subtrees at the drawing's ends, each read again as a
-    // whole, and a first step that starts at an end.
-    let ends: Vec<u32> = (0..g.points.len() as u32)
-        .filter(|&v| {
-            let p = f.parent[v as usize];
-            (p != NONE && f.size(v, SMALL + 1) <= SMALL)
-                || (p == NONE && f.children[v as usize].len() == 1)
-        })
-        .collect();
-    let seen = |u: u32| w.frame.apply(g.points[u as usize]);
-    // The best turn of the step into or out of end `v` now (a subtree
-    // placed again where the drawing has it): its gain in bits and what
-    // moves.
-    let mut best_turn = |f: &mut Forest, at: &[Option<DVec2>], v: u32| {
-        let mut best: Option<(f64, Move)> = None;
-        for dk in [-1, 1] {
-            let mv = f.turned(v, dk, at, seen, lattice)?;
-            let mut cost = 0.0;
-            for &(u, there) in &mv.points {
-                if seen(u).distance(there) > worst || f.taken_by_other(there, &mv.points, at) {
-                    cost = f64::INFINITY;
-                }
-                cost += seen(u).distance_squared(there) - seen(u).distance_squared(at[u as usize]?);
-            }
-            if !cost.is_finite() {
-                continue;
-            }
-            work += f.depth(v) + mv.ways.len();
-            if work > WORK {
-                return None;
-            }
-            let cost = cost / (2.0 * var) / std::f64::consts::LN_2 + f.turns_cost(&mv, &turn_bits);
-            let gain = f.fewer_if(&mv) as f64 * node_bits - cost;
-            if gain > 0.0 && best.as_ref().is_none_or(|b| gain > b.0) {
-                best = Some((gain, mv));
-            }
-        }
-        best
     };
+    let mut at = w.at.clone();
+    let ends = ends(g, &f);
     for _ in 0..PASSES {
         // The likeliest turns first, each weighed again when its turn
         // comes (a turn before it may have made it worthless: twin
         // subtrees, one misread, agree whichever of them turns).
         let mut gains: Vec<(f64, u32)> = ends
             .iter()
-            .filter_map(|&v| Some((best_turn(&mut f, &at, v)?.0, v)))
+            .filter_map(|&v| Some((weigh.best(&mut f, &at, v)?.0, v)))
             .collect();
         gains.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         let mut turned = false;
         for (_, v) in gains {
-            let Some((_, mv)) = best_turn(&mut f, &at, v) else {
+            let Some((_, mv)) = weigh.best(&mut f, &at, v) else {
                 continue;
             };
             f.apply(&mv);
@@ -124,6 +72,97 @@ pub(super) fn agreed(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice, w: Walked
         }
     }
     Walked { at, ..w }
+}
+
+/// The small subtrees at the drawing's ends, each read again as a whole,
+/// and a first step that starts at an end.
+fn ends(g: &Graph, f: &Forest) -> Vec<u32> {
+    (0..g.points.len() as u32)
+        .filter(|&v| {
+            let p = f.parent[v as usize];
+            (p != NONE && f.size(v, SMALL + 1) <= SMALL)
+                || (p == NONE && f.children[v as usize].len() == 1)
+        })
+        .collect()
+}
+
+/// What a move costs and gains, in bits.
+struct Weigh<'a> {
+    g: &'a Graph,
+    lattice: &'a Lattice,
+    w: &'a Walked,
+    /// The offsets' variance per coordinate, as the walk's own spread.
+    var: f64,
+    /// A subtree said once: its children's turns and subtrees.
+    node_bits: f64,
+    /// How far an inner vertex, pinned by what is drawn after it, already
+    /// is from the drawing: no moved vertex goes farther.
+    worst: f64,
+    /// Each turn's bits, as often as the forest turns it.
+    turn_bits: Vec<f64>,
+    /// Chain steps spent so far (see `WORK`).
+    work: usize,
+}
+
+impl<'a> Weigh<'a> {
+    fn new(g: &'a Graph, lattice: &'a Lattice, w: &'a Walked, f: &Forest) -> Option<Weigh<'a>> {
+        let offsets: Vec<f64> = (0..g.points.len())
+            .filter_map(|v| Some(w.frame.apply(g.points[v]).distance_squared(w.at[v]?)))
+            .collect();
+        if offsets.is_empty() {
+            return None;
+        }
+        let m = lattice.units.len() as f64;
+        Some(Weigh {
+            g,
+            lattice,
+            w,
+            var: (offsets.iter().sum::<f64>() / (2.0 * offsets.len() as f64)).max(1e-6),
+            node_bits: (f.live.max(2) as f64).log2() + m.log2(),
+            worst: (0..g.points.len())
+                .filter(|&v| g.adj[v].len() > 1)
+                .filter_map(|v| Some(w.frame.apply(g.points[v]).distance(w.at[v]?)))
+                .fold(0.0, f64::max),
+            turn_bits: f.turn_bits(),
+            work: 0,
+        })
+    }
+
+    fn seen(&self, u: u32) -> DVec2 {
+        self.w.frame.apply(self.g.points[u as usize])
+    }
+
+    /// The best turn of the step into or out of end `v` now (a subtree
+    /// placed again where the drawing has it): its gain in bits and what
+    /// moves; none when no turn gains or the work is spent.
+    fn best(&mut self, f: &mut Forest, at: &[Option<DVec2>], v: u32) -> Option<(f64, Move)> {
+        let mut best: Option<(f64, Move)> = None;
+        for dk in [-1, 1] {
+            let mv = f.turned(v, dk, at, |u| self.seen(u), self.lattice)?;
+            let mut cost = 0.0;
+            for &(u, there) in &mv.points {
+                let seen = self.seen(u);
+                if seen.distance(there) > self.worst || f.taken_by_other(there, &mv.points, at) {
+                    cost = f64::INFINITY;
+                }
+                cost += seen.distance_squared(there) - seen.distance_squared(at[u as usize]?);
+            }
+            if !cost.is_finite() {
+                continue;
+            }
+            self.work += f.depth(v) + mv.ways.len();
+            if self.work > WORK {
+                return None;
+            }
+            let cost = cost / (2.0 * self.var) / std::f64::consts::LN_2
+                + f.turns_cost(&mv, &self.turn_bits);
+            let gain = f.fewer_if(&mv) as f64 * self.node_bits - cost;
+            if gain > 0.0 && best.as_ref().is_none_or(|b| gain > b.0) {
+                best = Some((gain, mv));
+            }
+        }
+        best
+    }
 }
 
 /// A part of the walk read again: the vertices whose way in changes
