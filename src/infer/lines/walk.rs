@@ -20,7 +20,6 @@
 //! branches are the last level's, a few steps; the one around it draws a
 //! branch expanded once more, and the axis the rest. So the edges are also
 //! tried smaller subtree first, equal ones by their turns.
-
 //!
 //! Owns: which roots and orders are tried. Must not search grammars.
 
