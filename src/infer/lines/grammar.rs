@@ -161,6 +161,8 @@ pub fn matches(
 ) -> Outcome {
     let dirs = Directions::new(angles);
     let mut b = Builder::new();
+    // A gap read as the drawing's are, with δ known.
+    b.lattice = Some((angles.delta.to_radians(), angles.tolerance.to_radians()));
     let mut frames: Vec<(&[Sym], usize, u32)> = vec![(&g.axiom[..], 0, g.depth)];
     let mut heading = 0i32;
     let mut pos = DVec2::ZERO;
@@ -222,6 +224,7 @@ pub fn matches(
                             if n.parent != want.parent
                                 || n.kind != want.kind
                                 || (checked > 0 && n.turn != want.turn)
+                                || !same_jump(&b, tree, checked as u32)
                             {
                                 return Outcome::Differs { at: checked };
                             }
@@ -236,6 +239,15 @@ pub fn matches(
         Outcome::Same
     } else {
         Outcome::Differs { at: checked }
+    }
+}
+
+/// Whether node `i` jumps as far in both (or in neither).
+fn same_jump(b: &Builder, tree: &Tree, i: u32) -> bool {
+    match (b.jumps.get(&i), tree.jumps.get(&i)) {
+        (None, None) => true,
+        (Some(x), Some(y)) => x.distance(*y) <= super::turtle::TOUCH,
+        _ => false,
     }
 }
 
@@ -468,7 +480,7 @@ mod tests {
                 });
             }
         }
-        let tree = Tree { nodes };
+        let tree = Tree::of(nodes);
         assert_eq!(matches(&g, &tree, &angles, 1000, None), Outcome::Same);
         let mut other = g.clone();
         other.depth = 2;

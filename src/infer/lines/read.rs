@@ -7,7 +7,7 @@
 //! δ (every turn a whole number of δ), the start frame, and the tree of
 //! steps (`turtle::Builder`). Must not search grammars.
 
-use super::turtle::{Angles, Builder, Tree, Unfit};
+use super::turtle::{Angles, Builder, Kind, Tree, Unfit};
 use crate::infer::svg::{self, Seg};
 use glam::DVec2;
 
@@ -204,37 +204,7 @@ pub fn reading(lines: &[Vec<DVec2>], split: u32) -> Result<Reading, NotLines> {
         }
     }
     let step_error = (res / (lengths.len().max(2) - 1) as f64).sqrt() / rr.sqrt();
-    let origin = segments[0].0;
-    let mut b = Builder::new();
-    // Where each drawn step starts (world coordinates), by node; the first
-    // node of each segment.
-    let mut starts: Vec<(u32, DVec2)> = Vec::new();
-    let mut firsts: Vec<u32> = Vec::with_capacity(segments.len());
-    // The segment each node comes from (moves: none).
-    let mut edge_of: Vec<u32> = Vec::new();
-    for (edge, (&(a, e), &len)) in segments.iter().zip(&lengths).enumerate() {
-        let n = (len / step).round().max(1.0) as usize;
-        let (wa, we) = (a, e);
-        let (a, e) = ((a - origin) / step, (e - origin) / step);
-        for k in 0..n {
-            let p = a.lerp(e, k as f64 / n as f64);
-            let q = a.lerp(e, (k + 1) as f64 / n as f64);
-            b.push(p, q).map_err(|e| match e {
-                Unfit::TooLarge => NotLines::Steps(format!(
-                    "more than {} steps and moves (gaps of whole steps)",
-                    super::turtle::MAX_NODES
-                )),
-                _ => NotLines::Steps("a segment starts away from the drawing by a gap that is not a whole number of steps".into()),
-            })?;
-            let id = b.raw.len() as u32 - 1;
-            edge_of.resize(id as usize, u32::MAX);
-            edge_of.push(edge as u32);
-            if k == 0 {
-                firsts.push(id);
-            }
-            starts.push((id, wa.lerp(we, k as f64 / n as f64)));
-        }
-    }
+    let (mut b, mut steps) = build(&segments, &lengths, step, None)?;
     // δ roughly, from the turns; the headings in whole turns of it (a
     // loose reading: a turn between two short segments carries the noise
     // of both); δ and the first heading by least squares; then each step's
@@ -245,7 +215,23 @@ pub fn reading(lines: &[Vec<DVec2>], split: u32) -> Result<Reading, NotLines> {
         Unfit::Jump => NotLines::Steps("a gap that is not a whole number of steps".into()),
         Unfit::TooLarge => NotLines::Steps("too many steps".into()),
     };
-    let coarse = find_delta(&b, &edge_of)?;
+    let coarse = find_delta(&b, &steps.edge_of)?;
+    // A long gap in several directions may come near a whole number of
+    // steps: read with δ known, it is a jump.
+    let d = coarse.delta.to_radians();
+    let off = |i: usize| {
+        let t = b.turn_radians(i) / d;
+        (t - t.round()).abs() * coarse.delta > coarse.tolerance
+    };
+    if (1..b.raw.len()).any(|i| b.raw[i].kind == Kind::Move && off(i)) {
+        (b, steps) = build(
+            &segments,
+            &lengths,
+            step,
+            Some((d, coarse.tolerance.to_radians())),
+        )?;
+    }
+    let Steps { starts, firsts, .. } = steps;
     let loose = Angles::new(coarse.delta, None, 0.5 * coarse.delta + 1e-9);
     let first = headings(&b.tree(&loose).map_err(unfit)?);
     // Read again with the fitted δ: a curve that winds round and round
@@ -272,6 +258,62 @@ pub fn reading(lines: &[Vec<DVec2>], split: u32) -> Result<Reading, NotLines> {
         segments,
         delta_error,
     })
+}
+
+/// The drawn steps of a reading: where each starts, by node (world
+/// coordinates), the first node of each segment, the segment of each node
+/// (moves: none).
+struct Steps {
+    starts: Vec<(u32, DVec2)>,
+    firsts: Vec<u32>,
+    edge_of: Vec<u32>,
+}
+
+/// `segments` cut into steps of `step` and pushed into a builder; gaps off
+/// the `lattice` (δ and its tolerance, radians) are jumps.
+fn build(
+    segments: &[(DVec2, DVec2)],
+    lengths: &[f64],
+    step: f64,
+    lattice: Option<(f64, f64)>,
+) -> Result<(Builder, Steps), NotLines> {
+    let origin = segments[0].0;
+    let mut b = Builder::new();
+    b.lattice = lattice;
+    let mut starts: Vec<(u32, DVec2)> = Vec::new();
+    let mut firsts: Vec<u32> = Vec::with_capacity(segments.len());
+    let mut edge_of: Vec<u32> = Vec::new();
+    for (edge, (&(a, e), &len)) in segments.iter().zip(lengths).enumerate() {
+        let n = (len / step).round().max(1.0) as usize;
+        let (wa, we) = (a, e);
+        let (a, e) = ((a - origin) / step, (e - origin) / step);
+        for k in 0..n {
+            let p = a.lerp(e, k as f64 / n as f64);
+            let q = a.lerp(e, (k + 1) as f64 / n as f64);
+            b.push(p, q).map_err(|e| match e {
+                Unfit::TooLarge => NotLines::Steps(format!(
+                    "more than {} steps and moves (gaps of whole steps)",
+                    super::turtle::MAX_NODES
+                )),
+                _ => NotLines::Steps("a segment starts away from the drawing by a gap that is not a whole number of steps".into()),
+            })?;
+            let id = b.raw.len() as u32 - 1;
+            edge_of.resize(id as usize, u32::MAX);
+            edge_of.push(edge as u32);
+            if k == 0 {
+                firsts.push(id);
+            }
+            starts.push((id, wa.lerp(we, k as f64 / n as f64)));
+        }
+    }
+    Ok((
+        b,
+        Steps {
+            starts,
+            firsts,
+            edge_of,
+        },
+    ))
 }
 
 /// Each node's heading in whole turns of δ from the first node's.
@@ -473,7 +515,13 @@ fn requantize(b: &Builder, theta: f64, angles: &Angles) -> Result<(Vec<i64>, Tre
             kind: r.kind,
         });
     }
-    Ok((k, Tree { nodes }))
+    Ok((
+        k,
+        Tree {
+            nodes,
+            jumps: b.jumps.clone(),
+        },
+    ))
 }
 
 /// δ roughly: the turns between steps of different segments (in one
@@ -482,16 +530,39 @@ fn requantize(b: &Builder, theta: f64, angles: &Angles) -> Result<(Vec<i64>, Tre
 /// histogram; δ is the smallest peak away from 0, or a part of it when the
 /// other peaks are not its multiples.
 fn find_delta(b: &Builder, edge_of: &[u32]) -> Result<Angles, NotLines> {
-    let turns: Vec<f64> = (1..b.raw.len())
-        .filter(|&i| {
-            let p = b.raw[i].parent;
-            p == super::turtle::ROOT
-                || edge_of.get(i) != edge_of.get(p as usize)
-                || edge_of.get(i).is_none_or(|&e| e == u32::MAX)
-        })
-        .map(|i| b.turn_radians(i).to_degrees().abs())
-        .collect();
-    delta_from_turns(&turns)
+    use super::turtle::ROOT;
+    // A step turns from the drawn step before it, across any gap: a gap's
+    // own direction is where the next stroke happens to start (a long gap
+    // in several directions may come near a whole number of steps, at any
+    // angle). Gaps' directions count only when drawn steps never turn.
+    let drawn_before = |i: usize| {
+        let mut p = b.raw[i].parent;
+        while p != ROOT && b.raw[p as usize].kind != Kind::Draw {
+            p = b.raw[p as usize].parent;
+        }
+        p
+    };
+    let mut drawn = Vec::new();
+    let mut all = Vec::new();
+    for i in 1..b.raw.len() {
+        let p = b.raw[i].parent;
+        if p != ROOT && edge_of.get(i) == edge_of.get(p as usize) && edge_of[i] != u32::MAX {
+            continue;
+        }
+        all.push(b.turn_radians(i).to_degrees().abs());
+        if b.raw[i].kind == Kind::Draw {
+            let from = match drawn_before(i) {
+                ROOT => b.raw[0].angle,
+                a => b.raw[a as usize].angle,
+            };
+            drawn.push(super::turtle::wrap_degrees((b.raw[i].angle - from).to_degrees()).abs());
+        }
+    }
+    if drawn.iter().any(|t| *t >= 1.25) {
+        delta_from_turns(&drawn)
+    } else {
+        delta_from_turns(&all)
+    }
 }
 
 /// δ roughly from turns (degrees, any sign): see `find_delta`.

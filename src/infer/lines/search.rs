@@ -33,6 +33,7 @@ use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
 mod apex;
+mod moves;
 mod pair;
 
 /// How far the search goes.
@@ -96,6 +97,12 @@ pub fn propose(tree: &Tree, angles: &Angles, limits: &Limits) -> Proposals {
             out.grammars.push(g);
         }
     };
+    // Gaps of several legs: only the family that reads them.
+    if !tree.jumps.is_empty() {
+        moves::moves(tree, angles, limits, &mut add, &mut out);
+        cheapest_first(&mut out);
+        return out;
+    }
     edge_rewriting(tree, angles, limits, &mut add, &mut out);
     let mut seen = out.grammars.iter().cloned().collect::<HashSet<_>>();
     let mut room = limits.max_candidates;
@@ -119,13 +126,25 @@ pub fn propose(tree: &Tree, angles: &Angles, limits: &Limits) -> Proposals {
         any_drawn = out.grammars.len() > before;
     }
     if !any_drawn {
+        let before = out.grammars.len();
         pair::node_pairs(tree, angles, limits, &mut add, &mut out);
+        // Straight gaps the edge search did not place: moves in several
+        // directions that happen to line up.
+        if tree.nodes.iter().any(|n| n.kind == Kind::Move)
+            && !out.grammars[before..].iter().any(drawn)
+        {
+            moves::moves(tree, angles, limits, &mut add, &mut out);
+        }
     }
+    cheapest_first(&mut out);
+    out
+}
+
+fn cheapest_first(out: &mut Proposals) {
     out.grammars.sort_by_cached_key(|g| {
         let (size, rule_size, rules, text) = g.cost();
         (size, rule_size, rules, turned_ends(g), text)
     });
-    out
 }
 
 /// How many successors start or end with a turn: of candidates as large,
@@ -225,7 +244,7 @@ fn cut(
         let first = nodes[i];
         let len = match first.kind {
             Kind::Draw => sizes.b + sizes.c,
-            Kind::Move => sizes.s,
+            Kind::Move | Kind::Jump => sizes.s,
         };
         if len == 0 || i + len > n {
             return None;
@@ -237,7 +256,7 @@ fn cut(
         block_of[i..i + len].fill(block);
         let fits = match first.kind {
             Kind::Draw => draws == sizes.b && moves == sizes.c,
-            Kind::Move => moves == sizes.s,
+            Kind::Move | Kind::Jump => moves == sizes.s,
         };
         if !fits {
             return None;
@@ -254,7 +273,7 @@ fn cut(
                 let same_kind = shapes.iter().filter(|s| s.kind == first.kind).count();
                 let limit = match first.kind {
                     Kind::Draw => MAX_LETTERS,
-                    Kind::Move => MOVE_SHAPE_LIMIT,
+                    Kind::Move | Kind::Jump => MOVE_SHAPE_LIMIT,
                 };
                 if same_kind >= limit {
                     return None;
@@ -672,7 +691,7 @@ fn edge_grammars(
     'variant: for letters in variants {
         let sym = |shape: u8, kind: Kind| -> Sym {
             match kind {
-                Kind::Move => Sym::Letter(f_index),
+                Kind::Move | Kind::Jump => Sym::Letter(f_index),
                 Kind::Draw => {
                     if shape == UNKNOWN || shape as usize >= index.len() {
                         Sym::Letter(0)
@@ -1013,7 +1032,7 @@ fn copy_of(nodes: &[Node], start: usize, len: usize, angles: &Angles) -> Option<
             return None;
         });
     }
-    Some(Tree { nodes: out })
+    Some(Tree::of(out))
 }
 
 /// The ways (at most a few) to cut steps `start..start + len` into runs of
@@ -1391,11 +1410,12 @@ mod tests {
     use glam::DVec2;
 
     /// Draws a grammar with the builder, as a drawing would be read.
-    fn draw(g: &Grammar, angles: &Angles) -> Tree {
+    pub(super) fn draw(g: &Grammar, angles: &Angles) -> Tree {
         let mut frames: Vec<(&[Sym], usize, u32)> = vec![(&g.axiom[..], 0, g.depth)];
         let (mut h, mut pos) = (0i32, DVec2::ZERO);
         let mut saved = Vec::new();
         let mut b = Builder::new();
+        b.lattice = Some((angles.delta.to_radians(), angles.tolerance.to_radians()));
         while let Some(top) = frames.last_mut() {
             let (syms, i, d) = (top.0, top.1, top.2);
             if i >= syms.len() {
@@ -1442,7 +1462,7 @@ mod tests {
             .collect()
     }
 
-    fn grammar(axiom: &str, rules: &[(char, Action, &str)], depth: u32) -> Grammar {
+    pub(super) fn grammar(axiom: &str, rules: &[(char, Action, &str)], depth: u32) -> Grammar {
         let ls: Vec<(char, Action)> = rules.iter().map(|r| (r.0, r.1)).collect();
         Grammar {
             letters: rules

@@ -42,6 +42,9 @@ pub enum Kind {
     Draw,
     /// A step without drawing, `f`.
     Move,
+    /// A gap that is not one straight run of whole steps (moves in several
+    /// directions, `-f--ff+`): where it lands, in `Tree::jumps`.
+    Jump,
 }
 
 /// One step of the turtle: which node it continues from (`ROOT`: the start
@@ -59,6 +62,19 @@ pub struct Node {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Tree {
     pub nodes: Vec<Node>,
+    /// Where each `Jump` node lands from its parent's end, in steps, in
+    /// the parent's frame: (along its heading, to its left).
+    pub jumps: HashMap<u32, DVec2>,
+}
+
+impl Tree {
+    /// A tree of steps and straight moves only.
+    pub fn of(nodes: Vec<Node>) -> Tree {
+        Tree {
+            nodes,
+            jumps: HashMap::new(),
+        }
+    }
 }
 
 impl Tree {
@@ -144,6 +160,11 @@ pub struct Builder {
     chain: Vec<(u32, DVec2)>,
     /// Cell of a chain point to its places in `chain` (increasing).
     cells: HashMap<(i64, i64), Vec<u32>>,
+    /// Where each jump lands (see `Tree::jumps`).
+    pub jumps: HashMap<u32, DVec2>,
+    /// δ and how far a turn may be from a multiple of it (radians), when
+    /// known: a straight gap of whole steps in a direction off it is a jump.
+    pub lattice: Option<(f64, f64)>,
 }
 
 const CELL: f64 = 0.5;
@@ -164,6 +185,8 @@ impl Builder {
             raw: Vec::new(),
             chain: Vec::new(),
             cells: HashMap::new(),
+            jumps: HashMap::new(),
+            lattice: None,
         }
     }
 
@@ -228,11 +251,17 @@ impl Builder {
             let g = a - end;
             let len = g.length();
             let steps = len.round();
-            if !((1.0..=MAX_GAP).contains(&steps) && (len - steps).abs() <= GAP) {
+            let straight =
+                steps >= 1.0 && (len - steps).abs() <= GAP && self.on_lattice(node, g.y.atan2(g.x));
+            if len > MAX_GAP || (!straight && node == ROOT) {
                 return Err(Unfit::Jump);
             }
             if self.raw.len() + steps as usize >= MAX_NODES {
                 return Err(Unfit::TooLarge);
+            }
+            if !straight {
+                self.jump(node, g, a);
+                return self.push(a, b);
             }
             let angle = g.y.atan2(g.x);
             let mut parent = node;
@@ -262,6 +291,36 @@ impl Builder {
         });
         self.enter(id, b);
         Ok(())
+    }
+
+    /// Whether heading `angle` turns from `node`'s by a multiple of δ (any
+    /// heading while δ is not known).
+    fn on_lattice(&self, node: u32, angle: f64) -> bool {
+        let Some((delta, tolerance)) = self.lattice else {
+            return true;
+        };
+        let from = match node {
+            ROOT => return true,
+            n => self.raw[n as usize].angle,
+        };
+        let t = wrap_degrees((angle - from).to_degrees()).to_radians();
+        (t - (t / delta).round() * delta).abs() <= tolerance
+    }
+
+    /// A jump by `g` from the end of `node` (the chain's last), landing at `at`.
+    fn jump(&mut self, node: u32, g: DVec2, at: DVec2) {
+        let angle = self.raw[node as usize].angle;
+        let (sin, cos) = angle.sin_cos();
+        let id = self.raw.len() as u32;
+        self.raw.push(Raw {
+            parent: node,
+            angle,
+            kind: Kind::Jump,
+        });
+        // In the parent's frame: along its heading, and to its left.
+        self.jumps
+            .insert(id, DVec2::new(g.x * cos + g.y * sin, g.y * cos - g.x * sin));
+        self.enter(id, at);
     }
 
     /// The turn of raw node `i` from its parent's heading (the first node's
@@ -301,7 +360,10 @@ impl Builder {
         let nodes = (0..self.raw.len())
             .map(|i| self.node(i, angles))
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(Tree { nodes })
+        Ok(Tree {
+            nodes,
+            jumps: self.jumps.clone(),
+        })
     }
 }
 
@@ -345,10 +407,14 @@ mod tests {
         assert_eq!(t.nodes[2].turn, 1);
         let mut b = Builder::new();
         b.push(DVec2::ZERO, DVec2::Y).expect("first");
-        assert_eq!(
-            b.push(DVec2::new(0.5, 0.5), DVec2::new(0.5, 1.5)),
-            Err(Unfit::Jump)
-        );
+        // Not a straight run of whole steps: a jump, and where it lands
+        // (half a step back, half a step to the right).
+        assert_eq!(b.push(DVec2::new(0.5, 0.5), DVec2::new(0.5, 1.5)), Ok(()));
+        let t = b.tree(&Angles::new(90.0, Some(4), 1.0)).expect("turns");
+        let kinds: Vec<Kind> = t.nodes.iter().map(|n| n.kind).collect();
+        assert_eq!(kinds, [Kind::Draw, Kind::Jump, Kind::Draw]);
+        let at = t.jumps[&1];
+        assert!(at.distance(DVec2::new(-0.5, -0.5)) < 1e-12, "{at}");
     }
 
     #[test]

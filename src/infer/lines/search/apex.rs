@@ -75,7 +75,7 @@ fn without_tips(tree: &Tree) -> Option<Tree> {
         };
         kept.push(Node { parent, ..*n });
     }
-    (kept.len() >= 2).then_some(Tree { nodes: kept })
+    (kept.len() >= 2).then_some(Tree::of(kept))
 }
 
 /// `g` (F, and X drawing nothing) with X drawing a step, named G, when
@@ -186,14 +186,10 @@ mod tests {
             turn,
             kind: Kind::Draw,
         };
-        let t = Tree {
-            nodes: vec![node(ROOT, 0), node(0, 0), node(1, 1), node(1, -1)],
-        };
+        let t = Tree::of(vec![node(ROOT, 0), node(0, 0), node(1, 1), node(1, -1)]);
         assert_eq!(
             without_tips(&t),
-            Some(Tree {
-                nodes: vec![node(ROOT, 0), node(0, 0)]
-            })
+            Some(Tree::of(vec![node(ROOT, 0), node(0, 0)]))
         );
     }
 }
