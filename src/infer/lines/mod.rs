@@ -17,6 +17,7 @@
 pub mod blocks;
 pub mod emit;
 pub mod euler;
+pub mod frame;
 pub mod grammar;
 pub mod graph;
 pub mod ideal;
@@ -629,10 +630,32 @@ fn finish(
             start: place(r.start, p_c, heading, step),
         }
     };
-    // As measured, and as a person would have written it: δ to a twentieth
-    // of a degree, the heading to a multiple of δ or a whole degree, the
-    // start at the origin, when they are that close.
-    let precise = (angle, frame(angle, step), step);
+    // As measured (by the whole drawing when the grammar's steps pair up
+    // with it, precise enough for its far end: within a fiftieth of a step
+    // there), and as a person would have written it: δ to a twentieth of a
+    // degree, the heading to a multiple of δ or a whole degree, the start
+    // at the origin, when they are that close.
+    // Only for δ = 360/m, written exactly: a δ read from the turns is
+    // itself a little off, and a frame fitted to it puts the error on the
+    // root as well as on the tips.
+    let fitted = r.angles.period.and_then(|_| frame::fit(g, angle, r, work));
+    let precise = match fitted {
+        Some(f) => {
+            let far = 0.02 / f.extent;
+            let heading = nice(turtle::wrap_degrees(f.heading), far.to_degrees().min(1e-3));
+            let step = nice(f.step, far * f.step);
+            let start = place(r.start, p_c, heading, step);
+            // The start from the first step, unless the fit puts it closer
+            // to every step.
+            let start = if start.distance(f.start) <= 0.01 * step {
+                start
+            } else {
+                f.start
+            };
+            (angle, Frame { heading, start }, step)
+        }
+        None => (angle, frame(angle, step), step),
+    };
     let round_angle = if r.angles.period.is_some() {
         angle
     } else {
