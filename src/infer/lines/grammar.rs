@@ -244,7 +244,8 @@ pub fn matches(
 
 /// Whether node `i` jumps as far in both (or in neither).
 fn same_jump(b: &Builder, tree: &Tree, i: u32) -> bool {
-    match (b.jumps.get(&i), tree.jumps.get(&i)) {
+    let angle = b.raw[i as usize].angle;
+    match (b.landing(i, angle), tree.jumps.get(&i)) {
         (None, None) => true,
         (Some(x), Some(y)) => x.distance(*y) <= super::turtle::TOUCH,
         _ => false,

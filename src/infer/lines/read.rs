@@ -445,8 +445,12 @@ fn fit_start(
             p => ends[p as usize],
         };
         let a = theta + k[i] as f64 * delta;
+        let u = DVec2::new(a.cos(), a.sin());
         from[i] = s;
-        ends[i] = s + DVec2::new(a.cos(), a.sin());
+        ends[i] = match tree.jumps.get(&(i as u32)) {
+            Some(j) => s + u * j.x + u.perp() * j.y,
+            None => s + u,
+        };
     }
     // The first step's own start: the mean offset would be pulled off by
     // the slightest error of the step or of δ, over a large drawing.
@@ -515,13 +519,17 @@ fn requantize(b: &Builder, theta: f64, angles: &Angles) -> Result<(Vec<i64>, Tre
             kind: r.kind,
         });
     }
-    Ok((
-        k,
-        Tree {
-            nodes,
-            jumps: b.jumps.clone(),
-        },
-    ))
+    // Jumps in their parents' fitted frames: a step's own direction, read
+    // from its two ends, is off by more than a long jump can bear.
+    let jumps = b
+        .jumps
+        .keys()
+        .filter_map(|&i| {
+            let p = b.raw[i as usize].parent as usize;
+            Some((i, b.landing(i, theta + k[p] as f64 * d)?))
+        })
+        .collect();
+    Ok((k, Tree { nodes, jumps }))
 }
 
 /// δ roughly: the turns between steps of different segments (in one

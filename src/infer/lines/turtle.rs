@@ -29,6 +29,10 @@ pub const PER_CELL: usize = 64;
 /// How far a gap may be from a whole number of steps.
 pub const GAP: f64 = 0.15;
 
+/// The shortest gap, in steps, read as a jump: a nearer start is a stroke
+/// that missed the drawing (noise), not moves.
+pub const MIN_JUMP: f64 = 0.75;
+
 /// The longest gap, in steps, read as moves (`f`).
 pub const MAX_GAP: f64 = 100_000.0;
 
@@ -160,7 +164,7 @@ pub struct Builder {
     chain: Vec<(u32, DVec2)>,
     /// Cell of a chain point to its places in `chain` (increasing).
     cells: HashMap<(i64, i64), Vec<u32>>,
-    /// Where each jump lands (see `Tree::jumps`).
+    /// Each jump as drawn (in steps, not turned to its parent's frame).
     pub jumps: HashMap<u32, DVec2>,
     /// δ and how far a turn may be from a multiple of it (radians), when
     /// known: a straight gap of whole steps in a direction off it is a jump.
@@ -253,7 +257,7 @@ impl Builder {
             let steps = len.round();
             let straight =
                 steps >= 1.0 && (len - steps).abs() <= GAP && self.on_lattice(node, g.y.atan2(g.x));
-            if len > MAX_GAP || (!straight && node == ROOT) {
+            if len > MAX_GAP || (!straight && (node == ROOT || len < MIN_JUMP)) {
                 return Err(Unfit::Jump);
             }
             if self.raw.len() + steps as usize >= MAX_NODES {
@@ -310,17 +314,22 @@ impl Builder {
     /// A jump by `g` from the end of `node` (the chain's last), landing at `at`.
     fn jump(&mut self, node: u32, g: DVec2, at: DVec2) {
         let angle = self.raw[node as usize].angle;
-        let (sin, cos) = angle.sin_cos();
         let id = self.raw.len() as u32;
         self.raw.push(Raw {
             parent: node,
             angle,
             kind: Kind::Jump,
         });
-        // In the parent's frame: along its heading, and to its left.
-        self.jumps
-            .insert(id, DVec2::new(g.x * cos + g.y * sin, g.y * cos - g.x * sin));
+        self.jumps.insert(id, g);
         self.enter(id, at);
+    }
+
+    /// Where jump `i` lands in the frame of its parent heading `angle`
+    /// (radians from +x): along that heading, and to its left.
+    pub fn landing(&self, i: u32, angle: f64) -> Option<DVec2> {
+        let g = self.jumps.get(&i)?;
+        let (sin, cos) = angle.sin_cos();
+        Some(DVec2::new(g.x * cos + g.y * sin, g.y * cos - g.x * sin))
     }
 
     /// The turn of raw node `i` from its parent's heading (the first node's
@@ -360,10 +369,12 @@ impl Builder {
         let nodes = (0..self.raw.len())
             .map(|i| self.node(i, angles))
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(Tree {
-            nodes,
-            jumps: self.jumps.clone(),
-        })
+        let jumps = self
+            .jumps
+            .keys()
+            .filter_map(|&i| Some((i, self.landing(i, self.raw[i as usize].angle)?)))
+            .collect();
+        Ok(Tree { nodes, jumps })
     }
 }
 
@@ -407,14 +418,19 @@ mod tests {
         assert_eq!(t.nodes[2].turn, 1);
         let mut b = Builder::new();
         b.push(DVec2::ZERO, DVec2::Y).expect("first");
+        // Nearer than a jump: a stroke that missed the drawing.
+        assert_eq!(
+            b.push(DVec2::new(0.5, 0.5), DVec2::new(0.5, 1.5)),
+            Err(Unfit::Jump)
+        );
         // Not a straight run of whole steps: a jump, and where it lands
-        // (half a step back, half a step to the right).
-        assert_eq!(b.push(DVec2::new(0.5, 0.5), DVec2::new(0.5, 1.5)), Ok(()));
+        // (half a step back, a step and a half to the right).
+        assert_eq!(b.push(DVec2::new(1.5, 0.5), DVec2::new(1.5, 1.5)), Ok(()));
         let t = b.tree(&Angles::new(90.0, Some(4), 1.0)).expect("turns");
         let kinds: Vec<Kind> = t.nodes.iter().map(|n| n.kind).collect();
         assert_eq!(kinds, [Kind::Draw, Kind::Jump, Kind::Draw]);
         let at = t.jumps[&1];
-        assert!(at.distance(DVec2::new(-0.5, -0.5)) < 1e-12, "{at}");
+        assert!(at.distance(DVec2::new(-0.5, -1.5)) < 1e-12, "{at}");
     }
 
     #[test]

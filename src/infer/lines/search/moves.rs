@@ -32,7 +32,7 @@ const NEAR: f64 = 0.3;
 /// The most partial gaps looked at while finding one gap's legs.
 const LEG_WORK: usize = 20_000;
 /// The most candidates matched against the drawing.
-const MAX_MATCHED: usize = 400;
+const MAX_MATCHED: usize = 100;
 
 /// Headings as whole turns of δ (heading 0 is +y, turns anticlockwise).
 struct Lattice {
