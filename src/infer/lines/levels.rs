@@ -522,7 +522,9 @@ impl<D: Drawing> Parse<'_, D> {
             {
                 return Task::Choose(i + 1, self.guesses(pair));
             }
-            let mut alts: Vec<Alt> = (0..self.shapes.len() as u8)
+            let mut alts: Vec<Alt> = self
+                .longest_first()
+                .into_iter()
                 .filter(|&y| self.fits(i + 1, y))
                 .map(Alt::Block)
                 .collect();
@@ -542,7 +544,7 @@ impl<D: Drawing> Parse<'_, D> {
         if self.done < self.steps() {
             let pending = self.steps() - self.done;
             let mut alts = Vec::new();
-            for y in 0..self.shapes.len() as u8 {
+            for y in self.longest_first() {
                 alts.extend(self.cuts(y).into_iter().map(|c| Alt::Cut(y, c)));
             }
             if !all_shapes {
@@ -575,6 +577,14 @@ impl<D: Drawing> Parse<'_, D> {
             Some(l) if l.frozen && self.levels.len() >= 2 => Task::Done,
             _ => Task::Fail,
         }
+    }
+
+    /// The successors known so far, longest first (a short one fits in
+    /// more places, so it is the likelier wrong cut).
+    fn longest_first(&self) -> Vec<u8> {
+        let mut ys: Vec<u8> = (0..self.shapes.len() as u8).collect();
+        ys.sort_by_key(|&y| std::cmp::Reverse(self.shapes[y as usize].inner.len()));
+        ys
     }
 
     /// Whether every letter of `levels[i]` is there: the levels below it

@@ -23,6 +23,7 @@ pub mod graph;
 pub mod ideal;
 pub mod levels;
 pub mod read;
+pub mod root;
 pub mod search;
 pub mod synth;
 pub mod turtle;
@@ -314,6 +315,7 @@ fn by_reading(
             {
                 continue;
             }
+            let g = deepest(g, &reading, work, deadline);
             // The library's redraw is the costly check: a few per reading.
             verified += 1;
             if verified > MAX_REDRAWS {
@@ -404,6 +406,21 @@ fn from_graph(
         if grammar::matches(&gr, &reading.tree, &reading.angles, work, deadline) != Outcome::Same {
             continue;
         }
+        let gr = deepest(gr, &reading, work, deadline);
+        // The walk may run from the drawing's end: the same curve drawn
+        // from where its paths start, when the reversed grammar draws it.
+        let (gr, reading) = match (
+            root::reversed(&gr, &reading.angles),
+            read::reading(lines, split),
+        ) {
+            (Some(back), Ok(as_drawn))
+                if grammar::matches(&back, &as_drawn.tree, &reading.angles, work, deadline)
+                    == Outcome::Same =>
+            {
+                (back, as_drawn)
+            }
+            _ => (gr, reading),
+        };
         let tv = Instant::now();
         let (gr, angles) = grammar::aligned(&gr, &reading.angles);
         let reading = in_angles(&reading, angles);
@@ -422,6 +439,21 @@ fn from_graph(
         }
     }
     Err(late())
+}
+
+/// `g`, or the deepest of its roots (`root`) that draws the reading too.
+fn deepest(mut g: Grammar, r: &Reading, work: u64, deadline: Option<Instant>) -> Grammar {
+    // A root's root: a power of a power (at most a few times over).
+    for _ in 0..4 {
+        let root = root::deeper(&g, &r.angles)
+            .into_iter()
+            .find(|d| grammar::matches(d, &r.tree, &r.angles, work, deadline) == Outcome::Same);
+        match root {
+            Some(d) => g = d,
+            None => break,
+        }
+    }
+    g
 }
 
 /// `r` counted in `angles` (δ or a whole fraction of it, see

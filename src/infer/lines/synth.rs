@@ -1229,8 +1229,12 @@ fn along(shared: &mut Shared, depths: RangeInclusive<u32>, order: &[(u32, u32)])
 /// An edge-rewriting grammar read level by level (`levels`) off a curve
 /// drawn in one stroke in `order`, with one letter, then two, then three.
 fn by_levels(shared: &mut Shared, order: &[(u32, u32)]) -> Option<Found> {
-    let passes = passes(shared.limits.letters);
-    levels_with(shared, order, &passes, shared.limits.work)
+    let letters = shared.limits.letters;
+    let passes: Vec<(usize, bool)> = [false, true]
+        .into_iter()
+        .flat_map(|single| (1..=letters).map(move |k| (k, single)))
+        .collect();
+    levels_with(shared, order, &passes, 4 * shared.limits.work)
 }
 
 /// The level parse of `order` in the passes given (letters, one-step
