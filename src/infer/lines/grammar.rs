@@ -55,6 +55,24 @@ impl Grammar {
             .sum()
     }
 
+    /// Whether the axiom or a successor opens a branch.
+    pub fn pushes(&self) -> bool {
+        self.axiom
+            .iter()
+            .chain(
+                self.letters
+                    .iter()
+                    .filter_map(|l| l.rule.as_ref())
+                    .flatten(),
+            )
+            .any(|s| *s == Sym::Push)
+    }
+
+    /// Whether a letter moves without drawing.
+    pub fn moves(&self) -> bool {
+        self.letters.iter().any(|l| l.action == Action::Move)
+    }
+
     /// The order in which candidates are preferred: fewest symbols in the
     /// rules and the axiom together (a small rule with a long axiom explains
     /// little), then fewest rule symbols, then fewest rules, then the text.

@@ -91,8 +91,12 @@ pub fn propose(tree: &Tree, angles: &Angles, limits: &Limits) -> Proposals {
     }
     let mut seen = HashSet::new();
     let mut room = limits.max_candidates;
+    // A turtle with no brackets and no moves draws each step after the
+    // last: a drawing that branches needs a grammar that branches.
+    let branches = branches(tree);
+    let can_draw = |g: &Grammar| !branches || g.pushes() || g.moves();
     let mut add = |g: Grammar, out: &mut Proposals| {
-        if room > 0 && seen.insert(g.clone()) {
+        if room > 0 && can_draw(&g) && seen.insert(g.clone()) {
             room -= 1;
             out.grammars.push(g);
         }
@@ -107,7 +111,7 @@ pub fn propose(tree: &Tree, angles: &Angles, limits: &Limits) -> Proposals {
     let mut seen = out.grammars.iter().cloned().collect::<HashSet<_>>();
     let mut room = limits.max_candidates;
     let mut add = |g: Grammar, out: &mut Proposals| {
-        if room > 0 && seen.insert(g.clone()) {
+        if room > 0 && can_draw(&g) && seen.insert(g.clone()) {
             room -= 1;
             out.grammars.push(g);
         }
@@ -138,6 +142,12 @@ pub fn propose(tree: &Tree, angles: &Angles, limits: &Limits) -> Proposals {
     }
     cheapest_first(&mut out);
     out
+}
+
+/// Whether some step of `tree` has two steps after it (or the start two).
+fn branches(tree: &Tree) -> bool {
+    let mut seen = HashSet::with_capacity(tree.nodes.len());
+    tree.nodes.iter().any(|n| !seen.insert(n.parent))
 }
 
 fn cheapest_first(out: &mut Proposals) {
@@ -1536,6 +1546,26 @@ mod tests {
         );
         let found = finds(&g, &a);
         assert!(found.rule_size() <= g.rule_size(), "{}", found.describe());
+    }
+
+    /// A plant whose trunk runs straight for 64 steps: grammars with no
+    /// brackets that draw its first straight run (`X -> FFFFFX` at depth
+    /// 63) are not proposed, so the proposals' room goes to the plant's.
+    #[test]
+    fn a_drawing_that_branches_gets_grammars_that_branch() {
+        let a = Angles::new(45.0, Some(8), 1.0);
+        let g = grammar(
+            "X",
+            &[
+                ('F', Action::Draw, "FF"),
+                ('X', Action::Nothing, "FF[+FX]FF"),
+            ],
+            6,
+        );
+        let tree = draw(&g, &a);
+        let p = propose(&tree, &a, &Limits::default());
+        assert!(p.grammars.iter().all(Grammar::pushes));
+        assert_eq!(finds(&g, &a).describe(), g.describe());
     }
 
     /// Node letters whose copy the turtle goes on from, with turns before
