@@ -10,9 +10,11 @@
 //!
 //! Owns: that fit. Must not search or emit.
 
-use super::grammar::{Action, Grammar, Sym};
+use super::grammar::{self, Grammar};
 use super::read::Reading;
+use super::turtle::Angles;
 use glam::DVec2;
+use std::ops::ControlFlow;
 
 /// The fitted frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -99,60 +101,24 @@ fn drawn_starts(r: &Reading) -> Vec<DVec2> {
 /// Where each drawn step of `g` starts, from the origin heading +y with
 /// steps of 1; `None` beyond `work` symbols or `most` steps.
 fn starts(g: &Grammar, delta: f64, work: u64, most: usize) -> Option<Vec<DVec2>> {
-    let unit = |h: i64| {
-        let a = (90.0 + delta * h as f64).to_radians();
-        DVec2::new(a.cos(), a.sin())
-    };
     let mut out = Vec::new();
-    let mut frames: Vec<(&[Sym], usize, u32)> = vec![(&g.axiom[..], 0, g.depth)];
-    let (mut heading, mut pos) = (0i64, DVec2::ZERO);
-    let mut saved = Vec::new();
-    let mut read = 0u64;
-    while let Some(top) = frames.last_mut() {
-        let (syms, i, depth) = (top.0, top.1, top.2);
-        if i >= syms.len() {
-            frames.pop();
-            continue;
+    let mut more = false;
+    let angles = Angles::new(delta, None, 0.0);
+    grammar::each_step(g, &angles, work, |pos, _| {
+        if out.len() >= most {
+            more = true;
+            return ControlFlow::Break(());
         }
-        top.1 += 1;
-        read += 1;
-        if read > work {
-            return None;
-        }
-        match syms[i] {
-            Sym::Plus => heading += 1,
-            Sym::Minus => heading -= 1,
-            Sym::Push => saved.push((heading, pos)),
-            Sym::Pop => (heading, pos) = saved.pop()?,
-            Sym::Letter(k) => {
-                let letter = g.letters.get(k as usize)?;
-                if depth > 0
-                    && let Some(rule) = &letter.rule
-                {
-                    frames.push((&rule[..], 0, depth - 1));
-                    continue;
-                }
-                match letter.action {
-                    Action::Nothing => {}
-                    Action::Move => pos += unit(heading),
-                    Action::Draw => {
-                        if out.len() >= most {
-                            return None;
-                        }
-                        out.push(pos);
-                        pos += unit(heading);
-                    }
-                }
-            }
-        }
-    }
-    Some(out)
+        out.push(pos);
+        ControlFlow::Continue(())
+    })?;
+    (!more).then_some(out)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::infer::lines::grammar::Letter;
+    use crate::infer::lines::grammar::{Action, Letter, Sym};
 
     #[test]
     fn the_frame_comes_from_every_step() {

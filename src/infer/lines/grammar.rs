@@ -8,6 +8,7 @@
 
 use super::turtle::{Angles, Builder, Tree};
 use glam::DVec2;
+use std::ops::ControlFlow;
 
 /// A symbol of an axiom or a successor.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -273,6 +274,24 @@ fn same_jump(b: &Builder, tree: &Tree, i: u32) -> bool {
 /// The first drawn step of `g`: where it starts (in steps, from the turtle's
 /// start) and its heading (in δ from +y).
 pub fn first_step(g: &Grammar, angles: &Angles, work: u64) -> Option<(DVec2, i32)> {
+    let mut first = None;
+    each_step(g, angles, work, |pos, heading| {
+        first = Some((pos, heading));
+        ControlFlow::Break(())
+    })?;
+    first
+}
+
+/// Derives `g` and walks it as its turtle does, from the origin heading +y,
+/// handing each drawn step's start and heading (in δ from +y) to `step`
+/// until it says to stop; `None` past `work` symbols read, or at a letter
+/// or a `]` the grammar does not have.
+pub fn each_step(
+    g: &Grammar,
+    angles: &Angles,
+    work: u64,
+    mut step: impl FnMut(DVec2, i32) -> ControlFlow<()>,
+) -> Option<()> {
     let dirs = Directions::new(angles);
     let mut frames: Vec<(&[Sym], usize, u32)> = vec![(&g.axiom[..], 0, g.depth)];
     let mut heading = 0i32;
@@ -294,11 +313,7 @@ pub fn first_step(g: &Grammar, angles: &Angles, work: u64) -> Option<(DVec2, i32
             Sym::Plus => heading += 1,
             Sym::Minus => heading -= 1,
             Sym::Push => saved.push((heading, pos)),
-            Sym::Pop => {
-                let (h, p) = saved.pop()?;
-                heading = h;
-                pos = p;
-            }
+            Sym::Pop => (heading, pos) = saved.pop()?,
             Sym::Letter(k) => {
                 let letter = g.letters.get(k as usize)?;
                 if depth > 0
@@ -310,12 +325,17 @@ pub fn first_step(g: &Grammar, angles: &Angles, work: u64) -> Option<(DVec2, i32
                 match letter.action {
                     Action::Nothing => {}
                     Action::Move => pos += dirs.get(heading),
-                    Action::Draw => return Some((pos, heading)),
+                    Action::Draw => {
+                        if step(pos, heading).is_break() {
+                            return Some(());
+                        }
+                        pos += dirs.get(heading);
+                    }
                 }
             }
         }
     }
-    None
+    Some(())
 }
 
 /// Where `w` ends, drawn from the origin heading +y, with steps of 1 for
