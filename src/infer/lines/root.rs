@@ -131,7 +131,9 @@ pub fn deeper(g: &Grammar, angles: &Angles) -> Vec<Grammar> {
     else {
         return Vec::new();
     };
-    if m < 2 {
+    let n = tau.len();
+    let known = |s: &Succ| s.letters.iter().all(|&y| (y as usize) < n);
+    if m < 2 || !tau.iter().all(known) || !known(&axiom) {
         return Vec::new();
     }
     let mut out = Vec::new();
@@ -577,7 +579,8 @@ fn taken_up(rules: &[Succ], axiom: &Succ, m: i32) -> (Succ, u32) {
 /// before its first step).
 fn preimage(rules: &[Succ], a: &Succ, m: i32) -> Option<Succ> {
     let mut cut = Vec::new();
-    if !cut_into(rules, a, m, 0, &mut cut) {
+    let mut work = 0;
+    if !cut_into(rules, a, m, 0, &mut cut, &mut work) {
         return None;
     }
     let mut inner = Vec::new();
@@ -601,10 +604,21 @@ fn preimage(rules: &[Succ], a: &Succ, m: i32) -> Option<Succ> {
 }
 
 /// Cuts `a`'s letters from `from` on into successors whose letters and
-/// inner turns they are, into `cut`.
-fn cut_into(rules: &[Succ], a: &Succ, m: i32, from: usize, cut: &mut Vec<u8>) -> bool {
+/// inner turns they are, into `cut` (within `WORK` tries in all).
+fn cut_into(
+    rules: &[Succ],
+    a: &Succ,
+    m: i32,
+    from: usize,
+    cut: &mut Vec<u8>,
+    work: &mut u64,
+) -> bool {
     if from == a.letters.len() {
         return true;
+    }
+    *work += 1;
+    if *work > WORK {
+        return false;
     }
     for (y, r) in rules.iter().enumerate() {
         let len = r.letters.len();
@@ -616,7 +630,7 @@ fn cut_into(rules: &[Succ], a: &Succ, m: i32, from: usize, cut: &mut Vec<u8>) ->
                 .all(|(x, y)| (x - y).rem_euclid(m) == 0);
         if fits {
             cut.push(y as u8);
-            if cut_into(rules, a, m, from + len, cut) {
+            if cut_into(rules, a, m, from + len, cut, work) {
                 return true;
             }
             cut.pop();
