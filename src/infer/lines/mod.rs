@@ -408,15 +408,18 @@ fn from_graph(
         }
         let gr = deepest(gr, &reading, work, deadline);
         // The walk may run from the drawing's end: the same curve drawn
-        // from where its paths start, when the reversed grammar draws it.
+        // from where its paths start, when the reversed grammar draws it
+        // and the grammar found does not.
+        let draws = |g: &Grammar, r: &Reading| {
+            r.angles.period == reading.angles.period
+                && (r.angles.delta - reading.angles.delta).abs() < 1e-6
+                && grammar::matches(g, &r.tree, &r.angles, work, deadline) == Outcome::Same
+        };
         let (gr, reading) = match (
             root::reversed(&gr, &reading.angles),
             read::reading(lines, split),
         ) {
-            (Some(back), Ok(as_drawn))
-                if grammar::matches(&back, &as_drawn.tree, &reading.angles, work, deadline)
-                    == Outcome::Same =>
-            {
+            (Some(back), Ok(as_drawn)) if !draws(&gr, &as_drawn) && draws(&back, &as_drawn) => {
                 (back, as_drawn)
             }
             _ => (gr, reading),

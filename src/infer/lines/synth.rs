@@ -1227,7 +1227,10 @@ fn along(shared: &mut Shared, depths: RangeInclusive<u32>, order: &[(u32, u32)])
 }
 
 /// An edge-rewriting grammar read level by level (`levels`) off a curve
-/// drawn in one stroke in `order`, with one letter, then two, then three.
+/// drawn in one stroke in `order`: with one letter, then two, then three,
+/// none with a successor of one step; then again with them (the passes
+/// without them find such a program applied twice over, whose root
+/// `root.rs` offers, and the passes with them spend the most).
 fn by_levels(shared: &mut Shared, order: &[(u32, u32)]) -> Option<Found> {
     let letters = shared.limits.letters;
     let passes: Vec<(usize, bool)> = [false, true]
