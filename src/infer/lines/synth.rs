@@ -1237,8 +1237,20 @@ fn by_levels(shared: &mut Shared, order: &[(u32, u32)]) -> Option<Found> {
         .into_iter()
         .flat_map(|single| (1..=letters).map(move |k| (k, single)))
         .collect();
-    levels_with(shared, order, &passes, 4 * shared.limits.work)
+    // Four times the work for a drawing of up to `MORE_WORK_STEPS` steps
+    // (a three-letter program's square takes that); a parse's work costs
+    // more the larger the drawing, and a huge one that nothing explains
+    // would spend it all.
+    let work = if order.len() <= MORE_WORK_STEPS {
+        4 * shared.limits.work
+    } else {
+        shared.limits.work
+    };
+    levels_with(shared, order, &passes, work)
 }
+
+/// The largest drawing (steps) whose level parse gets four times the work.
+const MORE_WORK_STEPS: usize = 20_000;
 
 /// The level parse of `order` in the passes given (letters, one-step
 /// successors), each with at most `work`.
