@@ -863,7 +863,7 @@ impl<D: Drawing> Parse<'_, D> {
 
 /// A turn modulo m as the nearest signed one (half a turn counts as
 /// positive).
-fn signed(t: i32, m: i32) -> i32 {
+pub(super) fn signed(t: i32, m: i32) -> i32 {
     let t = t.rem_euclid(m);
     if 2 * t > m { t - m } else { t }
 }

@@ -27,6 +27,7 @@
 //! candidate against the drawing (`grammar::matches` does).
 
 use super::grammar::{Action, Grammar, Sym};
+use super::levels::signed;
 use super::turtle::Angles;
 
 /// Work (letters derived, values tried) for one grammar's roots at most.
@@ -549,12 +550,6 @@ fn small_first(m: i32) -> Vec<i32> {
         }
     }
     v
-}
-
-/// A turn modulo `m` as the nearest signed one.
-fn signed(t: i32, m: i32) -> i32 {
-    let t = t.rem_euclid(m);
-    if 2 * t > m { t - m } else { t }
 }
 
 /// `axiom` taken up the levels that make it shortest: while it is the
