@@ -22,6 +22,14 @@
 //!   keeps within the bound (both its vertices off, each its own way)
 //!   takes the nearest ways, unbounded, rather than end the walk.
 //!
+//! A path that starts where no path came before starts across a gap from
+//! where the last one ended: the turtle moved there by whole steps (`f`),
+//! so its start is the lattice point that one or two straight runs of
+//! moves reach nearest the gap as drawn (the likeliest by the same bits:
+//! its offset, each run's way and length), in the frame fitted again to
+//! the walk so far (a gap of a hundred steps is read as well as the frame's
+//! scale is known). A gap no such runs explain keeps its drawn start.
+//!
 //! The steps cut from one drawn segment go its one way: its points between
 //! the drawn ends were not drawn and carry their ends' noise, so reading
 //! them one by one would bend a straight segment.
@@ -369,6 +377,48 @@ impl Lattice {
     fn nearest(&self, d: DVec2) -> i64 {
         (d.y.atan2(d.x) / self.delta).round() as i64
     }
+
+    /// The sum of one or two straight runs of whole unit steps (`k·u`, or
+    /// `k·u + l·v`) likeliest to be the gap `g` as drawn, within half a
+    /// step of it: its offset from `g` costs d²/2σ² nats, each run the
+    /// bits to say its way and its length.
+    fn runs(&self, g: DVec2, sigma: f64) -> Option<DVec2> {
+        let m = self.units.len();
+        let way = (m as f64).log2();
+        let length = |k: f64| 2.0 * (k + 1.0).log2() + 1.0;
+        let mut best: Option<(f64, DVec2)> = None;
+        let mut offer = |p: DVec2, bits: f64| {
+            let d = p.distance(g);
+            if d > 0.5 {
+                return;
+            }
+            let cost = d * d / (2.0 * sigma * sigma) / std::f64::consts::LN_2 + bits;
+            if best.is_none_or(|(c, _)| cost < c) {
+                best = Some((cost, p));
+            }
+        };
+        for (i, &u) in self.units.iter().enumerate() {
+            let k = g.dot(u).round();
+            if k >= 1.0 {
+                offer(u * k, way + length(k));
+            }
+            for &v in &self.units[i + 1..] {
+                let det = u.perp_dot(v);
+                if det.abs() < 1e-9 {
+                    continue;
+                }
+                let (a, b) = (g.perp_dot(v) / det, u.perp_dot(g) / det);
+                for a in [a.floor(), a.ceil()] {
+                    for b in [b.floor(), b.ceil()] {
+                        if a >= 1.0 && b >= 1.0 {
+                            offer(u * a + v * b, 2.0 * way + length(a) + length(b));
+                        }
+                    }
+                }
+            }
+        }
+        best.map(|(_, p)| p)
+    }
 }
 
 /// A walk in the beam: its cost so far (bits), its last point in the
@@ -458,11 +508,28 @@ impl Pass<'_> {
     fn walk(&mut self, paths: &[Vec<u32>], prior: &[Option<DVec2>]) -> Option<Vec<Option<DVec2>>> {
         let mut at: Vec<Option<DVec2>> = vec![None; self.world.len()];
         let mut next: Vec<Step> = Vec::new();
+        // Where the last path ended: its vertex and its lattice point.
+        let mut last: Option<(u32, DVec2)> = None;
+        // Vertices placed, and placed when the frame was last fitted.
+        let (mut placed, mut fitted) = (0usize, 0usize);
         for path in paths {
             let first = path[0] as usize;
-            let start = at[first]
-                .or(prior.get(first).copied().flatten())
-                .unwrap_or_else(|| self.seen(path[0]));
+            let start = match at[first] {
+                Some(p) => p,
+                None => {
+                    // A long gap is read in steps of the frame: fitted
+                    // again to the walk so far as it grows by a quarter.
+                    if placed >= 8 && 4 * placed >= 5 * fitted {
+                        if let Some(f) = fit_to(self.world, &at) {
+                            self.frame = f;
+                        }
+                        fitted = placed;
+                    }
+                    last.and_then(|l| self.gap_end(l, path[0]))
+                        .or(prior.get(first).copied().flatten())
+                        .unwrap_or_else(|| self.seen(path[0]))
+                }
+            };
             // Each walk's points, back to the path's start.
             let mut arena: Vec<(DVec2, u32)> = vec![(start, u32::MAX)];
             let mut beam = vec![Head {
@@ -507,9 +574,22 @@ impl Pass<'_> {
                 beam = keep(&mut next, &mut arena, self.window.max(1), self.beam);
             }
             let best = beam.iter().min_by(|a, b| a.cost.total_cmp(&b.cost))?;
-            place(&mut at, path, &arena, best.at);
+            placed += place(&mut at, path, &arena, best.at);
+            let end = *path.last()?;
+            last = Some((end, at[end as usize]?));
         }
         Some(at)
+    }
+
+    /// Where a path that starts at vertex `v`, placed nowhere yet, starts on
+    /// the lattice: the turtle moved there from where the last path ended
+    /// (`(from, p)`: its vertex and lattice point), by one or two straight
+    /// runs of whole steps (`f`s, a turn between them), the likeliest of
+    /// those near the gap as drawn; `None` when none is near it (a gap no
+    /// short run of moves explains).
+    fn gap_end(&self, (from, p): (u32, DVec2), v: u32) -> Option<DVec2> {
+        let gap = self.seen(v) - self.seen(from);
+        Some(p + self.lattice.runs(gap, self.sigma)?)
     }
 
     /// The steps walk `h` may take to vertex `i` of `path`, into `next`
@@ -577,16 +657,21 @@ impl Pass<'_> {
 }
 
 /// Places `path`'s vertices where the walk ending at arena entry `h` has
-/// them (a vertex placed before keeps its place).
-fn place(at: &mut [Option<DVec2>], path: &[u32], arena: &[(DVec2, u32)], mut h: u32) {
+/// them (a vertex placed before keeps its place); how many were new.
+fn place(at: &mut [Option<DVec2>], path: &[u32], arena: &[(DVec2, u32)], mut h: u32) -> usize {
     let mut points = Vec::with_capacity(path.len());
     while h != u32::MAX {
         points.push(arena[h as usize].0);
         h = arena[h as usize].1;
     }
+    let mut new = 0;
     for (&v, p) in path.iter().zip(points.into_iter().rev()) {
-        at[v as usize].get_or_insert(p);
+        if at[v as usize].is_none() {
+            at[v as usize] = Some(p);
+            new += 1;
+        }
     }
+    new
 }
 
 /// The walk's point `n` steps before arena entry `h`.
@@ -889,5 +974,25 @@ mod tests {
             })
             .count();
         assert_eq!(off, 0, "steps of the redrawing not in the plant");
+    }
+
+    #[test]
+    fn a_gap_is_read_as_the_likeliest_runs_of_moves_near_it() {
+        let square = Lattice::new(4);
+        // Three steps right and two up, each end a fifth of a step off.
+        let run = square.runs(DVec2::new(3.15, 1.88), 0.1).expect("two runs");
+        assert!(run.distance(DVec2::new(3.0, 2.0)) < 1e-9, "{run}");
+        // Seven steps along one way.
+        let run = square.runs(DVec2::new(-0.1, -7.2), 0.1).expect("one run");
+        assert!(run.distance(DVec2::new(0.0, -7.0)) < 1e-9, "{run}");
+        // Halfway between lattice points: no run of moves ends there.
+        assert_eq!(square.runs(DVec2::new(2.5, 0.5), 0.1), None);
+        // At 60°: two steps one way and three the next, off by a fifth.
+        let hex = Lattice::new(6);
+        let truth = hex.units[0] * 2.0 + hex.units[1] * 3.0;
+        let run = hex
+            .runs(truth + DVec2::new(0.12, -0.15), 0.1)
+            .expect("two runs");
+        assert!(run.distance(truth) < 1e-9, "{run}");
     }
 }
