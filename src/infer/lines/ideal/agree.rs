@@ -9,11 +9,15 @@
 //! subtrees, so the wrong tip makes its parent's subtree (and its
 //! ancestors') one of a kind. A small subtree at the drawing's ends (a tip,
 //! a fork, a stalk of a few steps; or the first step from an end) is turned
-//! by one δ, its steps placed again nearest the drawing, when that makes the
-//! tree's distinct subtrees (its size as a DAG) fewer by more than the move
-//! costs in the drawing's offsets from the walk and in its turns (all in
-//! bits: a subtree said once, an offset as a normal spread of the walk's
-//! own offsets, a turn as often as the tree turns it).
+//! by one δ, its steps placed again nearest the drawing, when that makes
+//! the tree's distinct subtrees (its size as a DAG) fewer by more than the
+//! move costs in the drawing's offsets from the walk and in its turns (all
+//! in bits: a subtree said once, an offset as a normal spread of the walk's
+//! own offsets, a turn as often as the tree turns it). The step into a
+//! large subtree whose tree holds few steps besides (a short stalk at the
+//! drawing's start) is weighed the other way round: the subtree stays and
+//! the few steps move with the step's start. A step that one drawn segment
+//! holds with its neighbour is not turned alone.
 //!
 //! Owns: the tips' second reading. Must not search grammars.
 
@@ -74,14 +78,35 @@ pub(super) fn agreed(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice, w: Walked
     Walked { at, ..w }
 }
 
-/// The small subtrees at the drawing's ends, each read again as a whole,
-/// and a first step that starts at an end.
+/// The small subtrees at the drawing's ends, each read again as a whole;
+/// a first step that starts at an end; and the step into a large subtree
+/// whose tree holds little else (a short stalk from the drawing's start,
+/// read one δ off, moves the rest of the drawing with it: the stalk moves
+/// instead). Not a step that one drawn segment holds with the step before
+/// it or after it (the steps of a segment go its one way).
 fn ends(g: &Graph, f: &Forest) -> Vec<u32> {
+    let piece = |a: u32, b: u32| g.edge(a, b).map(|e| g.piece[e as usize]);
+    let one = |a: u32, b: u32, c: u32| piece(a, b).is_some_and(|x| piece(b, c) == Some(x));
+    let sizes = f.sizes();
     (0..g.points.len() as u32)
         .filter(|&v| {
             let p = f.parent[v as usize];
-            (p != NONE && f.size(v, SMALL + 1) <= SMALL)
-                || (p == NONE && f.children[v as usize].len() == 1)
+            if p == NONE {
+                let [c] = f.children[v as usize][..] else {
+                    return false;
+                };
+                return !f.children[c as usize].iter().any(|&d| one(v, c, d));
+            }
+            let pp = f.parent[p as usize];
+            if pp != NONE && one(pp, p, v) {
+                return false;
+            }
+            let size = sizes[v as usize];
+            if size <= SMALL {
+                return true;
+            }
+            let rest = sizes[f.root(v) as usize] - size;
+            rest <= SMALL && !f.children[v as usize].iter().any(|&c| one(p, v, c))
         })
         .collect()
 }
@@ -331,6 +356,34 @@ impl Forest {
     }
 
     /// How many vertices `v`'s subtree has, counted up to `most`.
+    /// Each vertex's subtree's size.
+    fn sizes(&self) -> Vec<usize> {
+        let mut order: Vec<u32> = (0..self.parent.len() as u32)
+            .filter(|&v| self.parent[v as usize] == NONE)
+            .collect();
+        let mut i = 0;
+        while i < order.len() {
+            order.extend(self.children[order[i] as usize].iter().copied());
+            i += 1;
+        }
+        let mut size = vec![1usize; self.parent.len()];
+        for &v in order.iter().rev() {
+            let p = self.parent[v as usize];
+            if p != NONE {
+                size[p as usize] += size[v as usize];
+            }
+        }
+        size
+    }
+
+    /// The root of `v`'s tree.
+    fn root(&self, mut v: u32) -> u32 {
+        while self.parent[v as usize] != NONE {
+            v = self.parent[v as usize];
+        }
+        v
+    }
+
     fn size(&self, v: u32, most: usize) -> usize {
         let mut stack = vec![v];
         let mut n = 0;
@@ -365,6 +418,9 @@ impl Forest {
                 points: vec![(v, at[c as usize]? - lattice.units[k as usize])],
             });
         }
+        if self.size(v, SMALL + 1) > SMALL {
+            return self.turned_rest(v, dk, at, lattice);
+        }
         let base = at[p as usize]?;
         let mut mv = Move {
             ways: Vec::new(),
@@ -384,6 +440,33 @@ impl Forest {
             mv.points.push((u, from + lattice.units[way as usize]));
         }
         Some(mv)
+    }
+
+    /// The step into `v` turned by `dk` δ with `v`'s subtree where it is:
+    /// the rest of its tree moves with the step's start, as it is.
+    fn turned_rest(
+        &self,
+        v: u32,
+        dk: i64,
+        at: &[Option<DVec2>],
+        lattice: &Lattice,
+    ) -> Option<Move> {
+        let p = self.parent[v as usize];
+        let k = (self.way[v as usize] + dk).rem_euclid(self.m);
+        let by = at[v as usize]? - lattice.units[k as usize] - at[p as usize]?;
+        let mut points = Vec::new();
+        let mut stack = vec![self.root(v)];
+        while let Some(u) = stack.pop() {
+            points.push((u, at[u as usize]? + by));
+            if points.len() > SMALL {
+                return None;
+            }
+            stack.extend(self.children[u as usize].iter().filter(|&&c| c != v));
+        }
+        Some(Move {
+            ways: vec![(v, k)],
+            points,
+        })
     }
 
     /// Whether a vertex that does not move is at `p` (`at`: where each is
@@ -483,6 +566,79 @@ impl Forest {
             self.add(old, -1);
             self.add(new, 1);
             self.class[x as usize] = new;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Similarity, paths};
+    use super::*;
+
+    fn unit(deg: f64) -> DVec2 {
+        DVec2::new(deg.to_radians().cos(), deg.to_radians().sin())
+    }
+
+    /// A stalk of two steps (one segment) along +x, then at its top a tree
+    /// at 20° drawn step by step, a polyline per branch.
+    fn drawing() -> Vec<Vec<DVec2>> {
+        let mut lines = vec![vec![DVec2::ZERO, 2.0 * unit(0.0)]];
+        let (mut at, mut heading) = (2.0 * unit(0.0), 20.0);
+        let mut stack = Vec::new();
+        lines.push(vec![at]);
+        for c in "F[+F[+F]F[-F]F]F[-F[+F]F[-F]F]F[+F]F".chars() {
+            match c {
+                '+' => heading += 20.0,
+                '-' => heading -= 20.0,
+                '[' => {
+                    stack.push((at, heading));
+                    lines.push(vec![at]);
+                }
+                ']' => {
+                    (at, heading) = stack.pop().expect("balanced");
+                    lines.push(vec![at]);
+                }
+                _ => {
+                    at += unit(heading);
+                    lines.last_mut().expect("a line").push(at);
+                }
+            }
+        }
+        lines.retain(|l| l.len() > 1);
+        lines
+    }
+
+    #[test]
+    fn a_stalk_read_one_delta_off_moves_back_and_the_tree_above_it_stays() {
+        let g = crate::infer::lines::graph::build(&drawing(), 1).expect("a stroke graph");
+        let lattice = Lattice::new(18);
+        let vertex = |p: DVec2| {
+            (0..g.points.len())
+                .min_by(|&a, &b| g.points[a].distance(p).total_cmp(&g.points[b].distance(p)))
+                .expect("vertices")
+        };
+        let truth: Vec<Option<DVec2>> = g.points.iter().map(|&p| Some(p)).collect();
+        // The stalk as if the step from its top into the tree were read at
+        // 40°, not 20°: the tree where the drawing has it, the stalk off.
+        let (top, first) = (vertex(2.0 * unit(0.0)), vertex(2.0 * unit(0.0) + unit(20.0)));
+        let by = g.points[first] - unit(40.0) - g.points[top];
+        let mut at = truth.clone();
+        for p in [DVec2::ZERO, unit(0.0), 2.0 * unit(0.0)] {
+            at[vertex(p)] = Some(p + by);
+        }
+        let walked = Walked {
+            at,
+            frame: Similarity {
+                from: DVec2::ZERO,
+                turn: DVec2::new(1.0, 0.0),
+                to: DVec2::ZERO,
+            },
+            bits: 0.0,
+        };
+        let agreed = agreed(&g, &paths(&g), &lattice, walked);
+        for (v, (got, want)) in agreed.at.iter().zip(&truth).enumerate() {
+            let (got, want) = (got.expect("placed"), want.expect("placed"));
+            assert!(got.distance(want) < 1e-6, "vertex {v} at {got}, drawn at {want}");
         }
     }
 }

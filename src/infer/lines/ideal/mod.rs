@@ -25,10 +25,11 @@
 //! A path that starts where no path came before starts across a gap from
 //! where the last one ended: the turtle moved there by whole steps (`f`),
 //! so its start is the lattice point that one or two straight runs of
-//! moves reach nearest the gap as drawn (the likeliest by the same bits:
-//! its offset, each run's way and length), in the frame fitted again to
-//! the walk so far (a gap of a hundred steps is read as well as the frame's
-//! scale is known). A gap no such runs explain keeps its drawn start.
+//! moves from that end reach nearest the start as drawn (the likeliest by
+//! the same bits: its offset, each run's way and length), in the frame
+//! fitted again to the walk so far (a gap of a hundred steps is read as
+//! well as the frame's scale is known). A gap no such runs explain keeps
+//! its drawn start.
 //!
 //! The steps cut from one drawn segment go its one way: its points between
 //! the drawn ends were not drawn and carry their ends' noise, so reading
@@ -508,8 +509,8 @@ impl Pass<'_> {
     fn walk(&mut self, paths: &[Vec<u32>], prior: &[Option<DVec2>]) -> Option<Vec<Option<DVec2>>> {
         let mut at: Vec<Option<DVec2>> = vec![None; self.world.len()];
         let mut next: Vec<Step> = Vec::new();
-        // Where the last path ended: its vertex and its lattice point.
-        let mut last: Option<(u32, DVec2)> = None;
+        // Where the last path ended, on the lattice.
+        let mut last: Option<DVec2> = None;
         // Vertices placed, and placed when the frame was last fitted.
         let (mut placed, mut fitted) = (0usize, 0usize);
         for path in paths {
@@ -525,7 +526,7 @@ impl Pass<'_> {
                         }
                         fitted = placed;
                     }
-                    last.and_then(|l| self.gap_end(l, path[0]))
+                    last.and_then(|p| self.gap_end(p, path[0]))
                         .or(prior.get(first).copied().flatten())
                         .unwrap_or_else(|| self.seen(path[0]))
                 }
@@ -575,21 +576,21 @@ impl Pass<'_> {
             }
             let best = beam.iter().min_by(|a, b| a.cost.total_cmp(&b.cost))?;
             placed += place(&mut at, path, &arena, best.at);
-            let end = *path.last()?;
-            last = Some((end, at[end as usize]?));
+            last = at[*path.last()? as usize];
         }
         Some(at)
     }
 
     /// Where a path that starts at vertex `v`, placed nowhere yet, starts on
     /// the lattice: the turtle moved there from where the last path ended
-    /// (`(from, p)`: its vertex and lattice point), by one or two straight
-    /// runs of whole steps (`f`s, a turn between them), the likeliest of
-    /// those near the gap as drawn; `None` when none is near it (a gap no
-    /// short run of moves explains).
-    fn gap_end(&self, (from, p): (u32, DVec2), v: u32) -> Option<DVec2> {
-        let gap = self.seen(v) - self.seen(from);
-        Some(p + self.lattice.runs(gap, self.sigma)?)
+    /// (its lattice point `p`), by one or two straight runs of whole steps
+    /// (`f`s, a turn between them), the likeliest of those near the
+    /// vertex as drawn; `None` when none is near it (a gap no short run of
+    /// moves explains). The gap is read from `p`, not from where the last
+    /// path ended as drawn: the frame is fitted to the walk, and the noise
+    /// of that end would add to the start's.
+    fn gap_end(&self, p: DVec2, v: u32) -> Option<DVec2> {
+        Some(p + self.lattice.runs(self.seen(v) - p, self.sigma)?)
     }
 
     /// The steps walk `h` may take to vertex `i` of `path`, into `next`
