@@ -620,7 +620,10 @@ mod tests {
         let truth: Vec<Option<DVec2>> = g.points.iter().map(|&p| Some(p)).collect();
         // The stalk as if the step from its top into the tree were read at
         // 40°, not 20°: the tree where the drawing has it, the stalk off.
-        let (top, first) = (vertex(2.0 * unit(0.0)), vertex(2.0 * unit(0.0) + unit(20.0)));
+        let (top, first) = (
+            vertex(2.0 * unit(0.0)),
+            vertex(2.0 * unit(0.0) + unit(20.0)),
+        );
         let by = g.points[first] - unit(40.0) - g.points[top];
         let mut at = truth.clone();
         for p in [DVec2::ZERO, unit(0.0), 2.0 * unit(0.0)] {
@@ -638,7 +641,10 @@ mod tests {
         let agreed = agreed(&g, &paths(&g), &lattice, walked);
         for (v, (got, want)) in agreed.at.iter().zip(&truth).enumerate() {
             let (got, want) = (got.expect("placed"), want.expect("placed"));
-            assert!(got.distance(want) < 1e-6, "vertex {v} at {got}, drawn at {want}");
+            assert!(
+                got.distance(want) < 1e-6,
+                "vertex {v} at {got}, drawn at {want}"
+            );
         }
     }
 }
