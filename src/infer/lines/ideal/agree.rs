@@ -87,7 +87,7 @@ pub(super) fn agreed(g: &Graph, paths: &[Vec<u32>], lattice: &Lattice, w: Walked
 fn ends(g: &Graph, f: &Forest) -> Vec<u32> {
     let piece = |a: u32, b: u32| g.edge(a, b).map(|e| g.piece[e as usize]);
     let one = |a: u32, b: u32, c: u32| piece(a, b).is_some_and(|x| piece(b, c) == Some(x));
-    let sizes = f.sizes();
+    let (sizes, trees) = f.sizes();
     (0..g.points.len() as u32)
         .filter(|&v| {
             let p = f.parent[v as usize];
@@ -105,7 +105,7 @@ fn ends(g: &Graph, f: &Forest) -> Vec<u32> {
             if size <= SMALL {
                 return true;
             }
-            let rest = sizes[f.root(v) as usize] - size;
+            let rest = trees[v as usize] - size;
             rest <= SMALL && !f.children[v as usize].iter().any(|&c| one(p, v, c))
         })
         .collect()
@@ -356,8 +356,8 @@ impl Forest {
     }
 
     /// How many vertices `v`'s subtree has, counted up to `most`.
-    /// Each vertex's subtree's size.
-    fn sizes(&self) -> Vec<usize> {
+    /// Each vertex's subtree's size, and the size of its whole tree.
+    fn sizes(&self) -> (Vec<usize>, Vec<usize>) {
         let mut order: Vec<u32> = (0..self.parent.len() as u32)
             .filter(|&v| self.parent[v as usize] == NONE)
             .collect();
@@ -373,7 +373,14 @@ impl Forest {
                 size[p as usize] += size[v as usize];
             }
         }
-        size
+        let mut tree = size.clone();
+        for &v in &order {
+            let p = self.parent[v as usize];
+            if p != NONE {
+                tree[v as usize] = tree[p as usize];
+            }
+        }
+        (size, tree)
     }
 
     /// The root of `v`'s tree.
