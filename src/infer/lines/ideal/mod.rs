@@ -487,7 +487,8 @@ struct Pass<'a> {
     window: usize,
     /// How far (steps) a walk may stray and be kept.
     bound: f64,
-    /// Whether the frame is fitted again as the walk goes.
+    /// Whether the frame is fitted again as a path goes (every pass fits
+    /// it again at the start of a path after a gap, see `walk`).
     refit: bool,
     /// Walks kept per step.
     beam: usize,
@@ -502,10 +503,11 @@ impl Pass<'_> {
     }
 
     /// Each path walked on the lattice from where it starts (a vertex
-    /// placed before, where `prior` placed it, or the drawing's own
-    /// point), each step among the three multiples of δ nearest the step
-    /// as drawn (and the way back to the drawing), the walks that stay
-    /// within `bound` kept, the nearest chosen.
+    /// placed before; after a gap, where runs of moves from the last
+    /// path's end reach (`gap_end`); else where `prior` placed it, or the
+    /// drawing's own point), each step among the three multiples of δ
+    /// nearest the step as drawn (and the way back to the drawing), the
+    /// walks that stay within `bound` kept, the nearest chosen.
     fn walk(&mut self, paths: &[Vec<u32>], prior: &[Option<DVec2>]) -> Option<Vec<Option<DVec2>>> {
         let mut at: Vec<Option<DVec2>> = vec![None; self.world.len()];
         let mut next: Vec<Step> = Vec::new();
