@@ -43,8 +43,8 @@ const FLOORS: &[(Class, [usize; 6])] = &[
     // every column, as a three-letter search often ends at the budget.
     (Class::Edge3, [14, 14, 10, 14, 4, 11]),
     (Class::Node, [26, 26, 11, 27, 22, 19]),
-    // Bracketed (session 15): debug 30/30/13/30/23/16.
-    (Class::Bracketed, [30, 30, 12, 30, 23, 15]),
+    // Bracketed (session 16): debug 30/30/13/30/23/17.
+    (Class::Bracketed, [30, 30, 12, 30, 23, 16]),
     // Moves (session 13): debug 26/25/3/25 clean to split, alone; two
     // under, as the debug run of every class shares the cores. Session
     // 15 (a gap in a noisy drawing starts on the lattice): jittered 8,
