@@ -591,10 +591,11 @@ struct Frame {
 }
 
 /// The settings of `g` drawn at a `decimal` δ in the frame that fits the
-/// drawing as it is (`drawn`) best: the first step's frame and step, moved
-/// and scaled by the similarity that brings what it draws nearest the
-/// drawing (its turn either way round, the closer). `(p_c, k_c)`: where the first step
-/// starts and its heading in δ (`grammar::first_step`).
+/// drawing as it is (`drawn`) best, and how they redraw it: the first
+/// step's frame and step, moved and scaled by the similarity that brings
+/// what it draws nearest the drawing (its turn either way round, the
+/// closer). `(p_c, k_c)`: where the first step starts and its heading in δ
+/// (`grammar::first_step`).
 fn decimal_frame<'a>(
     g: &Grammar,
     r: &Reading,
@@ -603,7 +604,7 @@ fn decimal_frame<'a>(
     step: f64,
     (p_c, k_c): (DVec2, i32),
     settings: &dyn Fn((f64, Frame, f64)) -> emit::Settings<'a>,
-) -> Option<emit::Settings<'a>> {
+) -> Option<(emit::Settings<'a>, verify::Redraw)> {
     let heading = turtle::wrap_degrees(r.heading - f64::from(k_c) * decimal);
     let first = Frame {
         heading,
@@ -627,10 +628,9 @@ fn decimal_frame<'a>(
                 start: fit.apply(first.start),
             };
             let (draft, s) = text(f, step);
-            verify::redraw(&draft, drawn, r.step).map(|d| (s, d.chamfer))
+            verify::redraw(&draft, drawn, r.step).map(|d| (s, d))
         })
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(s, _)| s)
+        .min_by(|a, b| a.1.chamfer.total_cmp(&b.1.chamfer))
 }
 
 /// Where the turtle starts so that the first step, which starts at `p_c`
@@ -811,13 +811,11 @@ fn finish(
     if let Some(drawn) = drawn
         && r.angles.period.is_some()
         && let Some(decimal) = Some(nice(angle, 0.05)).filter(|d| *d != angle)
-        && let Some(person) = decimal_frame(g, r, drawn, decimal, best.step, (p_c, k_c), &settings)
+        && let Some((person, d)) =
+            decimal_frame(g, r, drawn, decimal, best.step, (p_c, k_c), &settings)
     {
-        let against = |s: &emit::Settings| {
-            let draft = crate::fmt::format_file(&emit::program(g, s));
-            verify::redraw(&draft, drawn, r.step)
-        };
-        if let (Some(d), Some(b)) = (against(&person), against(&best))
+        let draft = crate::fmt::format_file(&emit::program(g, &best));
+        if let Some(b) = verify::redraw(&draft, drawn, r.step)
             && d.drawn == b.drawn
             && d.chamfer <= 1.1 * b.chamfer
         {
