@@ -616,10 +616,10 @@ fn decimal_frame<'a>(
     };
     let (draft, _) = text(first, step);
     let fit = verify::similarity_fit(&verify::drawn(&draft, 0)?, drawn)?;
-    let turned = fit.angle.to_degrees();
+    let turned = fit.angle().to_degrees();
     // The step as precise as a drawing of a few hundred steps across needs
     // (five digits), not the fit's sixteen.
-    let step = nice(step * fit.scale, 2e-5 * step);
+    let step = nice(step * fit.scale(), 2e-5 * step);
     [turned, -turned]
         .into_iter()
         .filter_map(|t| {

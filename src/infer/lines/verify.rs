@@ -5,6 +5,7 @@
 //! Owns: the comparison (segments matched, the symmetric Chamfer distance of
 //! points sampled along both drawings). Must not change the program.
 
+use super::ideal::Similarity;
 use super::turtle::PER_CELL;
 use crate::geometry::index::PointGrid;
 use crate::turtle::Sink;
@@ -153,26 +154,14 @@ pub fn compare(input: &[(DVec2, DVec2)], drawn: &[(DVec2, DVec2)], step: f64) ->
     }
 }
 
-/// A similarity of the plane: a turn by `angle` (radians, from +x towards
-/// +y) about the origin, a scale, then a shift.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Similarity {
-    pub angle: f64,
-    pub scale: f64,
-    pub shift: DVec2,
-}
-
-impl Similarity {
-    pub fn apply(&self, p: DVec2) -> DVec2 {
-        DVec2::from_angle(self.angle).rotate(p) * self.scale + self.shift
-    }
-}
-
 /// The similarity that brings the steps `drawn` nearest the steps
 /// `truth`: least squares over the steps' ends and midpoints, each paired
-/// with the nearest point of `truth`, in `ROUNDS` rounds (the pairs found
-/// again after each). `None` when either is empty.
-pub fn similarity_fit(drawn: &[(DVec2, DVec2)], truth: &[(DVec2, DVec2)]) -> Option<Similarity> {
+/// with the nearest point of `truth` to where the last fit puts it, in
+/// `ROUNDS` rounds. `None` when either is empty.
+pub(crate) fn similarity_fit(
+    drawn: &[(DVec2, DVec2)],
+    truth: &[(DVec2, DVec2)],
+) -> Option<Similarity> {
     const ROUNDS: usize = 12;
     const MOST_POINTS: usize = 30_000;
     if drawn.is_empty() || truth.is_empty() {
@@ -185,43 +174,18 @@ pub fn similarity_fit(drawn: &[(DVec2, DVec2)], truth: &[(DVec2, DVec2)]) -> Opt
         .step_by(every)
         .collect();
     let grid = crate::geometry::index::SegmentGrid::new(truth.to_vec());
-    let mut fit = Similarity {
-        angle: 0.0,
-        scale: 1.0,
-        shift: DVec2::ZERO,
-    };
+    let mut fit: Option<Similarity> = None;
     for _ in 0..ROUNDS {
         let pairs: Vec<(DVec2, DVec2)> = points
             .iter()
             .filter_map(|&p| {
-                let p = fit.apply(p);
-                grid.nearest(p).map(|(_, q, _)| (p, q))
+                let at = fit.map_or(p, |f| f.apply(p));
+                grid.nearest(at).map(|(_, q, _)| (p, q))
             })
             .collect();
-        let n = pairs.len().max(1) as f64;
-        let cp = pairs.iter().fold(DVec2::ZERO, |s, (p, _)| s + *p) / n;
-        let cq = pairs.iter().fold(DVec2::ZERO, |s, (_, q)| s + *q) / n;
-        let (mut dot, mut cross, mut norm) = (0.0, 0.0, 0.0);
-        for (p, q) in &pairs {
-            let (u, v) = (*p - cp, *q - cq);
-            dot += u.dot(v);
-            cross += u.perp_dot(v);
-            norm += u.length_squared();
-        }
-        let turn = cross.atan2(dot);
-        let r = DVec2::from_angle(turn);
-        let scale = if norm > 0.0 {
-            (dot * turn.cos() + cross * turn.sin()) / norm
-        } else {
-            1.0
-        };
-        fit = Similarity {
-            angle: fit.angle + turn,
-            scale: fit.scale * scale,
-            shift: r.rotate(fit.shift - cp) * scale + cq,
-        };
+        fit = Some(Similarity::fit(&pairs)?);
     }
-    Some(fit)
+    fit
 }
 
 /// Points a quarter of a step apart along each step (at most about 2
@@ -301,20 +265,17 @@ mod tests {
             steps.push((p, q));
             p = q;
         }
-        let truth = Similarity {
-            angle: 0.3f64.to_radians(),
-            scale: 1.002,
-            shift: DVec2::new(0.3, -0.2),
-        };
+        let (angle, scale, shift) = (0.3f64.to_radians(), 1.002, DVec2::new(0.3, -0.2));
+        let moved_point = |p: DVec2| DVec2::from_angle(angle).rotate(p) * scale + shift;
         let moved: Vec<_> = steps
             .iter()
-            .map(|&(a, b)| (truth.apply(a), truth.apply(b)))
+            .map(|&(a, b)| (moved_point(a), moved_point(b)))
             .collect();
         let fit = similarity_fit(&steps, &moved).expect("a fit");
-        assert!((fit.angle - truth.angle).abs() < 1e-4, "{fit:?}");
-        assert!((fit.scale - truth.scale).abs() < 1e-3, "{fit:?}");
+        assert!((fit.angle() - angle).abs() < 1e-4, "{fit:?}");
+        assert!((fit.scale() - scale).abs() < 1e-3, "{fit:?}");
         for &(a, _) in &steps {
-            assert!(fit.apply(a).distance(truth.apply(a)) < 0.05, "{fit:?}");
+            assert!(fit.apply(a).distance(moved_point(a)) < 0.05, "{fit:?}");
         }
     }
 }

@@ -770,22 +770,22 @@ fn mix(key: u64, x: u64) -> u64 {
 
 /// The similarity z ↦ to + turn·(z − from), `turn` a complex number (a
 /// turn and a scale).
-#[derive(Clone, Copy)]
-struct Similarity {
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Similarity {
     from: DVec2,
     turn: DVec2,
     to: DVec2,
 }
 
 impl Similarity {
-    fn apply(&self, p: DVec2) -> DVec2 {
+    pub(crate) fn apply(&self, p: DVec2) -> DVec2 {
         let (z, s) = (p - self.from, self.turn);
         DVec2::new(s.x * z.x - s.y * z.y, s.x * z.y + s.y * z.x) + self.to
     }
 
     /// The similarity that puts the first of each pair nearest the second,
     /// least squares.
-    fn fit(pairs: &[(DVec2, DVec2)]) -> Option<Similarity> {
+    pub(crate) fn fit(pairs: &[(DVec2, DVec2)]) -> Option<Similarity> {
         let n = pairs.len() as f64;
         if n < 2.0 {
             return None;
@@ -807,6 +807,16 @@ impl Similarity {
             turn: num / den,
             to: cw,
         })
+    }
+
+    /// The turn, radians (from +x towards +y).
+    pub(crate) fn angle(&self) -> f64 {
+        self.turn.y.atan2(self.turn.x)
+    }
+
+    /// The scale.
+    pub(crate) fn scale(&self) -> f64 {
+        self.turn.length()
     }
 }
 
