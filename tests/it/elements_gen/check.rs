@@ -111,7 +111,7 @@ pub fn check(case: &Case, variant: Variant) -> Outcome {
     } else {
         0.0
     };
-    let judged = judge(case, &program, slack);
+    let judged = judge(case, &program, slack, variant == Variant::Shuffled);
     o.redraws = judged.0;
     o.fail = judged.1;
     o.exact = o.fail.is_none();
@@ -119,8 +119,10 @@ pub fn check(case: &Case, variant: Variant) -> Outcome {
     o
 }
 
-/// (Redraws, why it is not exact.)
-fn judge(case: &Case, program: &str, slack: f64) -> (bool, Option<Fail>) {
+/// (Redraws, why it is not exact.) `rigid`: the drawing does not say where
+/// the design starts (its copies are in random order), so a next moved
+/// rigidly predicts as well (a row extended at its other end).
+fn judge(case: &Case, program: &str, slack: f64, rigid: bool) -> (bool, Option<Fail>) {
     let fail = |kind, detail| Some(Fail { kind, detail });
     let level = case.truth(&case.design.level);
     let drawn = match run(program, &[]) {
@@ -143,7 +145,7 @@ fn judge(case: &Case, program: &str, slack: f64) -> (bool, Option<Fail>) {
         .collect();
     let next = case.truth(&case.design.next);
     match run(program, &defines) {
-        Ok(d) => match same(next.as_bytes(), &d, slack) {
+        Ok(d) => match congruent(next.as_bytes(), &d, slack, rigid) {
             Ok(()) => (true, None),
             Err(e) => (true, fail("predict", format!("{}: {e}", defines.join(" ")))),
         },
@@ -204,6 +206,23 @@ struct Copy {
     outline: Vec<Vec<DVec2>>,
 }
 
+impl Copy {
+    /// Turned by `turn` radians about `from`, then moved from `from` to `to`.
+    fn moved(&self, from: DVec2, turn: f64, to: DVec2) -> Copy {
+        let r = DVec2::from_angle(turn);
+        let put = |p: DVec2| to + r.rotate(p - from);
+        Copy {
+            centre: put(self.centre),
+            size: self.size,
+            outline: self
+                .outline
+                .iter()
+                .map(|l| l.iter().map(|&p| put(p)).collect())
+                .collect(),
+        }
+    }
+}
+
 fn copies(svg: &[u8]) -> Result<Vec<Copy>, String> {
     let d = lsyc::infer::elements::read::read(svg).map_err(|e| format!("{e:?}"))?;
     Ok(d.elements
@@ -216,15 +235,55 @@ fn copies(svg: &[u8]) -> Result<Vec<Copy>, String> {
         .collect())
 }
 
-/// Whether `drawn` holds the copies of `truth`, each within 2 % of its size
-/// (plus `slack`) of a drawn copy, and no more.
+/// Whether `drawn` holds the copies of `truth` (see `same_copies`).
 fn same(truth: &[u8], drawn: &[u8], slack: f64) -> Result<(), String> {
+    same_copies(&copies(truth)?, &copies(drawn)?, slack)
+}
+
+/// Whether `drawn` holds the copies of `truth`, or (if `rigid`) of `truth`
+/// turned and moved: a turn about the copies' mean centre that takes the
+/// copy farthest from it to a drawn copy as far from theirs.
+fn congruent(truth: &[u8], drawn: &[u8], slack: f64, rigid: bool) -> Result<(), String> {
     let (t, d) = (copies(truth)?, copies(drawn)?);
+    let first = same_copies(&t, &d, slack);
+    if first.is_ok() || !rigid || t.len() != d.len() || t.is_empty() {
+        return first;
+    }
+    let mean = |cs: &[Copy]| cs.iter().map(|c| c.centre).sum::<DVec2>() / cs.len() as f64;
+    let (ct, cd) = (mean(&t), mean(&d));
+    let far = |c: &&Copy| c.centre.distance(ct);
+    let Some(a) = t.iter().max_by(|x, y| far(x).total_cmp(&far(y))) else {
+        return first;
+    };
+    let reach = a.centre.distance(ct);
+    let tol = 0.05 * a.size + 1e-3 * reach + slack;
+    for c in d
+        .iter()
+        .filter(|c| (c.centre.distance(cd) - reach).abs() <= tol)
+    {
+        let turn = (c.centre - cd).to_angle() - (a.centre - ct).to_angle();
+        let moved: Vec<Copy> = t.iter().map(|x| x.moved(ct, turn, cd)).collect();
+        if same_copies(&moved, &d, slack).is_ok() {
+            return Ok(());
+        }
+    }
+    first
+}
+
+/// Whether `d` holds the copies of `t`, each within 2 % of its size or
+/// 0.1 % of the drawing's diagonal, whichever is more (plus `slack`), of a
+/// drawn copy, and no more.
+fn same_copies(t: &[Copy], d: &[Copy], slack: f64) -> Result<(), String> {
     if t.len() != d.len() {
         return Err(format!("{} copies drawn for {}", d.len(), t.len()));
     }
+    let (lo, hi) = t.iter().flat_map(|c| c.outline.iter().flatten()).fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let diagonal = (hi - lo).length();
     for (i, c) in t.iter().enumerate() {
-        let tol = 0.02 * c.size + slack;
+        let tol = (0.02 * c.size).max(1e-3 * diagonal) + slack;
         let near = d
             .iter()
             .min_by(|a, b| {

@@ -25,7 +25,8 @@ pub enum Class {
     /// Rows of copies, stacked: two nested repetitions.
     Grid,
     /// A row whose step, or a sequence whose turn, changes by the same
-    /// amount at every copy (S0's Fig. 5).
+    /// amount at every copy, written t0 + tΔ·m as the counter m falls
+    /// (S0's Fig. 5).
     Linear,
     /// A binary branching of stems, each branch turned and scaled, with a
     /// leaf of another kind at every tip.
@@ -241,13 +242,20 @@ impl Plan {
             }
             Class::Linear => {
                 p.count = rng.range(6, 14) as usize;
+                let sign = if rng.chance(0.5) { 1.0 } else { -1.0 };
                 if rng.chance(0.5) {
-                    p.step = f64::from(rng.range(2, 3) * 5);
-                    p.step2 = f64::from(rng.range(1, 3));
+                    // Steps that shrink (tΔ > 0: the first is longest) or
+                    // grow, all longer than 5 even with one more copy.
+                    p.step2 = sign * f64::from(rng.range(1, 3));
+                    p.step = if sign > 0.0 {
+                        f64::from(rng.range(2, 3) * 5)
+                    } else {
+                        5.0 * ((p.step2.abs() * (p.count + 1) as f64) / 5.0).ceil() + 5.0
+                    };
                 } else {
                     p.step = f64::from(rng.range(10, 16));
                     p.turn = rng.pick(&[0.0, 5.0, 10.0]);
-                    p.turn2 = rng.pick(&[2.0, 3.0, 5.0]);
+                    p.turn2 = sign * rng.pick(&[2.0, 3.0, 5.0]);
                 }
             }
             Class::Tree => {
@@ -279,15 +287,19 @@ impl Plan {
         }
     }
 
+    /// `n` copies, each stepped from the one before by t(m) = t0 + tΔ·m as
+    /// the counter m falls from n − 1 to 1 (the paper's linear form, which
+    /// a constant t is too): one more copy puts a new first step before
+    /// the others.
     fn sequence(&self, n: usize) -> Vec<Place> {
         let mut t = Turtle::new(self.origin, self.heading);
         let mut out = Vec::new();
         for k in 0..n {
             out.push(t.place(0));
-            let k = k as f64;
-            t.forward(self.step + self.step2 * k);
+            let m = (n - 1 - k) as f64;
+            t.forward(self.step + self.step2 * m);
             t.scale *= self.scale;
-            t.heading += self.turn + self.turn2 * k;
+            t.heading += self.turn + self.turn2 * m;
         }
         out
     }
