@@ -678,9 +678,8 @@ pub fn instancing(
 }
 
 /// Chooses, for instances of symmetric kinds, the variant of frame whose
-/// rotation is closest to an already placed neighbour of the same kind
-/// (breadth first from the representative over nearest neighbours), so
-/// orientations vary smoothly. Round kinds the drawing does not place keep
+/// rotation is closest to its nearest already placed neighbour of the same
+/// kind (`nearest_first`), so orientations vary smoothly along a ring. Round kinds the drawing does not place keep
 /// the drawing's axes.
 fn orient_symmetric(
     kinds: &[Kind],
@@ -709,35 +708,56 @@ fn orient_symmetric(
             continue;
         }
         let points: Vec<DVec2> = members.iter().map(|&i| of[i].1.pos).collect();
-        let index = crate::geometry::index::PointGrid::new(&points);
-        let mut placed = vec![false; members.len()];
-        let mut queue = std::collections::VecDeque::new();
-        for start in 0..members.len() {
-            if placed[start] {
-                continue;
-            }
-            placed[start] = true;
-            queue.push_back(start);
-            while let Some(a) = queue.pop_front() {
-                let rot = of[members[a]].1.rot;
-                for b in index.nearest(points[a], NEIGHBOURS + 1) {
-                    if placed[b] {
-                        continue;
-                    }
-                    placed[b] = true;
-                    let i = members[b];
-                    if let Some(best) = choices[i]
-                        .iter()
-                        .copied()
-                        .min_by(|x, y| wrap(x.rot - rot).abs().total_cmp(&wrap(y.rot - rot).abs()))
-                    {
-                        of[i].1 = best;
-                    }
-                    queue.push_back(b);
-                }
+        for (from, b) in nearest_first(&points, NEIGHBOURS) {
+            let rot = of[members[from]].1.rot;
+            let i = members[b];
+            if let Some(best) = choices[i]
+                .iter()
+                .copied()
+                .min_by(|x, y| wrap(x.rot - rot).abs().total_cmp(&wrap(y.rot - rot).abs()))
+            {
+                of[i].1 = best;
             }
         }
     }
+}
+
+/// The points in the order a nearest-neighbour tree reaches them (Prim's
+/// order over each point's `k` nearest): each point after the first of its
+/// group as (the reached point it is nearest to, the point). Each point
+/// follows its nearest placed neighbour, not the group's first point, so
+/// orientations follow a ring or a row step by step.
+fn nearest_first(points: &[DVec2], k: usize) -> Vec<(usize, usize)> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    let index = crate::geometry::index::PointGrid::new(points);
+    let mut placed = vec![false; points.len()];
+    let mut order = Vec::new();
+    // (distance's bits, from, to): non-negative floats order as their bits.
+    let mut heap: BinaryHeap<Reverse<(u64, usize, usize)>> = BinaryHeap::new();
+    let reach = |a: usize, heap: &mut BinaryHeap<Reverse<(u64, usize, usize)>>| {
+        for b in index.nearest(points[a], k + 1) {
+            if b != a {
+                heap.push(Reverse((points[a].distance(points[b]).to_bits(), a, b)));
+            }
+        }
+    };
+    for start in 0..points.len() {
+        if placed[start] {
+            continue;
+        }
+        placed[start] = true;
+        reach(start, &mut heap);
+        while let Some(Reverse((_, a, b))) = heap.pop() {
+            if placed[b] {
+                continue;
+            }
+            placed[b] = true;
+            order.push((a, b));
+            reach(b, &mut heap);
+        }
+    }
+    order
 }
 
 #[cfg(test)]
