@@ -60,10 +60,6 @@ const NOT_YET_PLAIN: &[(&str, &str)] = &[
         "one sequence with its scale and turn, but the arrow's pen starts at (-1, 0), not at the writer's origin (0, 0): the step is 13.4, not 12",
     ),
     (
-        "tip-buds",
-        "the buds at the tips become pairs, not the m == 0 case of the branching (7 rules)",
-    ),
-    (
         "two-kinds",
         "a period of two kinds is coded as pairs (13 rules)",
     ),

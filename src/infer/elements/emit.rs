@@ -480,8 +480,9 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
                     place.as_ref(),
                 );
             }
-            Body::Branch { a, ts, tip } => {
-                w.branching(&mut consts, run(g, r), (*a, tip.unwrap_or(*a)), ts)
+            Body::Branch { a, ts, tip, tip_at } => {
+                let tip = (tip.unwrap_or(*a), tip_at.as_ref());
+                w.branching(&mut consts, run(g, r), *a, tip, ts)
             }
             // A sequence used only with m = 1 is the pair P -> A T A.
             Body::Seq { a, t, tip, .. } => w.pair(*a, t, tip.unwrap_or(*a)),
@@ -886,8 +887,16 @@ impl RuleWriter<'_> {
         self.add(m_is(BinOp::Eq), last, None);
     }
 
-    /// `R(m) : m > 0 -> [a] [T R(m - 1)] [U R(m - 1)]…; R(m) : m == 0 -> [tip]`.
-    fn branching(&mut self, consts: &mut Consts, n: f64, (a, tip): (Sym, Sym), ts: &[Tr]) {
+    /// `R(m) : m > 0 -> [a] [T R(m - 1)] [U R(m - 1)]…; R(m) : m == 0 -> [tip]`,
+    /// the tip moved from where a child would be by `tip_at`'s inverse.
+    fn branching(
+        &mut self,
+        consts: &mut Consts,
+        n: f64,
+        a: Sym,
+        (tip, tip_at): (Sym, Option<&Frame>),
+        ts: &[Tr],
+    ) {
         let parts: Vec<_> = ts
             .iter()
             .enumerate()
@@ -916,7 +925,13 @@ impl RuleWriter<'_> {
             }
         );
         self.add(m_is(BinOp::Gt), succ, Some(note));
-        let (last, _) = self.unit(tip, n, false);
+        let last = match tip_at {
+            Some(rel) => {
+                let place = Tr::between(&Frame::IDENTITY, &rel.inverse(), 1.0);
+                self.placed_at(tip, Some(&place))
+            }
+            None => self.unit(tip, n, false).0,
+        };
         self.add(m_is(BinOp::Eq), last, None);
     }
 

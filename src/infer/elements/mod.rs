@@ -20,7 +20,8 @@ pub mod space;
 
 use super::{InferError, MAX_SVG_BYTES};
 use crate::ast::File;
-use rules::{Inst, Sym, Tolerance, Weights};
+use rules::{Body, Grammar, Inst, Sym, Tolerance, Weights};
+use shape::{Frame, Instancing};
 use std::time::Instant;
 
 /// The most elements a drawing may have.
@@ -211,7 +212,8 @@ pub fn from_svg(
                 .symmetric(inst.kinds[*k].symmetry, sh.centroid)
         })
         .collect();
-    let grammar = rules::infer(insts, opts.weights, tol, progress).map_err(too_much)?;
+    let mut grammar = rules::infer(insts, opts.weights, tol, progress).map_err(too_much)?;
+    frame_tips(&mut inst, &mut grammar);
     stats.rules = grammar.rules.len();
     stats.rounds = grammar.rounds;
     stats.clusters = grammar.clusters;
@@ -236,6 +238,44 @@ pub fn from_svg(
         skipped: drawing.skipped,
         stats,
     })
+}
+
+/// A kind the drawing does not frame, drawn only at the tips of
+/// branchings and there always at one place relative to where a child
+/// would be, is framed at that place: the rules then end in `m == 0 -> B`,
+/// its path written as it sits at a tip.
+fn frame_tips(inst: &mut Instancing, g: &mut Grammar) {
+    for k in 0..inst.kinds.len() {
+        let me = Sym::Element(k);
+        let mut at: Option<Frame> = None;
+        let mut only_tips = !inst.kinds[k].given && g.axiom.is_none_or(|(_, s)| s != me);
+        for rule in &g.rules {
+            let (uses, tip) = match &rule.body {
+                Body::Seq { a, tip, .. } => (*a == me || *tip == Some(me), None),
+                Body::Pair { a, b, .. } => (*a == me || *b == me, None),
+                Body::Branch { a, tip, tip_at, .. } => match (tip, tip_at) {
+                    (Some(t), Some(rel)) if *t == me && *a != me => (false, Some(*rel)),
+                    _ => (*a == me || *tip == Some(me), None),
+                },
+            };
+            only_tips &= !uses;
+            if let Some(rel) = tip {
+                only_tips &= at.is_none_or(|f| f == rel);
+                at = Some(rel);
+            }
+        }
+        let Some(rel) = at.filter(|_| only_tips) else {
+            continue;
+        };
+        inst.reframe(k, &rel);
+        for rule in &mut g.rules {
+            if let Body::Branch { tip, tip_at, .. } = &mut rule.body
+                && *tip == Some(me)
+            {
+                *tip_at = None;
+            }
+        }
+    }
 }
 
 /// Replaces the path of element `name` in `file` by the drawing in `svg` (all

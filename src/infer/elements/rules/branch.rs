@@ -276,11 +276,16 @@ pub(super) fn branching(
     for &(i, v, c) in &links {
         child[i].insert(v, c);
     }
-    if let Some(tips) = tree_tips(insts, edges, outs, &leaves, &ts, &claimed, tol) {
+    let mut tip_at = None;
+    if let Some((tips, at)) = tree_tips(insts, edges, outs, &leaves, &ts, &claimed, tol) {
         for (&(leaf, _), below) in leaves.iter().zip(tips) {
-            for (map, &c) in child.iter_mut().zip(&below) {
+            for (map, &(c, _)) in child.iter_mut().zip(&below) {
                 map.insert(leaf, c);
                 gap += index.get(&(leaf, c)).map_or(1.0, |&k| edges[k].gap);
+            }
+            if let Some(at) = at {
+                let frames = tip_at.get_or_insert_with(|| (at, Vec::new()));
+                frames.1.extend(below.iter().copied());
             }
         }
         pairs += ts.len() * leaves.len();
@@ -294,15 +299,28 @@ pub(super) fn branching(
         phi: 1.0,
         length,
         pairs,
-        plan: Plan::Branch { trees, child, ts },
+        plan: Plan::Branch {
+            trees,
+            child,
+            ts,
+            tip_at,
+        },
     })
 }
+
+/// Each leaf's tips, each with the frame it is drawn at, and the tips'
+/// frame relative to where the transforms put a child (`None`: the same).
+type Tips = (Vec<Vec<(usize, Frame)>>, Option<Frame>);
 
 /// The tips of complete trees: where the transforms `tr` put the children
 /// of every leaf (`leaves`, with their frames as the trees draw them), two
 /// instances of one other kind that no tree claims (buds at the tips: the
-/// `m == 0` rule draws them); `None` unless every leaf has both. Each leaf's
-/// edges are read in their order, so the first of equally near ones wins.
+/// `m == 0` rule draws them); `None` unless every leaf has both. A tip's
+/// own frame may sit anywhere on it (a kind whose frame the drawing does
+/// not give is framed at its centre): the tips count when every one sits
+/// the same way relative to where a child would be, read from the first
+/// leaf's first tip. Each leaf's edges are read in their order, so the
+/// first of equally near ones wins.
 fn tree_tips(
     insts: &[Inst],
     edges: &[Edge],
@@ -311,44 +329,104 @@ fn tree_tips(
     tr: &[Tr],
     claimed: &[bool],
     tol: Tolerance,
-) -> Option<Vec<Vec<usize>>> {
-    let a = insts[leaves.first()?.0].sym;
-    let mut tips: Vec<Vec<usize>> = Vec::with_capacity(leaves.len());
+) -> Option<Tips> {
+    let &(first, f) = leaves.first()?;
+    let a = insts[first].sym;
+    let bud = |k: usize| {
+        let b = &insts[edges[k].to];
+        b.alive && b.sym != a && !claimed[edges[k].to]
+    };
+    // Where the tips sit relative to a child: as a child, or as the first
+    // leaf's candidates for its first tip sit.
+    let want = tr.first()?.apply(&f);
+    let mut relative = vec![Frame::IDENTITY];
+    for k in outs.of_instance(first).filter(|&k| bud(k)) {
+        for v in insts[edges[k].to].variants(want.rot) {
+            relative.push(v.inverse().then(&want));
+        }
+    }
+    relative.into_iter().find_map(|rel| {
+        let tips = tips_at(insts, edges, outs, leaves, tr, &bud, &rel, tol)?;
+        let sym = insts[tips[0][0].0].sym;
+        let mut seen = HashSet::new();
+        if !tips
+            .iter()
+            .flatten()
+            .all(|&(i, ..)| insts[i].sym == sym && seen.insert(i))
+        {
+            return None;
+        }
+        // Where they sit, averaged over all tips (not one tip's noise).
+        let rel = (rel != Frame::IDENTITY)
+            .then(|| {
+                let each: Vec<Frame> = tips
+                    .iter()
+                    .flatten()
+                    .map(|(_, have, want)| have.inverse().then(want))
+                    .collect();
+                Frame::mean(&each)
+            })
+            .flatten();
+        let at = rel.unwrap_or(Frame::IDENTITY);
+        let tips = tips
+            .into_iter()
+            .map(|l| {
+                l.into_iter()
+                    .map(|(i, have, _)| (i, have.then(&at)))
+                    .collect()
+            })
+            .collect();
+        Some((tips, rel))
+    })
+}
+
+/// Every leaf's tips when each sits at `rel` from where its child would be
+/// (`None` if a leaf lacks one), each with its frame (the variant that fits)
+/// and where its child would be from the leaf as drawn.
+#[allow(clippy::too_many_arguments)]
+fn tips_at(
+    insts: &[Inst],
+    edges: &[Edge],
+    outs: &Outs,
+    leaves: &[(usize, Frame)],
+    tr: &[Tr],
+    bud: &dyn Fn(usize) -> bool,
+    rel: &Frame,
+    tol: Tolerance,
+) -> Option<Vec<Vec<(usize, Frame, Frame)>>> {
+    let back = rel.inverse();
+    let mut tips = Vec::with_capacity(leaves.len());
     for &(leaf, f) in leaves {
-        let mut best: Vec<Option<(f64, usize)>> = vec![None; tr.len()];
-        for k in outs.of_instance(leaf) {
-            let e = &edges[k];
-            let b = &insts[e.to];
-            if !b.alive || b.sym == a || claimed[e.to] {
-                continue;
-            }
+        let mut best: Vec<Option<(f64, usize, Frame, Frame)>> = vec![None; tr.len()];
+        for k in outs.of_instance(leaf).filter(|&k| bud(k)) {
+            let b = &insts[edges[k].to];
             for side in 0..tr.len() {
                 let want = tr[side].apply(&f);
                 let step = tr[side].d * f.scale;
+                // The tip's frame where it would sit.
+                let at = want.then(&back);
                 let Some(have) = b
-                    .variants(want.rot)
+                    .variants(at.rot)
                     .into_iter()
-                    .find(|v| close(&want, v, step, b.size(), tol))
+                    .find(|v| close(&want, &v.then(rel), step, b.size(), tol))
                 else {
                     continue;
                 };
-                let off = want.pos.distance(have.pos);
-                if best[side].is_none_or(|(o, _)| off < o) {
-                    best[side] = Some((off, e.to));
+                let off = want.pos.distance(have.then(rel).pos);
+                if best[side].is_none_or(|(o, ..)| off < o) {
+                    // Where the child would be from the leaf as drawn (the
+                    // tree's frames drift with depth).
+                    let near = tr[side].apply(&insts[leaf].frame);
+                    best[side] = Some((off, edges[k].to, have, near));
                 }
             }
         }
         // A leaf without both tips: no tree has tips.
         tips.push(
             best.into_iter()
-                .map(|x| Some(x?.1))
-                .collect::<Option<_>>()?,
+                .map(|x| x.map(|(_, i, have, want)| (i, have, want)))
+                .collect::<Option<Vec<_>>>()?,
         );
     }
-    let sym = insts[tips[0][0]].sym;
-    let mut seen = HashSet::new();
-    tips.iter()
-        .flatten()
-        .all(|&i| insts[i].sym == sym && seen.insert(i))
-        .then_some(tips)
+    Some(tips)
 }

@@ -62,6 +62,9 @@ pub enum Body {
         a: Sym,
         ts: Vec<Tr>,
         tip: Option<Sym>,
+        /// The tip's frame relative to where a child would be, when not
+        /// there (`m == 0 -> [T tip]`).
+        tip_at: Option<Frame>,
     },
     /// `Q -> [a] T [b]`.
     Pair { a: Sym, t: Tr, b: Sym },
@@ -251,6 +254,9 @@ enum Plan {
         /// Per transform, each node's child by it.
         child: Vec<HashMap<usize, usize>>,
         ts: Vec<Tr>,
+        /// Where tips sit relative to where a child would be (when not
+        /// there), and each tip's frame as a child's.
+        tip_at: Option<(Frame, Vec<(usize, Frame)>)>,
     },
     Pair {
         pairs: Vec<(usize, usize)>,
@@ -1082,8 +1088,20 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
                 counts,
             });
         }
-        Plan::Branch { trees, child, ts } => {
+        Plan::Branch {
+            trees,
+            child,
+            ts,
+            tip_at,
+        } => {
             let a = insts[trees[0].0].sym;
+            // Tips drawn as children: their frames where a child's would be.
+            let tip_at = tip_at.map(|(rel, frames)| {
+                for (i, f) in frames {
+                    insts[i].frame = f;
+                }
+                rel
+            });
             let tip = tree_members(&child, trees[0].0, trees[0].1)
                 .last()
                 .map(|&i| insts[i].sym)
@@ -1119,7 +1137,12 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
             }
             let ts = reg.map_or(ts, |reg| reg.t);
             g.rules.push(Rule {
-                body: Body::Branch { a, ts, tip },
+                body: Body::Branch {
+                    a,
+                    ts,
+                    tip,
+                    tip_at: tip_at.filter(|_| tip.is_some()),
+                },
                 counts,
             });
         }
@@ -1212,7 +1235,7 @@ impl Grammar {
                 Body::Seq {
                     a, tip: Some(b), ..
                 } => u64::from(m) * self.covered(*a) + self.covered(*b),
-                Body::Branch { a, ts, tip } => {
+                Body::Branch { a, ts, tip, .. } => {
                     // k^m leaves below k^m − 1 … 1 nodes: (k^m − 1)/(k − 1).
                     let k = ts.len().max(2) as u64;
                     let leaves = k.saturating_pow(m);
