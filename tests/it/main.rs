@@ -7,6 +7,8 @@ mod corpus;
 mod diagnostics;
 mod docs;
 mod edit;
+mod elements_gen;
+mod elements_random;
 mod evaluator;
 mod fuzz_smoke;
 mod geometry;

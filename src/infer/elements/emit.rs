@@ -60,9 +60,10 @@ impl Names {
             .rules
             .iter()
             .zip(inline)
-            .map(|(rule, &inlined)| match rule.body {
+            .enumerate()
+            .map(|(i, (rule, &inlined))| match rule.body {
                 _ if inlined => String::new(),
-                Body::Seq { .. } if rule.counts.iter().all(|&m| m == 1) => {
+                Body::Seq { .. } if !counted(g, i) => {
                     q += 1;
                     format!("Q{q}")
                 }
@@ -150,13 +151,12 @@ fn unit(g: &Grammar, inline: &[bool], s: Sym) -> Vec<(Sym, Frame)> {
     }
 }
 
-/// Whether a rule takes the count `m` (sequences longer than a pair, branchings).
+/// Whether a rule takes the count `m`: sequences longer than a pair,
+/// branchings, and sequences of such (two rows of a grid).
 fn counted(g: &Grammar, r: usize) -> bool {
-    match g.rules[r].body {
-        Body::Seq { .. } => !g.rules[r].counts.iter().all(|&m| m == 1),
-        Body::Branch { .. } => true,
-        Body::Pair { .. } => false,
-    }
+    let rule = &g.rules[r];
+    rule.repeats()
+        || matches!(rule.body, Body::Seq { a: Sym::Rule(q, _), .. } if g.rules[q].repeats())
 }
 
 /// Derivation steps to expand `s` completely, as named counts (with their

@@ -47,6 +47,27 @@ impl Case {
         out + "</svg>\n"
     }
 
+    /// Whether `drawn` holds the design's copies, as `variant` draws them
+    /// (within the hand placement's jitter).
+    #[allow(dead_code)]
+    pub fn holds(&self, drawn: &[u8], variant: Variant) -> Result<(), String> {
+        same(
+            self.truth(&self.design.level).as_bytes(),
+            drawn,
+            self.slack(variant),
+        )
+    }
+
+    /// How far a copy may be off in `variant`, beyond the tolerance of
+    /// `same_copies`: the hand placement's jitter (1 % of the step, 1°).
+    fn slack(&self, variant: Variant) -> f64 {
+        if variant == Variant::Jittered {
+            0.02 * self.step()
+        } else {
+            0.0
+        }
+    }
+
     /// The distance between neighbouring copies, about.
     fn step(&self) -> f64 {
         let l = &self.design.level;
@@ -106,11 +127,7 @@ pub fn check(case: &Case, variant: Variant) -> Outcome {
         }
     };
     o.ratio = program.len() as f64 / svg.len() as f64;
-    let slack = if variant == Variant::Jittered {
-        0.02 * case.step()
-    } else {
-        0.0
-    };
+    let slack = case.slack(variant);
     let judged = judge(case, &program, slack, variant == Variant::Shuffled);
     o.redraws = judged.0;
     o.fail = judged.1;

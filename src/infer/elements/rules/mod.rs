@@ -77,6 +77,18 @@ pub struct Rule {
     pub counts: BTreeSet<u32>,
 }
 
+impl Rule {
+    /// Whether it repeats something a count of times: a sequence longer
+    /// than a pair, or a branching.
+    pub fn repeats(&self) -> bool {
+        match self.body {
+            Body::Seq { .. } => !self.counts.iter().all(|&m| m == 1),
+            Body::Branch { .. } => true,
+            Body::Pair { .. } => false,
+        }
+    }
+}
+
 /// The weights of the cluster importance w = w_n·n + w_h·h + w_φ·φ + w_l·l.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Weights {
@@ -1148,6 +1160,12 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
         }
         Plan::Pair { pairs, t } => {
             let (a, b) = (insts[pairs[0].0].sym, insts[pairs[0].1].sym);
+            // Two of one sequence (two rows of a grid) are a sequence of
+            // it, counted (`m` = 1), as a person extends a grid.
+            let nested = a == b
+                && matches!(a, Sym::Rule(q, _)
+                    if g.rules[q].repeats() && matches!(g.rules[q].body, Body::Seq { .. }));
+            let m = u32::from(nested);
             // Pairs of one cluster are a repeated structure; a lone pair is not.
             let reg = (tol.regular && pairs.len() >= 2)
                 .then(|| {
@@ -1164,15 +1182,26 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
                             drawn: &reg.drawn[2 * k..2 * k + 2],
                             sigma2: reg.sigma2,
                         };
-                        replace_at(insts, reg.starts[k], &[x, y], Sym::Rule(r, 0), Some(placed))
+                        replace_at(insts, reg.starts[k], &[x, y], Sym::Rule(r, m), Some(placed))
                     }
-                    None => replace(insts, x, &[x, y], Sym::Rule(r, 0)),
+                    None => replace(insts, x, &[x, y], Sym::Rule(r, m)),
                 }
             }
             let t = reg.map_or(t, |reg| reg.t[0]);
+            let body = if nested {
+                Body::Seq {
+                    a,
+                    t,
+                    delta: None,
+                    place: None,
+                    tip: None,
+                }
+            } else {
+                Body::Pair { a, t, b }
+            };
             g.rules.push(Rule {
-                body: Body::Pair { a, t, b },
-                counts: BTreeSet::from([0]),
+                body,
+                counts: BTreeSet::from([m]),
             });
         }
     }
