@@ -17,6 +17,9 @@
 
 #[path = "../tests/it/elements_gen/mod.rs"]
 mod elements_gen;
+#[path = "../tests/it/rng.rs"]
+#[allow(dead_code)]
+mod rng;
 
 use elements_gen::draw::Variant;
 use elements_gen::programs::Class;

@@ -21,6 +21,9 @@
 
 #[path = "../tests/it/lines_gen/mod.rs"]
 mod lines_gen;
+#[path = "../tests/it/rng.rs"]
+#[allow(dead_code)]
+mod rng;
 
 use lines_gen::draw::Variant;
 use lines_gen::programs::Class;

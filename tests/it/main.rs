@@ -25,6 +25,8 @@ mod lsp;
 mod lsp_stress;
 mod outputs;
 mod plants;
+#[allow(dead_code)]
+mod rng;
 mod roundtrip;
 mod run;
 mod scene;

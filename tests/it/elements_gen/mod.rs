@@ -7,9 +7,7 @@
 pub mod check;
 pub mod draw;
 pub mod programs;
-#[path = "../lines_gen/rng.rs"]
-#[allow(dead_code)]
-pub mod rng;
+pub(crate) use crate::rng;
 
 use check::{Case, Outcome, Table};
 use draw::Variant;

@@ -7,7 +7,7 @@
 pub mod check;
 pub mod draw;
 pub mod programs;
-pub mod rng;
+pub(crate) use crate::rng;
 
 use check::{Case, Table};
 use draw::Variant;
