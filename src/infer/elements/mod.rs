@@ -202,23 +202,6 @@ pub fn from_svg(
     stats.kinds = inst.kinds.len();
     stats.instancing_ms = ms(t);
     let t = Instant::now();
-    let insts: Vec<Inst> = drawing
-        .elements
-        .iter()
-        .zip(&inst.of)
-        .zip(&inst.shapes)
-        .map(|((e, (k, f)), sh)| {
-            Inst::new(Sym::Element(*k), *f, e.min, e.max)
-                .symmetric(inst.kinds[*k].symmetry, sh.centroid)
-        })
-        .collect();
-    let mut grammar = rules::infer(insts, opts.weights, tol, progress).map_err(too_much)?;
-    frame_tips(&mut inst, &mut grammar);
-    stats.rules = grammar.rules.len();
-    stats.rounds = grammar.rounds;
-    stats.clusters = grammar.clusters;
-    stats.rules_ms = ms(t);
-    let t = Instant::now();
     let (source, system) = super::program::names(name);
     let settings = emit::Settings {
         source: &source,
@@ -226,9 +209,31 @@ pub fn from_svg(
         symmetrize: opts.symmetrize,
         jitter: opts.jitter,
     };
-    let file = emit::program(&drawing.elements, &inst, &grammar, &settings);
-    let text = crate::fmt::format_file(&file);
-    stats.emit_ms = ms(t);
+    let mut program = |mut inst: Instancing| {
+        let mut grammar = rules::infer(insts(&drawing, &inst), opts.weights, tol, progress)?;
+        frame_tips(&mut inst, &mut grammar);
+        let t = Instant::now();
+        let file = emit::program(&drawing.elements, &inst, &grammar, &settings);
+        let text = crate::fmt::format_file(&file);
+        Ok((grammar, file, text, ms(t)))
+    };
+    // Round kinds turned along their neighbours, when there are any: the
+    // shorter program wins (a spiral of discs steps alike at every disc, a
+    // row keeps the drawing's axes).
+    let turned = inst.facing_neighbours();
+    let (mut grammar, mut file, mut text, mut emit_ms) = program(inst).map_err(too_much)?;
+    if let Some(turned) = turned {
+        let other = program(turned).map_err(too_much)?;
+        emit_ms += other.3;
+        if other.2.len() < text.len() {
+            (grammar, file, text, _) = other;
+        }
+    }
+    stats.rules = grammar.rules.len();
+    stats.rounds = grammar.rounds;
+    stats.clusters = grammar.clusters;
+    stats.emit_ms = emit_ms;
+    stats.rules_ms = ms(t) - emit_ms;
     stats.svg_bytes = data.len();
     stats.program_bytes = text.len();
     stats.size_ratio = text.len() as f64 / data.len().max(1) as f64;
@@ -238,6 +243,20 @@ pub fn from_svg(
         skipped: drawing.skipped,
         stats,
     })
+}
+
+/// The drawing's elements as instances of their kinds, for the rules.
+fn insts(drawing: &read::Drawing, inst: &Instancing) -> Vec<Inst> {
+    drawing
+        .elements
+        .iter()
+        .zip(&inst.of)
+        .zip(&inst.shapes)
+        .map(|((e, (k, f)), sh)| {
+            Inst::new(Sym::Element(*k), *f, e.min, e.max)
+                .symmetric(inst.kinds[*k].symmetry, sh.centroid)
+        })
+        .collect()
 }
 
 /// A kind the drawing does not frame, drawn only at the tips of

@@ -360,6 +360,37 @@ pub struct Instancing {
 }
 
 impl Instancing {
+    /// Round kinds the drawing does not frame, each instance turned to head
+    /// away from its nearest neighbour of its kind (turtle heading: its
+    /// local +y); `None` when there are none. A disc has no heading of its
+    /// own, and a spiral of discs steps and turns alike at every disc only
+    /// if each heads the way the spiral runs.
+    pub fn facing_neighbours(&self) -> Option<Instancing> {
+        let mut out = self.clone();
+        let mut any = false;
+        for (k, kind) in self.kinds.iter().enumerate() {
+            if kind.symmetry != 0 || kind.given {
+                continue;
+            }
+            let members: Vec<usize> = (0..self.of.len()).filter(|&i| self.of[i].0 == k).collect();
+            if members.len() < 3 {
+                continue;
+            }
+            let points: Vec<DVec2> = members.iter().map(|&i| self.of[i].1.pos).collect();
+            let index = crate::geometry::index::PointGrid::new(&points);
+            for (a, &i) in members.iter().enumerate() {
+                let Some(b) = index.nearest(points[a], 2).into_iter().find(|&b| b != a) else {
+                    continue;
+                };
+                let d = points[a] - points[b];
+                out.of[i].1.rot = (-d.x).atan2(d.y);
+            }
+            out.kinds[k].frame.rot = out.of[kind.representative].1.rot;
+            any = true;
+        }
+        any.then_some(out)
+    }
+
     /// Moves kind `k`'s local frame by `change` (given in the old local
     /// frame), and every instance's frame with it.
     pub fn reframe(&mut self, k: usize, change: &Frame) {

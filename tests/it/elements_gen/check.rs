@@ -301,15 +301,19 @@ fn same_copies(t: &[Copy], d: &[Copy], slack: f64) -> Result<(), String> {
     let diagonal = (hi - lo).length();
     for (i, c) in t.iter().enumerate() {
         let tol = (0.02 * c.size).max(1e-3 * diagonal) + slack;
-        let near = d
+        // The nearest of the few drawn copies centred nearest (copies may
+        // overlap: a tree's two branches start at one point).
+        let mut near: Vec<&Copy> = d.iter().collect();
+        near.sort_by(|a, b| {
+            a.centre
+                .distance(c.centre)
+                .total_cmp(&b.centre.distance(c.centre))
+        });
+        let off = near
             .iter()
-            .min_by(|a, b| {
-                a.centre
-                    .distance(c.centre)
-                    .total_cmp(&b.centre.distance(c.centre))
-            })
-            .ok_or("nothing drawn")?;
-        let off = hausdorff(&c.outline, &near.outline).max(hausdorff(&near.outline, &c.outline));
+            .take(4)
+            .map(|n| hausdorff(&c.outline, &n.outline).max(hausdorff(&n.outline, &c.outline)))
+            .fold(f64::INFINITY, f64::min);
         if off > tol {
             return Err(format!(
                 "copy {} at ({:.2}, {:.2}) is {off:.3} off (tolerance {tol:.3})",
