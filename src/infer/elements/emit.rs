@@ -334,9 +334,9 @@ struct Round {
 impl Round {
     fn new(n: f64, d: f64) -> Round {
         Round {
-            angle: 0.002 / n,
-            d: (d * 2e-5).max(1e-6) / n,
-            s: 2e-5 / n,
+            angle: 0.01 / n,
+            d: (d * 1e-4).max(1e-5) / n.sqrt(),
+            s: 1e-4 / n.sqrt(),
         }
     }
 

@@ -218,14 +218,14 @@ pub fn from_svg(
         Ok((grammar, file, text, ms(t)))
     };
     // Round kinds turned along their neighbours, when there are any: the
-    // shorter program wins (a spiral of discs steps alike at every disc, a
-    // row keeps the drawing's axes).
+    // program with fewer numbers wins (a spiral of discs steps alike at
+    // every disc, a row keeps the drawing's axes).
     let turned = inst.facing_neighbours();
     let (mut grammar, mut file, mut text, mut emit_ms) = program(inst).map_err(too_much)?;
     if let Some(turned) = turned {
         let other = program(turned).map_err(too_much)?;
         emit_ms += other.3;
-        if other.2.len() < text.len() {
+        if numbers(&other.2) < numbers(&text) {
             (grammar, file, text, _) = other;
         }
     }
@@ -243,6 +243,20 @@ pub fn from_svg(
         skipped: drawing.skipped,
         stats,
     })
+}
+
+/// How many numbers a program writes outside its comments and its
+/// elements' outlines: its description length, for choosing between two.
+fn numbers(text: &str) -> usize {
+    text.lines()
+        .map(str::trim_start)
+        .filter(|l| !l.starts_with("//") && !l.starts_with("element") && !l.starts_with("path"))
+        .map(|l| {
+            l.split(|c: char| !(c.is_ascii_digit() || c == '.'))
+                .filter(|t| t.chars().any(|c| c.is_ascii_digit()))
+                .count()
+        })
+        .sum()
 }
 
 /// The drawing's elements as instances of their kinds, for the rules.

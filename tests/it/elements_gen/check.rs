@@ -102,6 +102,10 @@ pub struct Outcome {
     pub ms: f64,
     /// The program's size over the SVG's.
     pub ratio: f64,
+    /// Exact, and no number of the program (but its elements' outlines)
+    /// is a short decimal blurred by the drawing's rounding (`15.0003`,
+    /// `0.99998`, `-0.001`).
+    pub clean: bool,
     pub program: String,
 }
 
@@ -117,6 +121,7 @@ pub fn check(case: &Case, variant: Variant) -> Outcome {
         fail: None,
         ms,
         ratio: 0.0,
+        clean: false,
         program: String::new(),
     };
     let program = match program {
@@ -127,11 +132,13 @@ pub fn check(case: &Case, variant: Variant) -> Outcome {
         }
     };
     o.ratio = program.len() as f64 / svg.len() as f64;
+    let blurred = blurred(&program);
     let slack = case.slack(variant);
     let judged = judge(case, &program, slack, variant == Variant::Shuffled);
     o.redraws = judged.0;
     o.fail = judged.1;
     o.exact = o.fail.is_none();
+    o.clean = o.exact && blurred.is_empty();
     o.program = program;
     o
 }
@@ -183,6 +190,35 @@ fn infer_program(svg: &str, symmetrize: bool) -> Result<String, Fail> {
             Err(e) => Err(fail("error", e.to_string())),
         },
     }
+}
+
+/// The numbers of a program, outside its elements' outlines, that lie
+/// within 0.005 % (or 0.0005) of a decimal of at most two places without
+/// being it: what the drawing's rounding left in a number a person writes.
+pub fn blurred(program: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for line in program.lines() {
+        let line = line.trim();
+        if line.starts_with("//") || line.starts_with("element") || line.starts_with("path") {
+            continue;
+        }
+        let mut token = String::new();
+        for ch in line.chars().chain(std::iter::once(' ')) {
+            if ch.is_ascii_digit() || ch == '.' || (ch == '-' && token.is_empty()) {
+                token.push(ch);
+                continue;
+            }
+            if let Ok(v) = token.parse::<f64>() {
+                let short = (v * 100.0).round() / 100.0;
+                let near = (v - short).abs() <= (5e-5 * short.abs()).max(5e-4);
+                if near && v != short {
+                    out.push(token.clone());
+                }
+            }
+            token.clear();
+        }
+    }
+    out
 }
 
 /// `const NAME_N = K;` of a program: its counts.
@@ -357,6 +393,7 @@ pub struct Cell {
     pub redraws: usize,
     pub ms: Vec<f64>,
     pub ratios: Vec<f64>,
+    pub clean: usize,
     /// Failure kind → (seed, detail).
     pub fails: BTreeMap<&'static str, Vec<(u64, String)>>,
 }
@@ -375,6 +412,7 @@ impl Table {
         c.redraws += usize::from(o.redraws);
         c.ms.push(o.ms);
         c.ratios.push(o.ratio);
+        c.clean += usize::from(o.clean);
         if let Some(f) = &o.fail {
             c.fails
                 .entry(f.kind)
@@ -404,13 +442,13 @@ impl Table {
         let grid = |title: &str, f: &dyn Fn(&Cell) -> String| {
             let mut out = format!("{title}\n{:<8}", "class");
             for v in &variants {
-                out.push_str(&format!("{:>14}", v.name()));
+                out.push_str(&format!("{:>18}", v.name()));
             }
             out.push('\n');
             for &c in &classes {
                 out.push_str(&format!("{:<8}", c.name()));
                 for &v in &variants {
-                    out.push_str(&format!("{:>14}", f(&self.get(c, v))));
+                    out.push_str(&format!("{:>18}", f(&self.get(c, v))));
                 }
                 out.push('\n');
             }
@@ -421,8 +459,8 @@ impl Table {
             xs.sort_by(f64::total_cmp);
             xs.get(xs.len() / 2).copied().unwrap_or(0.0)
         };
-        let mut out = grid("exact/total (redrawn)", &|c| {
-            format!("{}/{} ({})", c.exact, c.total, c.redraws)
+        let mut out = grid("exact/total (redrawn, exact with clean numbers)", &|c| {
+            format!("{}/{} ({}, {})", c.exact, c.total, c.redraws, c.clean)
         });
         out += &grid("\nprogram size / SVG size, median", &|c| {
             format!("{:.2}", median(&c.ratios))
