@@ -256,8 +256,13 @@ fn a_never_ending_string_and_drag_are_stopped_by_newer_requests() {
     let (_, reply) = post(port, "/api/run", &edit, LONG);
     assert_eq!(reply["ok"], true, "{reply}");
     let (_, dragged) = dragging.join().expect("answers");
+    // Stopped by the edit, or by the scene's step limit before the edit was
+    // sent (a quick machine reaches 100,000 steps within the 500 ms).
+    let done_before = dragged["stats"]["total_ms"]
+        .as_f64()
+        .is_some_and(|ms| ms < 500.0);
     assert!(
-        dragged["superseded"] == true || dragged["ok"] == false,
+        dragged["superseded"] == true || dragged["ok"] == false || done_before,
         "{dragged}"
     );
 }

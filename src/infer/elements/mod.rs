@@ -21,7 +21,7 @@ pub mod space;
 use super::{InferError, MAX_SVG_BYTES};
 use crate::ast::File;
 use rules::{Body, Grammar, Inst, Sym, Tolerance, Weights};
-use shape::{Frame, Instancing};
+use shape::{Facing, Frame, Instancing};
 use std::time::Instant;
 
 /// The most elements a drawing may have.
@@ -220,9 +220,12 @@ pub fn from_svg(
     // Round kinds turned along their neighbours, when there are any: the
     // program with fewer numbers wins (a spiral of discs steps alike at
     // every disc, a row keeps the drawing's axes).
-    let turned = inst.facing_neighbours();
+    let turned: Vec<Instancing> = [Facing::Neighbour, Facing::Out]
+        .into_iter()
+        .filter_map(|f| inst.turned_round(f))
+        .collect();
     let (mut grammar, mut file, mut text, mut emit_ms) = program(inst).map_err(too_much)?;
-    if let Some(turned) = turned {
+    for turned in turned {
         let other = program(turned).map_err(too_much)?;
         emit_ms += other.3;
         if numbers(&other.2) < numbers(&text) {

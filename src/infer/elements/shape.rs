@@ -361,11 +361,11 @@ pub struct Instancing {
 
 impl Instancing {
     /// Round kinds the drawing does not frame, each instance turned to head
-    /// away from its nearest neighbour of its kind (turtle heading: its
-    /// local +y); `None` when there are none. A disc has no heading of its
-    /// own, and a spiral of discs steps and turns alike at every disc only
-    /// if each heads the way the spiral runs.
-    pub fn facing_neighbours(&self) -> Option<Instancing> {
+    /// (turtle heading: its local +y) as `facing` says; `None` when there
+    /// are none. A disc has no heading of its own, and a spiral of discs
+    /// steps and turns alike at every disc only if each heads the way the
+    /// spiral runs, a ring of discs only if each heads out of the ring.
+    pub fn turned_round(&self, facing: Facing) -> Option<Instancing> {
         let mut out = self.clone();
         let mut any = false;
         for (k, kind) in self.kinds.iter().enumerate() {
@@ -378,12 +378,16 @@ impl Instancing {
             }
             let points: Vec<DVec2> = members.iter().map(|&i| self.of[i].1.pos).collect();
             let index = crate::geometry::index::PointGrid::new(&points);
+            let mean = points.iter().sum::<DVec2>() / points.len() as f64;
             for (a, &i) in members.iter().enumerate() {
-                let Some(b) = index.nearest(points[a], 2).into_iter().find(|&b| b != a) else {
-                    continue;
+                let from = match facing {
+                    Facing::Neighbour => index.nearest(points[a], 2).into_iter().find(|&b| b != a),
+                    Facing::Out => None,
                 };
-                let d = points[a] - points[b];
-                out.of[i].1.rot = (-d.x).atan2(d.y);
+                let d = points[a] - from.map_or(mean, |b| points[b]);
+                if d.length_squared() > 0.0 {
+                    out.of[i].1.rot = (-d.x).atan2(d.y);
+                }
             }
             out.kinds[k].frame.rot = out.of[kind.representative].1.rot;
             any = true;
@@ -401,6 +405,15 @@ impl Instancing {
             }
         }
     }
+}
+
+/// Which way a round element is turned to head (`Instancing::turned_round`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Facing {
+    /// Away from its nearest neighbour of its kind.
+    Neighbour,
+    /// Away from the mean place of its kind.
+    Out,
 }
 
 /// Subpaths with every point mapped by `f`.
