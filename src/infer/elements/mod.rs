@@ -10,6 +10,7 @@
 //! (`emit`). Must not write files or print (the CLI does), and must not panic
 //! on any input.
 
+pub mod choose;
 pub mod emit;
 pub mod origin;
 pub mod pivot;
@@ -217,19 +218,35 @@ pub fn from_svg(
         let text = crate::fmt::format_file(&file);
         Ok((grammar, file, text, ms(t)))
     };
-    // Round kinds turned along their neighbours, when there are any: the
-    // program with fewer numbers wins (a spiral of discs steps alike at
-    // every disc, a row keeps the drawing's axes).
+    // Round kinds turned along their neighbours or out of their ring, when
+    // there are any: the program with fewer numbers wins if it puts the
+    // elements where the first does (a spiral of discs steps alike at every
+    // disc, a row keeps the drawing's axes).
     let turned: Vec<Instancing> = [Facing::Neighbour, Facing::Out]
         .into_iter()
         .filter_map(|f| inst.turned_round(f))
         .collect();
+    let places: Vec<glam::DVec2> = inst.of.iter().map(|(_, f)| f.pos).collect();
     let (mut grammar, mut file, mut text, mut emit_ms) = program(inst).map_err(too_much)?;
-    for turned in turned {
-        let other = program(turned).map_err(too_much)?;
-        emit_ms += other.3;
-        if numbers(&other.2) < numbers(&text) {
-            (grammar, file, text, _) = other;
+    if !turned.is_empty() {
+        // As near as the first, or (with `--symmetrize`) within the noise
+        // of the drawing's placement.
+        let first = choose::misfit(&text, &places).unwrap_or(f64::INFINITY);
+        let mut sizes: Vec<f64> = drawing
+            .elements
+            .iter()
+            .map(|e| (e.max - e.min).length())
+            .collect();
+        sizes.sort_by(f64::total_cmp);
+        let size = sizes[sizes.len() / 2];
+        let near = first * 1.5 + if opts.symmetrize { 0.1 } else { 1e-3 } * size;
+        for turned in turned {
+            let other = program(turned).map_err(too_much)?;
+            emit_ms += other.3;
+            let fits = choose::misfit(&other.2, &places).is_some_and(|m| m <= near);
+            if fits && choose::numbers(&other.2) < choose::numbers(&text) {
+                (grammar, file, text, _) = other;
+            }
         }
     }
     stats.rules = grammar.rules.len();
@@ -246,20 +263,6 @@ pub fn from_svg(
         skipped: drawing.skipped,
         stats,
     })
-}
-
-/// How many numbers a program writes outside its comments and its
-/// elements' outlines: its description length, for choosing between two.
-fn numbers(text: &str) -> usize {
-    text.lines()
-        .map(str::trim_start)
-        .filter(|l| !l.starts_with("//") && !l.starts_with("element") && !l.starts_with("path"))
-        .map(|l| {
-            l.split(|c: char| !(c.is_ascii_digit() || c == '.'))
-                .filter(|t| t.chars().any(|c| c.is_ascii_digit()))
-                .count()
-        })
-        .sum()
 }
 
 /// The drawing's elements as instances of their kinds, for the rules.
