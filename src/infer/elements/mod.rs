@@ -28,6 +28,10 @@ use std::time::Instant;
 /// The most elements a drawing may have.
 pub const MAX_ELEMENTS: usize = 200_000;
 
+/// The most elements a drawing may have for its round kinds to be read
+/// turned as well (`choose`): each reading infers the rules again.
+pub const MAX_REREAD: usize = 20_000;
+
 /// A phase would do more work than its limit: `what` it counts, and the limit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TooMuchWork {
@@ -210,7 +214,7 @@ pub fn from_svg(
         symmetrize: opts.symmetrize,
         jitter: opts.jitter,
     };
-    let mut program = |mut inst: Instancing| {
+    let program = |mut inst: Instancing, progress: &mut dyn FnMut(usize)| {
         let mut grammar = rules::infer(insts(&drawing, &inst), opts.weights, tol, progress)?;
         frame_tips(&mut inst, &mut grammar);
         let t = Instant::now();
@@ -219,15 +223,19 @@ pub fn from_svg(
         Ok((grammar, file, text, ms(t)))
     };
     // Round kinds turned along their neighbours or out of their ring, when
-    // there are any: the program with fewer numbers wins if it puts the
-    // elements where the first does (a spiral of discs steps alike at every
-    // disc, a row keeps the drawing's axes).
+    // there are any (in drawings of up to `MAX_REREAD` elements: each
+    // reading costs the rules again): the program with fewer numbers wins
+    // if it puts the elements where the first does (a spiral of discs steps
+    // alike at every disc, a row keeps the drawing's axes). A reading that
+    // reaches a work limit is left out.
     let turned: Vec<Instancing> = [Facing::Neighbour, Facing::Out]
         .into_iter()
+        .filter(|_| drawing.elements.len() <= MAX_REREAD)
         .filter_map(|f| inst.turned_round(f))
         .collect();
     let places: Vec<glam::DVec2> = inst.of.iter().map(|(_, f)| f.pos).collect();
-    let (mut grammar, mut file, mut text, mut emit_ms) = program(inst).map_err(too_much)?;
+    let (mut grammar, mut file, mut text, mut emit_ms) =
+        program(inst, progress).map_err(too_much)?;
     if !turned.is_empty() {
         // As near as the first, or (with `--symmetrize`) within the noise
         // of the drawing's placement.
@@ -241,7 +249,9 @@ pub fn from_svg(
         let size = sizes[sizes.len() / 2];
         let near = first * 1.5 + if opts.symmetrize { 0.1 } else { 1e-3 } * size;
         for turned in turned {
-            let other = program(turned).map_err(too_much)?;
+            let Ok(other) = program(turned, &mut |_| {}) else {
+                continue;
+            };
             emit_ms += other.3;
             let fits = choose::misfit(&other.2, &places).is_some_and(|m| m <= near);
             if fits && choose::numbers(&other.2) < choose::numbers(&text) {
