@@ -24,7 +24,7 @@ const PER_CLASS: u64 = 20;
 const FLOORS: &[(Class, [usize; 5])] = &[
     (Class::Row, [20, 20, 20, 20, 20]),
     (Class::Ring, [20, 20, 20, 20, 20]),
-    (Class::Spiral, [20, 19, 20, 9, 19]),
+    (Class::Spiral, [20, 19, 20, 18, 19]),
     (Class::Period, [20, 20, 20, 20, 20]),
     (Class::Grid, [20, 20, 20, 20, 19]),
     (Class::Linear, [20, 17, 20, 8, 3]),

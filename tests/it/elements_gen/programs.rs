@@ -107,6 +107,10 @@ pub struct Design {
     pub shapes: Vec<Shape>,
     pub level: Vec<Place>,
     pub next: Vec<Place>,
+    /// For a sequence of one step (rows, spirals): the design extended at
+    /// its start instead, as a reading from its other end predicts (empty
+    /// for the other classes).
+    pub before: Vec<Place>,
     /// The design as a person would write it, for failure reports.
     pub text: String,
 }
@@ -128,6 +132,7 @@ pub fn design(class: Class, seed: u64) -> Design {
     Design {
         level: plan.places(0),
         next: plan.places(1),
+        before: plan.before(),
         text: plan.text(),
         shapes,
     }
@@ -285,6 +290,26 @@ impl Plan {
                 out
             }
         }
+    }
+
+    /// The design with one more copy before its first (rows and spirals).
+    fn before(&self) -> Vec<Place> {
+        if !matches!(self.class, Class::Row | Class::Spiral) {
+            return Vec::new();
+        }
+        // The turtle one step before the first copy.
+        let heading = self.heading - self.turn;
+        let scale = 1.0 / self.scale;
+        let at = self.origin - dir(heading) * self.step * scale;
+        let mut t = Turtle { at, heading, scale };
+        let mut out = Vec::new();
+        for _ in 0..=self.count {
+            out.push(t.place(0));
+            t.forward(self.step);
+            t.scale *= self.scale;
+            t.heading += self.turn;
+        }
+        out
     }
 
     /// `n` copies, each stepped from the one before by t(m) = t0 + tΔ·m as

@@ -133,7 +133,7 @@ impl Tolerance {
     pub const RELAXED: Tolerance = Tolerance {
         angle: 10.0 * std::f64::consts::PI / 180.0,
         distance: 0.15,
-        scale: 0.1,
+        scale: 0.03,
         regular: true,
     };
 }
