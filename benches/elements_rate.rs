@@ -17,6 +17,8 @@
 
 #[path = "../tests/it/elements_gen/mod.rs"]
 mod elements_gen;
+#[path = "../tests/it/pool.rs"]
+mod pool;
 #[path = "../tests/it/rng.rs"]
 #[allow(dead_code)]
 mod rng;

@@ -21,6 +21,8 @@
 
 #[path = "../tests/it/lines_gen/mod.rs"]
 mod lines_gen;
+#[path = "../tests/it/pool.rs"]
+mod pool;
 #[path = "../tests/it/rng.rs"]
 #[allow(dead_code)]
 mod rng;

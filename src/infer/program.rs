@@ -91,6 +91,26 @@ pub(crate) fn file(items: Vec<Node<Item>>) -> File {
     }
 }
 
+/// Derives the program `text` `more` steps beyond its own `derive` and
+/// draws it into `sink`, as `lsyc run` does (seed 0): how inference checks
+/// what a program it wrote draws. `None` if it does not run.
+pub(crate) fn draw(text: &str, more: u32, sink: &mut dyn crate::turtle::Sink) -> Option<()> {
+    let fe = crate::frontend::run(text, Vec::new(), &[]);
+    if fe.has_errors() {
+        return None;
+    }
+    let checked = fe.checked.as_ref()?;
+    let prog = crate::compile::compile(&fe.file, checked, None).ok()?;
+    let limits = crate::derive::Limits::default();
+    let axiom = crate::derive::axiom(&prog, &vec![0.0; prog.params.len()], 0).ok()?;
+    let steps = prog.derive.checked_add(more)?;
+    let string = crate::derive::derive(&prog, axiom, steps, 0, limits, &|_, _| {}).ok()?;
+    let state = crate::turtle::State::default();
+    crate::turtle::interpret_limited(&prog, &string, 0, state, limits, sink)
+        .ok()
+        .map(|_| ())
+}
+
 /// The shortest decimal within `tol` of `v` (at most 6 decimals).
 pub fn nice(v: f64, tol: f64) -> f64 {
     for digits in 0..=6 {

@@ -25,6 +25,7 @@ mod lsp;
 mod lsp_stress;
 mod outputs;
 mod plants;
+mod pool;
 #[allow(dead_code)]
 mod rng;
 mod roundtrip;

@@ -46,25 +46,8 @@ pub fn misfit(text: &str, places: &[DVec2]) -> Option<f64> {
 
 /// Where the program `text` draws its elements (seed 0).
 fn drawn(text: &str) -> Option<Vec<DVec2>> {
-    let fe = crate::frontend::run(text, Vec::new(), &[]);
-    if fe.has_errors() {
-        return None;
-    }
-    let checked = fe.checked.as_ref()?;
-    let prog = crate::compile::compile(&fe.file, checked, None).ok()?;
-    let limits = crate::derive::Limits::default();
-    let axiom = crate::derive::axiom(&prog, &vec![0.0; prog.params.len()], 0).ok()?;
-    let string = crate::derive::derive(&prog, axiom, prog.derive, 0, limits, &|_, _| {}).ok()?;
     let mut sink = Places::default();
-    crate::turtle::interpret_limited(
-        &prog,
-        &string,
-        0,
-        crate::turtle::State::default(),
-        limits,
-        &mut sink,
-    )
-    .ok()?;
+    crate::infer::program::draw(text, 0, &mut sink)?;
     Some(sink.0)
 }
 

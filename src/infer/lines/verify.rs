@@ -79,26 +79,8 @@ pub fn redraw(text: &str, segments: &[(DVec2, DVec2)], step: f64) -> Option<Redr
 /// steps beyond its own `derive`, as `lsyc run` derives and draws it (seed
 /// 0). `None` if the program does not run.
 pub fn drawn(text: &str, more: u32) -> Option<Vec<(DVec2, DVec2)>> {
-    let fe = crate::frontend::run(text, Vec::new(), &[]);
-    if fe.has_errors() {
-        return None;
-    }
-    let checked = fe.checked.as_ref()?;
-    let prog = crate::compile::compile(&fe.file, checked, None).ok()?;
-    let limits = crate::derive::Limits::default();
-    let axiom = crate::derive::axiom(&prog, &vec![0.0; prog.params.len()], 0).ok()?;
-    let steps = prog.derive.checked_add(more)?;
-    let string = crate::derive::derive(&prog, axiom, steps, 0, limits, &|_, _| {}).ok()?;
     let mut sink = Segments::default();
-    crate::turtle::interpret_limited(
-        &prog,
-        &string,
-        0,
-        crate::turtle::State::default(),
-        limits,
-        &mut sink,
-    )
-    .ok()?;
+    crate::infer::program::draw(text, more, &mut sink)?;
     Some(sink.0)
 }
 

@@ -12,8 +12,6 @@ pub(crate) use crate::rng;
 use check::{Case, Outcome, Table};
 use draw::Variant;
 use programs::Class;
-use std::collections::VecDeque;
-use std::sync::Mutex;
 
 /// What to run.
 pub struct Run<'a> {
@@ -31,38 +29,19 @@ pub struct Run<'a> {
 /// every outcome, in the order of classes, seeds and variants, however many
 /// threads infer them.
 pub fn run(r: &Run, each: &mut dyn FnMut(&Case, Variant, &Outcome)) -> Table {
-    let mut queue = VecDeque::new();
-    for &class in r.classes {
-        for seed in r.first..r.first + r.per_class {
-            queue.push_back((queue.len(), Case::new(class, seed)));
-        }
-    }
-    let queue = Mutex::new(queue);
-    let done = Mutex::new(Vec::new());
-    std::thread::scope(|s| {
-        for _ in 0..r.threads.max(1) {
-            s.spawn(|| {
-                loop {
-                    let next = queue.lock().map(|mut q| q.pop_front());
-                    let Ok(Some((at, case))) = next else {
-                        break;
-                    };
-                    let outcomes: Vec<_> = r
-                        .variants
-                        .iter()
-                        .map(|&v| (v, check::check(&case, v)))
-                        .collect();
-                    if let Ok(mut d) = done.lock() {
-                        d.push((at, case, outcomes));
-                    }
-                }
-            });
-        }
+    let cases: Vec<Case> = r
+        .classes
+        .iter()
+        .flat_map(|&class| (r.first..r.first + r.per_class).map(move |seed| Case::new(class, seed)))
+        .collect();
+    let done = crate::pool::in_order(cases, r.threads, |case| {
+        r.variants
+            .iter()
+            .map(|&v| (v, check::check(case, v)))
+            .collect::<Vec<_>>()
     });
-    let mut done = done.into_inner().unwrap_or_else(|e| e.into_inner());
-    done.sort_by_key(|d| d.0);
     let mut table = Table::default();
-    for (_, case, outcomes) in &done {
+    for (case, outcomes) in &done {
         for (v, o) in outcomes {
             each(case, *v, o);
             table.add(case, *v, o);

@@ -12,8 +12,6 @@ pub(crate) use crate::rng;
 use check::{Case, Table};
 use draw::Variant;
 use programs::{Class, Rejections};
-use std::collections::VecDeque;
-use std::sync::Mutex;
 use std::time::Duration;
 
 /// What to run.
@@ -35,42 +33,24 @@ pub struct Run<'a> {
 /// classes, seeds and variants, however many threads infer them.
 pub fn run(r: &Run, each: &mut dyn FnMut(&Case, Variant, &check::Outcome)) -> Table {
     let mut table = Table::default();
-    let mut queue = VecDeque::new();
+    let mut cases = Vec::new();
     for &class in r.classes {
         let mut rejections = Rejections::default();
         for seed in r.first..r.first + r.per_class {
             match Case::new(class, seed, &mut rejections) {
-                Some(case) => queue.push_back((queue.len(), case)),
+                Some(case) => cases.push(case),
                 None => *table.ungenerated.entry(class).or_default() += 1,
             }
         }
         table.rejections.insert(class, rejections);
     }
-    let queue = Mutex::new(queue);
-    let done = Mutex::new(Vec::new());
-    std::thread::scope(|s| {
-        for _ in 0..r.threads.max(1) {
-            s.spawn(|| {
-                loop {
-                    let next = queue.lock().map(|mut q| q.pop_front());
-                    let Ok(Some((at, case))) = next else {
-                        break;
-                    };
-                    let outcomes: Vec<_> = r
-                        .variants
-                        .iter()
-                        .map(|&v| (v, check::check(&case, v, r.budget)))
-                        .collect();
-                    if let Ok(mut d) = done.lock() {
-                        d.push((at, case, outcomes));
-                    }
-                }
-            });
-        }
+    let done = crate::pool::in_order(cases, r.threads, |case| {
+        r.variants
+            .iter()
+            .map(|&v| (v, check::check(case, v, r.budget)))
+            .collect::<Vec<_>>()
     });
-    let mut done = done.into_inner().unwrap_or_else(|e| e.into_inner());
-    done.sort_by_key(|d| d.0);
-    for (_, case, outcomes) in &done {
+    for (case, outcomes) in &done {
         for (v, o) in outcomes {
             each(case, *v, o);
             table.add(case, *v, o);
