@@ -28,7 +28,7 @@ const FLOORS: &[(Class, [usize; 5])] = &[
     (Class::Period, [20, 20, 20, 20, 20]),
     (Class::Grid, [20, 20, 20, 20, 19]),
     (Class::Linear, [20, 17, 20, 8, 3]),
-    (Class::Tree, [14, 10, 13, 10, 7]),
+    (Class::Tree, [20, 16, 19, 16, 12]),
 ];
 
 #[test]

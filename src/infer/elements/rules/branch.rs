@@ -168,6 +168,8 @@ fn depth_of(v: usize, groups: &[&Children], memo: &mut [u32], open: &mut [bool])
 
 /// Complete trees whose children come from `groups` (clusters of edges, one
 /// per transform); `outs` are the round's edges by the instance they leave.
+/// With `tips`, only trees with buds at their tips count.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn branching(
     insts: &[Inst],
     edges: &[Edge],
@@ -175,6 +177,7 @@ pub(super) fn branching(
     outs: &Outs,
     spots: &[(Frame, f64)],
     groups: &[&Children],
+    tips: bool,
     tol: Tolerance,
 ) -> Option<Candidate> {
     if groups.len() > 3 {
@@ -277,7 +280,11 @@ pub(super) fn branching(
         child[i].insert(v, c);
     }
     let mut tip_at = None;
-    if let Some((tips, at)) = tree_tips(insts, edges, outs, &leaves, &ts, &claimed, tol) {
+    let found = tree_tips(insts, edges, outs, &leaves, &ts, &claimed, tol);
+    if tips && found.is_none() {
+        return None;
+    }
+    if let Some((tips, at)) = found {
         for (&(leaf, _), below) in leaves.iter().zip(tips) {
             for (map, &(c, _)) in child.iter_mut().zip(&below) {
                 map.insert(leaf, c);

@@ -531,7 +531,18 @@ fn candidates(
         if a == b {
             // Branchings: two or three clusters of one kind, each node with
             // a child in each.
-            let mut big: Vec<&Vec<usize>> = groups.iter().filter(|g| g.len() >= 2).collect();
+            // A kind of at most four instances may be one tree's root and
+            // its children (a tree of two levels of stems and buds at the
+            // tips): its clusters of one edge count too, and such a tree
+            // must have tips.
+            let few = ks
+                .iter()
+                .map(|&k| edges[k].from)
+                .collect::<BTreeSet<_>>()
+                .len()
+                <= 4;
+            let least = if few { 1 } else { 2 };
+            let mut big: Vec<&Vec<usize>> = groups.iter().filter(|g| g.len() >= least).collect();
             big.sort_by_key(|g| std::cmp::Reverse(g.len()));
             big.truncate(8);
             let n = big.len();
@@ -556,7 +567,8 @@ fn candidates(
                 .par_iter()
                 .map(|set| {
                     let groups: Vec<&Children> = set.iter().map(|&g| &children[g]).collect();
-                    branching(insts, edges, &index, outs, spots, &groups, tol)
+                    let tips = set.iter().any(|&g| big[g].len() < 2);
+                    branching(insts, edges, &index, outs, spots, &groups, tips, tol)
                 })
                 .collect();
             out.extend(found.into_iter().flatten());
