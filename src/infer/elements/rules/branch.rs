@@ -404,7 +404,9 @@ fn tips_at(
     let back = rel.inverse();
     let mut tips = Vec::with_capacity(leaves.len());
     for &(leaf, f) in leaves {
-        let mut best: Vec<Option<(f64, usize, Frame, Frame)>> = vec![None; tr.len()];
+        // Every bud that sits where a side's child would: (offset, side,
+        // bud, its frame, where the child would be from the leaf as drawn).
+        let mut fits: Vec<(f64, usize, usize, Frame, Frame)> = Vec::new();
         for k in outs.of_instance(leaf).filter(|&k| bud(k)) {
             let b = &insts[edges[k].to];
             for side in 0..tr.len() {
@@ -420,20 +422,25 @@ fn tips_at(
                     continue;
                 };
                 let off = want.pos.distance(have.then(rel).pos);
-                if best[side].is_none_or(|(o, ..)| off < o) {
-                    // Where the child would be from the leaf as drawn (the
-                    // tree's frames drift with depth).
-                    let near = tr[side].apply(&insts[leaf].frame);
-                    best[side] = Some((off, edges[k].to, have, near));
-                }
+                // Where the child would be from the leaf as drawn (the
+                // tree's frames drift with depth).
+                let near = tr[side].apply(&insts[leaf].frame);
+                fits.push((off, side, edges[k].to, have, near));
+            }
+        }
+        // Nearest first, each bud on one side only (two like buds at one
+        // place are one for each side, not one for both).
+        fits.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut best: Vec<Option<(usize, Frame, Frame)>> = vec![None; tr.len()];
+        let mut used = Vec::new();
+        for (_, side, i, have, near) in fits {
+            if best[side].is_none() && !used.contains(&i) {
+                best[side] = Some((i, have, near));
+                used.push(i);
             }
         }
         // A leaf without both tips: no tree has tips.
-        tips.push(
-            best.into_iter()
-                .map(|x| x.map(|(_, i, have, want)| (i, have, want)))
-                .collect::<Option<Vec<_>>>()?,
-        );
+        tips.push(best.into_iter().collect::<Option<Vec<_>>>()?);
     }
     Some(tips)
 }
