@@ -228,7 +228,13 @@ fn search(
         .map(|&k| fixed(&edges[k].t, tol, vary, any_origin))
         .collect();
     budget.spend(points.len())?;
-    let (label, centres) = cluster(&points, 0.0);
+    // A growing chain's edges share their angles, which wrap (a step
+    // straight back is α = ±π).
+    let turn = match vary {
+        Vary::Grow => std::f64::consts::TAU / tol.angle,
+        Vary::Turn => 0.0,
+    };
+    let (label, centres) = cluster(&points, turn);
     let mut groups: Vec<Vec<usize>> = vec![Vec::new(); centres.len()];
     for (&k, &l) in ks.iter().zip(&label) {
         groups[l].push(k);
