@@ -1,7 +1,8 @@
 //! Choosing between programs inferred from one drawing read in different
 //! ways (round kinds turned along the drawing's axes, along their
-//! neighbours, out of their ring): the one that writes the fewest numbers
-//! among those that put every element where the drawing has it.
+//! neighbours, out of their ring, along the path through them): the one
+//! that writes the fewest numbers among those that put every element where
+//! the drawing has it.
 //!
 //! Owns: a program's description length (`numbers`) and how far the
 //! elements it draws are from the drawing's (`misfit`, by deriving and
@@ -16,12 +17,31 @@ pub fn numbers(text: &str) -> usize {
     text.lines()
         .map(str::trim_start)
         .filter(|l| !l.starts_with("//") && !l.starts_with("element") && !l.starts_with("path"))
-        .map(|l| {
-            l.split(|c: char| !(c.is_ascii_digit() || c == '.'))
-                .filter(|t| t.chars().any(|c| c.is_ascii_digit()))
-                .count()
-        })
+        .map(literals)
         .sum()
+}
+
+/// The number literals on a line: runs of digits and points not inside a
+/// name (`P1_N` is a name, not the number 1).
+fn literals(line: &str) -> usize {
+    let chars: Vec<char> = line.chars().collect();
+    let word: fn(char) -> bool = |c| c.is_alphanumeric() || c == '_';
+    let (mut i, mut count) = (0, 0);
+    while i < chars.len() {
+        let run: fn(char) -> bool = if chars[i].is_ascii_digit() {
+            count += 1;
+            |c| c.is_ascii_digit() || c == '.'
+        } else if word(chars[i]) {
+            word
+        } else {
+            i += 1;
+            continue;
+        };
+        while i < chars.len() && run(chars[i]) {
+            i += 1;
+        }
+    }
+    count
 }
 
 /// The mean distance from each of `places` (where the drawing's elements'
@@ -71,6 +91,8 @@ mod tests {
         let text = "// 3 rules\nelement A { path \"M0 0 L1 2 Z\"; }\nconst N = 12;\n\
                     lsystem S {\n    derive N + 1;\n    axiom f(2.5)+(90) A;\n}\n";
         assert_eq!(numbers(text), 4);
+        let names = "lsystem S {\n    axiom P2(P2_N) f(0.5) Q1;\n}\n";
+        assert_eq!(numbers(names), 1);
     }
 
     #[test]

@@ -377,16 +377,27 @@ impl Instancing {
                 continue;
             }
             let points: Vec<DVec2> = members.iter().map(|&i| self.of[i].1.pos).collect();
-            let index = crate::geometry::index::PointGrid::new(&points);
-            let mean = points.iter().sum::<DVec2>() / points.len() as f64;
-            for (a, &i) in members.iter().enumerate() {
-                let from = match facing {
-                    Facing::Neighbour => index.nearest(points[a], 2).into_iter().find(|&b| b != a),
-                    Facing::Out => None,
-                };
-                let d = points[a] - from.map_or(mean, |b| points[b]);
-                if d.length_squared() > 0.0 {
-                    out.of[i].1.rot = (-d.x).atan2(d.y);
+            let heads = match facing {
+                Facing::Path => along_path(&points),
+                _ => {
+                    let index = crate::geometry::index::PointGrid::new(&points);
+                    let mean = points.iter().sum::<DVec2>() / points.len() as f64;
+                    (0..points.len())
+                        .map(|a| {
+                            let from = match facing {
+                                Facing::Neighbour => {
+                                    index.nearest(points[a], 2).into_iter().find(|&b| b != a)
+                                }
+                                _ => None,
+                            };
+                            heading(points[a] - from.map_or(mean, |b| points[b]))
+                        })
+                        .collect()
+                }
+            };
+            for (&i, head) in members.iter().zip(heads) {
+                if let Some(rot) = head {
+                    out.of[i].1.rot = rot;
                 }
             }
             out.kinds[k].frame.rot = out.of[kind.representative].1.rot;
@@ -414,6 +425,73 @@ pub enum Facing {
     Neighbour,
     /// Away from the mean place of its kind.
     Out,
+    /// The way the path through its kind runs (`along_path`).
+    Path,
+}
+
+/// The turtle heading (local +y) along `d`; `None` for no direction.
+fn heading(d: DVec2) -> Option<f64> {
+    (d.length_squared() > 0.0).then(|| (-d.x).atan2(d.y))
+}
+
+/// Headings along the nearest-neighbour tree of `points` read from one of
+/// its ends: each point heads the way it was reached (away from its parent),
+/// the end itself as the turning of the three steps after it continues
+/// (a chain of discs whose turn changes step by step reads as a turtle
+/// walking it, the same change at every step). `None` where a point
+/// coincides with its parent.
+fn along_path(points: &[DVec2]) -> Vec<Option<f64>> {
+    const NEIGHBOURS: usize = 6;
+    let n = points.len();
+    let mut next: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (a, b) in nearest_first(points, NEIGHBOURS) {
+        next[a].push(b);
+        next[b].push(a);
+    }
+    // Breadth first from `root`: each point's parent, and the last reached.
+    let walk = |root: usize| {
+        let mut parent = vec![usize::MAX; n];
+        let mut queue = std::collections::VecDeque::from([root]);
+        parent[root] = root;
+        let mut last = root;
+        while let Some(v) = queue.pop_front() {
+            last = v;
+            for &w in &next[v] {
+                if parent[w] == usize::MAX {
+                    parent[w] = v;
+                    queue.push_back(w);
+                }
+            }
+        }
+        (parent, last)
+    };
+    let (_, end) = walk(0);
+    let (parent, _) = walk(end);
+    let mut heads: Vec<Option<f64>> = (0..n)
+        .map(|v| match parent[v] {
+            p if p == v || p == usize::MAX => None,
+            p => heading(points[v] - points[p]),
+        })
+        .collect();
+    // The end heads as the turning continued backwards: with h1, h2, h3
+    // the headings of the three points after it, h0 = h1 − (2(h2 − h1) −
+    // (h3 − h2)).
+    let only = |v: usize| match next[v].as_slice() {
+        [w] => Some(*w),
+        [a, b] if parent[*a] == v && parent[*b] != v => Some(*a),
+        [a, b] if parent[*b] == v && parent[*a] != v => Some(*b),
+        _ => None,
+    };
+    let chain = only(end).and_then(|c1| {
+        let c2 = only(c1)?;
+        let c3 = only(c2)?;
+        Some((heads[c1]?, heads[c2]?, heads[c3]?))
+    });
+    heads[end] = match chain {
+        Some((h1, h2, h3)) => Some(wrap(h1 - (2.0 * wrap(h2 - h1) - wrap(h3 - h2)))),
+        None => next[end].first().and_then(|&c| heads[c]),
+    };
+    heads
 }
 
 /// Subpaths with every point mapped by `f`.
