@@ -24,10 +24,10 @@ const PER_CLASS: u64 = 20;
 const FLOORS: &[(Class, [usize; 5])] = &[
     (Class::Row, [20, 20, 20, 20, 20]),
     (Class::Ring, [20, 20, 20, 20, 20]),
-    (Class::Spiral, [20, 19, 20, 18, 19]),
+    (Class::Spiral, [20, 20, 20, 20, 20]),
     (Class::Period, [20, 20, 20, 20, 20]),
     (Class::Grid, [20, 20, 20, 20, 19]),
-    (Class::Linear, [20, 17, 20, 8, 3]),
+    (Class::Linear, [20, 20, 20, 11, 3]),
     (Class::Tree, [20, 16, 19, 16, 12]),
 ];
 
