@@ -146,7 +146,7 @@ pub fn check(case: &Case, variant: Variant) -> Outcome {
 /// (Redraws, why it is not exact.) `rigid`: the drawing does not say where
 /// the design starts (its copies are in random order), so a next moved
 /// rigidly predicts as well (a row extended at its other end), and so does
-/// a row or spiral extended before its first copy.
+/// a sequence extended at its other end (`Design::before`), moved rigidly.
 fn judge(case: &Case, program: &str, slack: f64, rigid: bool) -> (bool, Option<Fail>) {
     let fail = |kind, detail| Some(Fail { kind, detail });
     let level = case.truth(&case.design.level);
@@ -171,7 +171,9 @@ fn judge(case: &Case, program: &str, slack: f64, rigid: bool) -> (bool, Option<F
     let next = case.truth(&case.design.next);
     let before = case.truth(&case.design.before);
     let from_start = |d: &[u8]| {
-        rigid && !case.design.before.is_empty() && same(before.as_bytes(), d, slack).is_ok()
+        rigid
+            && !case.design.before.is_empty()
+            && congruent(before.as_bytes(), d, slack, rigid).is_ok()
     };
     match run(program, &defines) {
         Ok(d) if from_start(&d) => (true, None),

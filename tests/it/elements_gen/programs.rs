@@ -107,9 +107,9 @@ pub struct Design {
     pub shapes: Vec<Shape>,
     pub level: Vec<Place>,
     pub next: Vec<Place>,
-    /// For a sequence of one step (rows, spirals): the design extended at
-    /// its start instead, as a reading from its other end predicts (empty
-    /// for the other classes).
+    /// For a sequence (rows, spirals, linear changes): the design extended
+    /// at its other end instead, as a reading from its other end predicts
+    /// (empty for the other classes).
     pub before: Vec<Place>,
     /// The design as a person would write it, for failure reports.
     pub text: String,
@@ -292,8 +292,23 @@ impl Plan {
         }
     }
 
-    /// The design with one more copy before its first (rows and spirals).
+    /// The design with one more copy at its other end: before its first
+    /// (rows and spirals), or after its last with the counter run down to
+    /// 0 (linear changes: read from the last copy, the change runs the
+    /// other way and one more copy comes at that end).
     fn before(&self) -> Vec<Place> {
+        if self.class == Class::Linear {
+            let mut out = self.sequence(self.count);
+            let mut t = Turtle::new(self.origin, self.heading);
+            for k in 0..self.count {
+                let m = (self.count - 1 - k) as f64;
+                t.forward(self.step + self.step2 * m);
+                t.scale *= self.scale;
+                t.heading += self.turn + self.turn2 * m;
+            }
+            out.push(t.place(0));
+            return out;
+        }
         if !matches!(self.class, Class::Row | Class::Spiral) {
             return Vec::new();
         }
