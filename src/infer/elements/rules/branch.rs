@@ -312,6 +312,7 @@ pub(super) fn branching(
             ts,
             tip_at,
         },
+        hidden: false,
     })
 }
 

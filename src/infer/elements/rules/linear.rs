@@ -153,6 +153,30 @@ pub(super) fn linear(
     Ok(best)
 }
 
+/// Linear rules for the chains of a constant sequence (`chains`, longest
+/// first, each of four instances at least), turning and growing: a
+/// relaxed reading (`--symmetrize`) links a chain whose turn or step
+/// changes by less per step than its tolerance, and whose changes vary with
+/// the drawing's noise more than the search for linear chains allows; a
+/// fit to the whole chain still finds the change (`hidden_change` in the
+/// choice says which wins).
+pub(super) fn refit(
+    insts: &[Inst],
+    edges: &[Edge],
+    index: &Index,
+    chains: &[Vec<usize>],
+    tol: Tolerance,
+) -> Vec<Candidate> {
+    let long: Vec<Vec<usize>> = chains.iter().filter(|c| c.len() >= 4).cloned().collect();
+    if long.is_empty() {
+        return Vec::new();
+    }
+    [Vary::Turn, Vary::Grow]
+        .into_iter()
+        .filter_map(|vary| rule(insts, edges, index, long.clone(), tol, vary))
+        .collect()
+}
+
 /// More pairs; at a tie, chains that follow the drawing's order.
 fn better(a: &Candidate, b: &Candidate) -> bool {
     let forward = |c: &Candidate| match &c.plan {

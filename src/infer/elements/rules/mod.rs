@@ -286,6 +286,9 @@ struct Candidate {
     h: f64,
     /// Similarity of the two kinds.
     phi: f64,
+    /// A constant sequence refitted as a linear change: chosen only in the
+    /// sequence's place (`hidden_change`).
+    hidden: bool,
 }
 
 /// Edges by their two ends.
@@ -293,6 +296,10 @@ type Index = CellMap<(usize, usize), usize>;
 
 /// The largest change of a turn per step of a linear sequence, radians.
 const LINEAR_STEP_MAX: f64 = 30.0 * std::f64::consts::PI / 180.0;
+
+/// Constant sequences of a kind (the most pairs first) refitted as linear
+/// changes per round, with `--symmetrize`.
+const REFITS: usize = 3;
 
 /// Neighbours compared per instance.
 const NEIGHBOURS: usize = 8;
@@ -374,7 +381,7 @@ pub fn infer(
         let edges = edges(&insts, &live, diagonal);
         let (mut candidates, clusters) = candidates(&insts, &edges, tol, &mut budget)?;
         g.clusters += clusters;
-        let best = choose(&insts, &mut candidates, weights);
+        let best = choose(&insts, &mut candidates, weights, tol);
         match best {
             Some(c) if c.pairs >= 2 => apply(&mut g, &mut insts, c.plan, tol),
             _ => pair_up(&mut g, &mut insts, &edges, tol),
@@ -527,6 +534,25 @@ fn candidates(
             .par_iter()
             .map(|group| sequence(insts, edges, &index, group, a == b, tol, phi, near.as_ref()))
             .collect();
+        if tol.regular && a == b {
+            // The longest constant sequences, fitted as linear changes too.
+            let mut seqs: Vec<&Candidate> = found
+                .iter()
+                .flatten()
+                .filter(|c| matches!(c.plan, Plan::Seq { delta: None, .. }))
+                .collect();
+            seqs.sort_by(|x, y| y.pairs.cmp(&x.pairs));
+            seqs.truncate(REFITS);
+            let refits: Vec<Candidate> = seqs
+                .par_iter()
+                .flat_map_iter(|c| match &c.plan {
+                    Plan::Seq { chains, .. } => linear::refit(insts, edges, &index, chains, tol),
+                    _ => Vec::new(),
+                })
+                .map(|c| Candidate { hidden: true, ..c })
+                .collect();
+            out.extend(refits);
+        }
         out.extend(found.into_iter().flatten());
         if a == b {
             // Branchings: two or three clusters of one kind, each node with
@@ -875,6 +901,7 @@ fn seq_candidate(
             place: None,
             fitted: None,
         },
+        hidden: false,
     })
 }
 
@@ -884,7 +911,15 @@ const TIE: f64 = 0.005;
 
 /// The most important candidate; between equals, the one whose links run
 /// most in the drawing's order (a ring read as it was drawn, not backwards).
-fn choose(insts: &[Inst], cands: &mut Vec<Candidate>, w: Weights) -> Option<Candidate> {
+fn choose(
+    insts: &[Inst],
+    cands: &mut Vec<Candidate>,
+    w: Weights,
+    tol: Tolerance,
+) -> Option<Candidate> {
+    let (mut hidden, rest): (Vec<Candidate>, Vec<Candidate>) =
+        std::mem::take(cands).into_iter().partition(|c| c.hidden);
+    *cands = rest;
     let max_n = cands.iter().map(|c| c.pairs).max()? as f64;
     let max_l = cands.iter().map(|c| c.length).fold(0.0, f64::max);
     let score = |c: &Candidate| {
@@ -948,7 +983,78 @@ fn choose(insts: &[Inst], cands: &mut Vec<Candidate>, w: Weights) -> Option<Cand
             best = p;
         }
     }
+    if let Some(l) = hidden_change(insts, &cands[best], &hidden, tol) {
+        return Some(hidden.swap_remove(l));
+    }
     Some(cands.swap_remove(best))
+}
+
+/// A linear candidate that draws most of a constant sequence's chain
+/// (`best`) with a change the tolerance hides: its turn, step or scale
+/// changes over the chain by more than the tolerance allows between two
+/// copies, and it puts the copies nearer than the constant one does (the
+/// variance about it under a ninth of the constant fit's). A relaxed
+/// reading (`--symmetrize`) takes a turn that grows by 2° a step for a
+/// constant one; the change is what the drawing shows, and a noisy row
+/// stays a row.
+fn hidden_change(
+    insts: &[Inst],
+    best: &Candidate,
+    cands: &[Candidate],
+    tol: Tolerance,
+) -> Option<usize> {
+    let Plan::Seq {
+        chains,
+        t: constant,
+        delta: None,
+        ..
+    } = &best.plan
+    else {
+        return None;
+    };
+    let members: HashSet<usize> = chains.iter().flatten().copied().collect();
+    let shows = |c: &Candidate| {
+        let Plan::Seq {
+            chains,
+            t,
+            delta: Some(d),
+            ..
+        } = &c.plan
+        else {
+            return false;
+        };
+        let steps = chains
+            .iter()
+            .map(Vec::len)
+            .max()
+            .unwrap_or(1)
+            .saturating_sub(1) as f64;
+        let shared = chains
+            .iter()
+            .flatten()
+            .filter(|i| members.contains(i))
+            .count();
+        shared * 5 >= members.len() * 4
+            && c.pairs * 5 >= best.pairs * 4
+            && ((d.alpha + d.beta).abs() * steps > tol.angle
+                || d.d.abs() * steps > tol.distance * t.d.abs()
+                || d.s.abs() * steps > tol.scale * t.s.abs())
+    };
+    let mut shown: Vec<usize> = (0..cands.len()).filter(|&i| shows(&cands[i])).collect();
+    if shown.is_empty() {
+        return None;
+    }
+    let spread =
+        regular::sequence(insts, chains, constant, tol).map_or(f64::INFINITY, |r| r.sigma2);
+    shown.retain(|&i| match &cands[i].plan {
+        Plan::Seq {
+            fitted: Some(r), ..
+        } => r.sigma2 * 9.0 < spread,
+        _ => false,
+    });
+    shown
+        .into_iter()
+        .max_by(|&x, &y| cands[x].pairs.cmp(&cands[y].pairs).then(y.cmp(&x)))
 }
 
 fn union_box(insts: &[Inst], ids: impl IntoIterator<Item = usize>) -> (DVec2, DVec2) {
