@@ -27,7 +27,7 @@ const FLOORS: &[(Class, [usize; 5])] = &[
     (Class::Spiral, [20, 20, 20, 20, 20]),
     (Class::Period, [20, 20, 20, 20, 20]),
     (Class::Grid, [20, 20, 20, 20, 19]),
-    (Class::Linear, [20, 20, 20, 20, 3]),
+    (Class::Linear, [20, 20, 20, 20, 9]),
     (Class::Tree, [20, 16, 19, 16, 12]),
 ];
 
