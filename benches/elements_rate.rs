@@ -79,7 +79,13 @@ fn main() {
         }
         if show {
             let verdict = if o.exact { "exact" } else { "not exact" };
-            println!("== {name}: {verdict}\n{}\n{}", case.design.text, o.program);
+            let noise = o.noise.map_or(String::new(), |(i, p)| {
+                format!(" (copies off the clean design: drawing {i:.3}, program {p:.3})")
+            });
+            println!(
+                "== {name}: {verdict}{noise}\n{}\n{}",
+                case.design.text, o.program
+            );
         }
         if let Some(f) = &o.fail {
             println!(

@@ -107,6 +107,11 @@ pub struct Outcome {
     /// `0.99998`, `-0.001`).
     pub clean: bool,
     pub program: String,
+    /// A jittered drawing whose program draws as many copies: how far the
+    /// drawing's copies are from the clean design's, and the program's
+    /// (mean outline distance): `--symmetrize` regularizes when the second
+    /// is no more than the first.
+    pub noise: Option<(f64, f64)>,
 }
 
 /// Infers `case` drawn in `variant` and checks the program.
@@ -123,6 +128,7 @@ pub fn check(case: &Case, variant: Variant) -> Outcome {
         ratio: 0.0,
         clean: false,
         program: String::new(),
+        noise: None,
     };
     let program = match program {
         Ok(p) => p,
@@ -139,6 +145,9 @@ pub fn check(case: &Case, variant: Variant) -> Outcome {
     o.fail = judged.1;
     o.exact = o.fail.is_none();
     o.clean = o.exact && blurred.is_empty();
+    if variant == Variant::Jittered {
+        o.noise = noise(case, svg.as_bytes(), &program);
+    }
     o.program = program;
     o
 }
@@ -296,6 +305,40 @@ fn copies(svg: &[u8]) -> Result<Vec<Copy>, String> {
         .collect())
 }
 
+/// How far the copies of `drawing` and of what `program` draws are from
+/// the clean design's, each a mean over the design's copies; `None` unless
+/// both hold as many copies as the design.
+fn noise(case: &Case, drawing: &[u8], program: &str) -> Option<(f64, f64)> {
+    let truth = copies(case.truth(&case.design.level).as_bytes()).ok()?;
+    let input = mean_off(&truth, &copies(drawing).ok()?)?;
+    let output = mean_off(&truth, &copies(&run(program, &[]).ok()?).ok()?)?;
+    Some((input, output))
+}
+
+/// The mean over `t`'s copies of the outline distance to the nearest of
+/// `d`'s (as `same_copies` finds it); `None` for another count.
+fn mean_off(t: &[Copy], d: &[Copy]) -> Option<f64> {
+    if t.len() != d.len() || t.is_empty() {
+        return None;
+    }
+    let sum: f64 = t
+        .iter()
+        .map(|c| {
+            let mut near: Vec<&Copy> = d.iter().collect();
+            near.sort_by(|a, b| {
+                a.centre
+                    .distance(c.centre)
+                    .total_cmp(&b.centre.distance(c.centre))
+            });
+            near.iter()
+                .take(4)
+                .map(|n| hausdorff(&c.outline, &n.outline).max(hausdorff(&n.outline, &c.outline)))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .sum();
+    Some(sum / t.len() as f64)
+}
+
 /// Whether `drawn` holds the copies of `truth` (see `same_copies`).
 fn same(truth: &[u8], drawn: &[u8], slack: f64) -> Result<(), String> {
     same_copies(&copies(truth)?, &copies(drawn)?, slack)
@@ -402,6 +445,12 @@ pub struct Cell {
     pub ms: Vec<f64>,
     pub ratios: Vec<f64>,
     pub clean: usize,
+    /// Jittered drawings measured (`Outcome::noise`), those whose program
+    /// is no farther from the clean design than the drawing, and each
+    /// program's distance over the drawing's.
+    pub measured: usize,
+    pub closer: usize,
+    pub shrink: Vec<f64>,
     /// Failure kind → (seed, detail).
     pub fails: BTreeMap<&'static str, Vec<(u64, String)>>,
 }
@@ -421,6 +470,11 @@ impl Table {
         c.ms.push(o.ms);
         c.ratios.push(o.ratio);
         c.clean += usize::from(o.clean);
+        if let Some((input, output)) = o.noise {
+            c.measured += 1;
+            c.closer += usize::from(output <= input);
+            c.shrink.push(output / input.max(1e-12));
+        }
         if let Some(f) = &o.fail {
             c.fails
                 .entry(f.kind)
@@ -477,6 +531,19 @@ impl Table {
             let max = c.ms.iter().copied().fold(0.0, f64::max);
             format!("{:.0} / {max:.0}", median(&c.ms))
         });
+        if variants.contains(&Variant::Jittered) {
+            out.push_str("\n--symmetrize on jittered drawings: programs no farther from the clean design than the drawing / measured, median program distance / drawing distance\n");
+            for &c in &classes {
+                let cell = self.get(c, Variant::Jittered);
+                out.push_str(&format!(
+                    "{:<8}{:>8}/{:<4}{:>8.2}\n",
+                    c.name(),
+                    cell.closer,
+                    cell.measured,
+                    median(&cell.shrink)
+                ));
+            }
+        }
         out.push_str("\nfailures by kind\n");
         for ((c, v), cell) in &self.cells {
             for (kind, seeds) in &cell.fails {

@@ -135,7 +135,11 @@ pub(super) fn sequence(
         &mut p,
         tol,
         Some(longest),
-        Loose { rep, same },
+        Loose {
+            rep,
+            same,
+            deep: false,
+        },
     );
     Regular {
         t: vec![transform(&p)],
@@ -193,7 +197,11 @@ pub(super) fn branching(
     };
     let mut p: Vec<f64> = ts.iter().flat_map(params).collect();
     p.push(0.0);
-    let loose = Loose { rep, same: true };
+    let loose = Loose {
+        rep,
+        same: true,
+        deep: true,
+    };
     let sol = snap(&members, trees.len(), &model, &mut p, tol, None, loose);
     Regular {
         t: (0..k).map(|i| transform(&p[4 * i..4 * i + 4])).collect(),
@@ -214,6 +222,10 @@ pub(super) fn branching(
 struct Loose {
     rep: bool,
     same: bool,
+    /// A tree: a turn is drawn again at every level below it, so it is
+    /// only as uncertain as the fit says (an element's own rotation does
+    /// not loosen it).
+    deep: bool,
 }
 
 /// Fits `p` (one or more transforms, four numbers each, then the tilt) and
@@ -280,7 +292,7 @@ fn snap(
                 continue;
             };
             let (sol, se) = fit.result(p, &free);
-            let one = if loose.rep && (offset == 0 || (offset == 3 && !loose.same)) {
+            let one = if loose.rep && !loose.deep && (offset == 0 || (offset == 3 && !loose.same)) {
                 sol.rot_rms
             } else {
                 0.0
