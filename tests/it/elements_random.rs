@@ -28,8 +28,13 @@ const FLOORS: &[(Class, [usize; 5])] = &[
     (Class::Period, [20, 20, 20, 20, 20]),
     (Class::Grid, [20, 20, 20, 20, 19]),
     (Class::Linear, [20, 20, 20, 20, 9]),
-    (Class::Tree, [20, 16, 19, 16, 12]),
+    (Class::Tree, [20, 16, 19, 16, 16]),
 ];
+
+/// Jittered drawings, per class in the order of `FLOORS`, whose
+/// `--symmetrize` program is no farther from the clean design than the
+/// drawing (`Cell::closer`): a ratchet on "--symmetrize only regularizes".
+const CLOSER: [usize; 7] = [20, 20, 20, 19, 20, 15, 14];
 
 #[test]
 fn random_designs_are_inferred_at_least_as_often_as_before() {
@@ -58,7 +63,16 @@ fn random_designs_are_inferred_at_least_as_often_as_before() {
     eprintln!("{}", table.render());
     eprintln!("{:.1} s", start.elapsed().as_secs_f64());
     let mut below = Vec::new();
-    for &(class, floors) in FLOORS {
+    for (&(class, floors), closer) in FLOORS.iter().zip(CLOSER) {
+        let cell = table.get(class, Variant::Jittered);
+        if cell.closer < closer {
+            below.push(format!(
+                "{} jittered: --symmetrize programs no farther from the clean design than the drawing in {}/{}, floor {closer}",
+                class.name(),
+                cell.closer,
+                cell.measured
+            ));
+        }
         for (v, floor) in Variant::ALL.into_iter().zip(floors) {
             let cell = table.get(class, v);
             if cell.exact < floor {
