@@ -993,7 +993,8 @@ fn choose(
 /// (`best`) with a change the tolerance hides: its turn, step or scale
 /// changes over the chain by more than the tolerance allows between two
 /// copies, and it puts the copies nearer than the constant one does (the
-/// variance about it under a ninth of the constant fit's). A relaxed
+/// mean square of how far and how much larger or smaller it draws them
+/// under a ninth of the constant fit's). A relaxed
 /// reading (`--symmetrize`) takes a turn that grows by 2° a step for a
 /// constant one; the change is what the drawing shows, and a noisy row
 /// stays a row.
@@ -1044,12 +1045,31 @@ fn hidden_change(
     if shown.is_empty() {
         return None;
     }
-    let spread =
-        regular::sequence(insts, chains, constant, tol).map_or(f64::INFINITY, |r| r.sigma2);
+    // How far a fit draws its members from where they are: the mean
+    // square of the distance and of the size a wrong scale makes up (a
+    // row whose steps shrink linearly fits a geometric sequence by
+    // shrinking copies the drawing does not shrink).
+    let misfit = |chains: &[Vec<usize>], r: &regular::Regular| {
+        let (sum, n) =
+            chains
+                .iter()
+                .flatten()
+                .zip(&r.drawn)
+                .fold((0.0, 0usize), |(sum, n), (&i, d)| {
+                    let f = &insts[i].frame;
+                    let size = 0.5 * insts[i].size() * (f.scale / d.scale).ln();
+                    (sum + f.pos.distance_squared(d.pos) + size * size, n + 1)
+                });
+        sum / n.max(1) as f64
+    };
+    let spread = regular::sequence(insts, chains, constant, tol)
+        .map_or(f64::INFINITY, |r| misfit(chains, &r));
     shown.retain(|&i| match &cands[i].plan {
         Plan::Seq {
-            fitted: Some(r), ..
-        } => r.sigma2 * 9.0 < spread,
+            chains,
+            fitted: Some(r),
+            ..
+        } => misfit(chains, r) * 9.0 < spread,
         _ => false,
     });
     shown
