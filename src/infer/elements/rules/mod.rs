@@ -545,8 +545,11 @@ fn candidates(
             seqs.truncate(REFITS);
             let refits: Vec<Candidate> = seqs
                 .par_iter()
-                .flat_map_iter(|c| match &c.plan {
-                    Plan::Seq { chains, .. } => linear::refit(insts, edges, &index, chains, tol),
+                .flat_map_iter(|c| match (&c.plan, near.as_ref()) {
+                    (Plan::Seq { chains, .. }, Some(near)) => {
+                        let chains = extend_changing(insts, chains.clone(), near, tol);
+                        linear::refit(insts, edges, &index, &chains, tol)
+                    }
                     _ => Vec::new(),
                 })
                 .map(|c| Candidate { hidden: true, ..c })
@@ -786,6 +789,65 @@ impl Near {
         let j = *self.ids.get(*self.grid.nearest(want.pos, 1).first()?)?;
         close(&insts[j].frame, want, step, insts[j].size(), tol).then_some(j)
     }
+}
+
+/// Chains of three or more grown at both ends while an instance no chain
+/// holds is where the change between their last (first) two transforms,
+/// continued, puts the next (`--symmetrize`): a constant sequence that
+/// stood for a changing one was cut where the change outgrew it, and its
+/// linear refit takes the copies back.
+fn extend_changing(
+    insts: &[Inst],
+    mut chains: Vec<Vec<usize>>,
+    near: &Near,
+    tol: Tolerance,
+) -> Vec<Vec<usize>> {
+    let mut used: HashSet<usize> = chains.iter().flatten().copied().collect();
+    let between = |a: usize, b: usize| {
+        let f = &insts[a].frame;
+        Tr::between(f, &insts[b].frame, insts[a].size() / f.scale)
+    };
+    // The transform after `a` then `b`, each number changed by as much again.
+    let continued = |a: &Tr, b: &Tr| Tr {
+        alpha: wrap(b.alpha + wrap(b.alpha - a.alpha)),
+        d: 2.0 * b.d - a.d,
+        s: 2.0 * b.s - a.s,
+        beta: wrap(b.beta + wrap(b.beta - a.beta)),
+    };
+    let origin = Frame {
+        pos: DVec2::ZERO,
+        rot: 0.0,
+        scale: 1.0,
+    };
+    for chain in chains.iter_mut().filter(|c| c.len() >= 3) {
+        loop {
+            let n = chain.len();
+            let t = continued(
+                &between(chain[n - 3], chain[n - 2]),
+                &between(chain[n - 2], chain[n - 1]),
+            );
+            let f = insts[chain[n - 1]].frame;
+            if t.d <= 0.0 || t.s <= 0.0 {
+                break;
+            }
+            match near.at(insts, &t.apply(&f), t.d * f.scale, tol) {
+                Some(j) if used.insert(j) => chain.push(j),
+                _ => break,
+            }
+        }
+        loop {
+            let t = continued(&between(chain[1], chain[2]), &between(chain[0], chain[1]));
+            if t.d <= 0.0 || t.s <= 0.0 {
+                break;
+            }
+            let want = insts[chain[0]].frame.then(&t.apply(&origin).inverse());
+            match near.at(insts, &want, t.d * want.scale, tol) {
+                Some(j) if used.insert(j) => chain.insert(0, j),
+                _ => break,
+            }
+        }
+    }
+    chains
 }
 
 /// Chains grown at both ends while the next instance `t` leads to (or the
