@@ -135,19 +135,30 @@ fn inlined(g: &Grammar) -> Vec<bool> {
 fn unit(g: &Grammar, inline: &[bool], s: Sym) -> Vec<(Sym, Frame)> {
     match s {
         Sym::Rule(r, _) if inline[r] => match &g.rules[r].body {
-            Body::Pair { a, t, b } => {
-                let mut out = unit(g, inline, *a);
+            Body::Pair { a, t, b, swap } => {
                 let at = t.apply(&Frame::IDENTITY);
-                out.extend(
-                    unit(g, inline, *b)
-                        .into_iter()
-                        .map(|(x, f)| (x, at.then(&f))),
-                );
-                out
+                let first = unit(g, inline, *a);
+                let second = unit(g, inline, *b)
+                    .into_iter()
+                    .map(|(x, f)| (x, at.then(&f)));
+                in_paint_order(first, second, *swap)
             }
             _ => vec![(s, Frame::IDENTITY)],
         },
         _ => vec![(s, Frame::IDENTITY)],
+    }
+}
+
+/// A pair's two parts in the order the drawing paints them.
+fn in_paint_order(
+    first: Vec<(Sym, Frame)>,
+    second: impl Iterator<Item = (Sym, Frame)>,
+    swap: bool,
+) -> Vec<(Sym, Frame)> {
+    if swap {
+        second.chain(first).collect()
+    } else {
+        first.into_iter().chain(second).collect()
     }
 }
 
@@ -485,8 +496,8 @@ pub fn program(elements: &[Element], inst: &Instancing, g: &Grammar, s: &Setting
                 w.branching(&mut consts, run(g, r), *a, tip, ts)
             }
             // A sequence used only with m = 1 is the pair P -> A T A.
-            Body::Seq { a, t, tip, .. } => w.pair(*a, t, tip.unwrap_or(*a)),
-            Body::Pair { a, t, b } => w.pair(*a, t, *b),
+            Body::Seq { a, t, tip, .. } => w.pair(*a, t, tip.unwrap_or(*a), false),
+            Body::Pair { a, t, b, swap } => w.pair(*a, t, *b, *swap),
         }
     }
     let (axiom, derive) = axiom(elements, g, &names, &count_of, &inline);
@@ -935,15 +946,15 @@ impl RuleWriter<'_> {
         self.add(m_is(BinOp::Eq), last, None);
     }
 
-    /// `Q -> [a] T [b]`, the transform inlined.
-    fn pair(&mut self, a: Sym, t: &Tr, b: Sym) {
-        let mut items = unit(self.g, self.inline, a);
+    /// `Q -> [a] T [b]`, the transform inlined, the parts in the order the
+    /// drawing paints them.
+    fn pair(&mut self, a: Sym, t: &Tr, b: Sym, swap: bool) {
         let at = t.apply(&Frame::IDENTITY);
-        items.extend(
-            unit(self.g, self.inline, b)
-                .into_iter()
-                .map(|(x, f)| (x, at.then(&f))),
-        );
+        let first = unit(self.g, self.inline, a);
+        let second = unit(self.g, self.inline, b)
+            .into_iter()
+            .map(|(x, f)| (x, at.then(&f)));
+        let items = in_paint_order(first, second, swap);
         let (succ, _) = self.write(&items, 1.0, true);
         let note = match items.len() {
             2 if a == b => format!("{}: two {} (a pair)", self.name, self.describe(a)),

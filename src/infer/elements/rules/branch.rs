@@ -410,9 +410,9 @@ fn tips_at(
         let mut fits: Vec<(f64, usize, usize, Frame, Frame)> = Vec::new();
         for k in outs.of_instance(leaf).filter(|&k| bud(k)) {
             let b = &insts[edges[k].to];
-            for side in 0..tr.len() {
-                let want = tr[side].apply(&f);
-                let step = tr[side].d * f.scale;
+            for (side, t) in tr.iter().enumerate() {
+                let want = t.apply(&f);
+                let step = t.d * f.scale;
                 // The tip's frame where it would sit.
                 let at = want.then(&back);
                 let Some(have) = b
@@ -425,7 +425,7 @@ fn tips_at(
                 let off = want.pos.distance(have.then(rel).pos);
                 // Where the child would be from the leaf as drawn (the
                 // tree's frames drift with depth).
-                let near = tr[side].apply(&insts[leaf].frame);
+                let near = t.apply(&insts[leaf].frame);
                 fits.push((off, side, edges[k].to, have, near));
             }
         }

@@ -66,8 +66,9 @@ pub enum Body {
         /// there (`m == 0 -> [T tip]`).
         tip_at: Option<Frame>,
     },
-    /// `Q -> [a] T [b]`.
-    Pair { a: Sym, t: Tr, b: Sym },
+    /// `Q -> [a] T [b]`; `swap`: the drawing paints `b` first (a flag's
+    /// field before its stars), so the program draws it first.
+    Pair { a: Sym, t: Tr, b: Sym, swap: bool },
 }
 
 #[derive(Clone, Debug)]
@@ -541,7 +542,7 @@ fn candidates(
                 .flatten()
                 .filter(|c| matches!(c.plan, Plan::Seq { delta: None, .. }))
                 .collect();
-            seqs.sort_by(|x, y| y.pairs.cmp(&x.pairs));
+            seqs.sort_by_key(|c| std::cmp::Reverse(c.pairs));
             seqs.truncate(REFITS);
             let refits: Vec<Candidate> = seqs
                 .par_iter()
@@ -1366,6 +1367,12 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
                 && matches!(a, Sym::Rule(q, _)
                     if g.rules[q].repeats() && matches!(g.rules[q].body, Body::Seq { .. }));
             let m = u32::from(nested);
+            // Which part the drawing paints first, in most pairs.
+            let later = pairs
+                .iter()
+                .filter(|&&(x, y)| insts[y].order < insts[x].order)
+                .count();
+            let swap = later * 2 > pairs.len();
             // Pairs of one cluster are a repeated structure; a lone pair is not.
             let reg = (tol.regular && pairs.len() >= 2)
                 .then(|| {
@@ -1397,7 +1404,7 @@ fn apply(g: &mut Grammar, insts: &mut Vec<Inst>, plan: Plan, tol: Tolerance) {
                     tip: None,
                 }
             } else {
-                Body::Pair { a, t, b }
+                Body::Pair { a, t, b, swap }
             };
             g.rules.push(Rule {
                 body,
