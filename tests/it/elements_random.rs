@@ -12,6 +12,7 @@
 //! run is `benches/elements_rate.rs`.
 
 use crate::elements_gen::{self, check::Case, draw::Variant, programs::Class};
+use crate::support::against_floor;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -75,26 +76,13 @@ fn random_designs_are_inferred_at_least_as_often_as_before() {
         }
         for (v, floor) in Variant::ALL.into_iter().zip(floors) {
             let cell = table.get(class, v);
-            if cell.exact < floor {
-                below.push(format!(
-                    "{} {}: {}/{} exact, floor {floor}; not exact:\n  {}",
-                    class.name(),
-                    v.name(),
-                    cell.exact,
-                    cell.total,
-                    failed
-                        .get(&(class, v))
-                        .map_or(String::new(), |f| f.join("\n  "))
-                ));
-            } else if cell.exact > floor {
-                eprintln!(
-                    "{} {}: {}/{} exact, above the floor {floor}: raise it",
-                    class.name(),
-                    v.name(),
-                    cell.exact,
-                    cell.total
-                );
-            }
+            against_floor(
+                &mut below,
+                &format!("{} {}", class.name(), v.name()),
+                (cell.exact, cell.total),
+                floor,
+                failed.get(&(class, v)),
+            );
         }
     }
     assert!(below.is_empty(), "below the floor:\n{}", below.join("\n"));

@@ -105,3 +105,23 @@ pub fn drawing_distance(a: &[u8], b: &[u8]) -> f64 {
     let step = diag / 1500.0;
     chamfer(&drawing_samples(a, step), &drawing_samples(b, step)) / diag
 }
+
+/// One cell of a ratchet (a random generator's count held to a floor):
+/// below the floor, a line for the assertion (with the failures, one a
+/// line); above it, a note to raise the floor.
+pub fn against_floor(
+    below: &mut Vec<String>,
+    cell: &str,
+    (exact, total): (usize, usize),
+    floor: usize,
+    failed: Option<&Vec<String>>,
+) {
+    if exact < floor {
+        below.push(format!(
+            "{cell}: {exact}/{total} exact, floor {floor}; not exact:\n  {}",
+            failed.map_or(String::new(), |f| f.join("\n  "))
+        ));
+    } else if exact > floor {
+        eprintln!("{cell}: {exact}/{total} exact, above the floor {floor}: raise it");
+    }
+}

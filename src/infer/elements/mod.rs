@@ -225,10 +225,10 @@ pub fn from_svg(
     // Round kinds turned along their neighbours, out of their ring or along
     // the path through them, when there are any (in drawings of up to
     // `MAX_REREAD` elements: each reading costs the rules again): the
-    // program with fewer numbers (not names' digits) wins
-    // if it puts the elements where the first does (a spiral of discs steps
-    // alike at every disc, a row keeps the drawing's axes). A reading that
-    // reaches a work limit is left out.
+    // program with fewer numbers (not names' digits) wins if it puts the
+    // elements where the first does (a spiral of discs steps alike at every
+    // disc, a row keeps the drawing's axes). A reading that reaches a work
+    // limit is left out.
     let turned: Vec<Instancing> = [Facing::Neighbour, Facing::Out, Facing::Path]
         .into_iter()
         .filter(|_| drawing.elements.len() <= MAX_REREAD)
