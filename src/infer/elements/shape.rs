@@ -143,6 +143,18 @@ impl Shape {
         h + ((self.perimeter - other.perimeter) / self.perimeter).abs()
     }
 
+    /// Whether the outline can be `k`-fold symmetric: every harmonic whose
+    /// order is not a multiple of `k` is too weak to fix a rotation (a
+    /// star of five points pulled out of true turns into itself by a third
+    /// of a turn within the tolerance, but its fifth harmonic says it is
+    /// not 3-fold).
+    fn turns_alike(&self, k: usize) -> bool {
+        self.harmonics
+            .iter()
+            .enumerate()
+            .all(|(i, m)| (i + 1) % k == 0 || m.length() < SIGNIFICANT)
+    }
+
     /// The first harmonic strong enough to fix a rotation.
     fn order(&self) -> Option<usize> {
         self.harmonics
@@ -663,7 +675,10 @@ pub fn instancing(
     let mut mirrored_by: Vec<bool> = Vec::new();
     let symmetry_of = |sh: &Shape| match sh.order() {
         None => 0,
-        Some(_) => sh.align(sh, tolerance).len().max(1),
+        Some(_) => match sh.align(sh, tolerance).len() {
+            k if k > 1 && sh.turns_alike(k) => k,
+            _ => 1,
+        },
     };
     // Kinds whose frames the drawing gives (a group's kind is its index).
     for g in given_groups(elements) {
@@ -928,5 +943,35 @@ mod tests {
         assert!(a.align(&sq, 0.02).is_empty());
         // A square has four rotations onto itself.
         assert_eq!(sq.align(&sq, 0.02).len(), 4);
+    }
+
+    #[test]
+    fn a_star_pulled_out_of_true_is_not_three_fold() {
+        let id = Frame::IDENTITY;
+        // Public Icons' star (Unlicense): five points, not quite regular.
+        let star = [
+            (41.504, 39.537),
+            (60.062, 0.0),
+            (78.618, 39.538),
+            (120.115, 45.877),
+            (90.088, 76.653),
+            (97.176, 120.107),
+            (60.061, 99.593),
+            (22.946, 120.107),
+            (30.035, 76.653),
+            (0.01, 45.878),
+        ];
+        let sh = Shape::of(&poly(&star, id)).unwrap();
+        assert!(!sh.turns_alike(3), "{:?}", sh.harmonics);
+        let regular: Vec<(f64, f64)> = (0..10)
+            .map(|i| {
+                let r = if i % 2 == 0 { 50.0 } else { 20.0 };
+                let a = (36.0 * i as f64).to_radians();
+                (r * a.sin(), r * a.cos())
+            })
+            .collect();
+        let sh = Shape::of(&poly(&regular, id)).unwrap();
+        assert!(sh.turns_alike(5));
+        assert_eq!(sh.align(&sh, 0.02).len(), 5);
     }
 }
