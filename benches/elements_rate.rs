@@ -78,7 +78,11 @@ fn main() {
             std::fs::write(dir.join(format!("{name}.lsy")), &o.program).expect("writes");
         }
         if show {
-            let verdict = if o.exact { "exact" } else { "not exact" };
+            let verdict = match (o.exact, o.clean) {
+                (true, true) => "exact",
+                (true, false) => "exact, numbers blurred",
+                _ => "not exact",
+            };
             let noise = o.noise.map_or(String::new(), |(i, p)| {
                 format!(" (copies off the clean design: drawing {i:.3}, program {p:.3})")
             });
