@@ -210,8 +210,10 @@ fn infer_program(svg: &str, symmetrize: bool) -> Result<String, Fail> {
 }
 
 /// The numbers of a program, outside its elements' outlines, that lie
-/// within 0.005 % (or 0.0005) of a decimal of at most two places without
-/// being it: what the drawing's rounding left in a number a person writes.
+/// within 0.005 % (or 0.0005) of a short decimal without being it: what the
+/// drawing's rounding left in a number a person writes. A short decimal has
+/// at most two places and four significant digits (`15`, `0.25`, `137.5`;
+/// not `111.33`, which a number of three places is near by chance alone).
 pub fn blurred(program: &str) -> Vec<String> {
     let mut out = Vec::new();
     for line in program.lines() {
@@ -228,7 +230,12 @@ pub fn blurred(program: &str) -> Vec<String> {
             if let Ok(v) = token.parse::<f64>() {
                 let short = (v * 100.0).round() / 100.0;
                 let near = (v - short).abs() <= (5e-5 * short.abs()).max(5e-4);
-                if near && v != short {
+                let digits = format!("{short}")
+                    .chars()
+                    .filter(char::is_ascii_digit)
+                    .collect::<String>();
+                let significant = digits.trim_start_matches('0').trim_end_matches('0').len();
+                if near && v != short && significant <= 4 {
                     out.push(token.clone());
                 }
             }
