@@ -110,7 +110,7 @@ fn every_encoding_of_a_design_holds_its_copies() {
 /// short decimal is blurred; a measured number of three places is not.
 #[test]
 fn blurred_numbers_are_short_decimals_the_drawing_rounded() {
-    let program = "lsystem D {\n    axiom -(24.97) f(111.331)+(89.999) A f(15.0003) *(0.99998) f(0.2501);\n}\n";
+    let program = "lsystem D {\n    axiom -(24.97) f(111.331)+(89.999) A f(15.0003) *(0.99998) f(0.2501) f(66.483);\n}\n";
     let found = elements_gen::check::blurred(program);
     assert_eq!(found, ["89.999", "15.0003", "0.99998", "0.2501"]);
 }

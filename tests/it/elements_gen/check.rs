@@ -212,8 +212,9 @@ fn infer_program(svg: &str, symmetrize: bool) -> Result<String, Fail> {
 /// The numbers of a program, outside its elements' outlines, that lie
 /// within 0.005 % (or 0.0005) of a short decimal without being it: what the
 /// drawing's rounding left in a number a person writes. A short decimal has
-/// at most two places and four significant digits (`15`, `0.25`, `137.5`;
-/// not `111.33`, which a number of three places is near by chance alone).
+/// at most two places and three significant digits (`15`, `0.25`, `22.5`;
+/// not `66.48` or `111.33`, which a measured number of three places, such
+/// as a chord or where the design starts, is near by chance alone).
 pub fn blurred(program: &str) -> Vec<String> {
     let mut out = Vec::new();
     for line in program.lines() {
@@ -235,7 +236,7 @@ pub fn blurred(program: &str) -> Vec<String> {
                     .filter(char::is_ascii_digit)
                     .collect::<String>();
                 let significant = digits.trim_start_matches('0').trim_end_matches('0').len();
-                if near && v != short && significant <= 4 {
+                if near && v != short && significant <= 3 {
                     out.push(token.clone());
                 }
             }
@@ -511,13 +512,13 @@ impl Table {
         let grid = |title: &str, f: &dyn Fn(&Cell) -> String| {
             let mut out = format!("{title}\n{:<8}", "class");
             for v in &variants {
-                out.push_str(&format!("{:>18}", v.name()));
+                out.push_str(&format!("{:>20}", v.name()));
             }
             out.push('\n');
             for &c in &classes {
                 out.push_str(&format!("{:<8}", c.name()));
                 for &v in &variants {
-                    out.push_str(&format!("{:>18}", f(&self.get(c, v))));
+                    out.push_str(&format!("{:>20}", f(&self.get(c, v))));
                 }
                 out.push('\n');
             }
