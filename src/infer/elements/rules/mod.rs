@@ -815,11 +815,6 @@ fn extend_changing(
         s: 2.0 * b.s - a.s,
         beta: wrap(b.beta + wrap(b.beta - a.beta)),
     };
-    let origin = Frame {
-        pos: DVec2::ZERO,
-        rot: 0.0,
-        scale: 1.0,
-    };
     for chain in chains.iter_mut().filter(|c| c.len() >= 3) {
         loop {
             let n = chain.len();
@@ -841,7 +836,9 @@ fn extend_changing(
             if t.d <= 0.0 || t.s <= 0.0 {
                 break;
             }
-            let want = insts[chain[0]].frame.then(&t.apply(&origin).inverse());
+            let want = insts[chain[0]]
+                .frame
+                .then(&t.apply(&Frame::IDENTITY).inverse());
             match near.at(insts, &want, t.d * want.scale, tol) {
                 Some(j) if used.insert(j) => chain.insert(0, j),
                 _ => break,
@@ -1057,10 +1054,9 @@ fn choose(
 /// changes over the chain by more than the tolerance allows between two
 /// copies, and it puts the copies nearer than the constant one does (the
 /// mean square of how far and how much larger or smaller it draws them
-/// under a ninth of the constant fit's). A relaxed
-/// reading (`--symmetrize`) takes a turn that grows by 2° a step for a
-/// constant one; the change is what the drawing shows, and a noisy row
-/// stays a row.
+/// under a ninth of the constant fit's). A relaxed reading (`--symmetrize`)
+/// takes a turn that grows by 2° a step for a constant one; the change is
+/// what the drawing shows, and a noisy row stays a row.
 fn hidden_change(
     insts: &[Inst],
     best: &Candidate,
