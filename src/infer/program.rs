@@ -95,18 +95,31 @@ pub(crate) fn file(items: Vec<Node<Item>>) -> File {
 /// draws it into `sink`, as `lsyc run` does (seed 0): how inference checks
 /// what a program it wrote draws. `None` if it does not run.
 pub(crate) fn draw(text: &str, more: u32, sink: &mut dyn crate::turtle::Sink) -> Option<()> {
+    draw_compiled(&compiled(text)?, more, sink)
+}
+
+/// The program `text` compiled; `None` if it has errors.
+pub(crate) fn compiled(text: &str) -> Option<crate::compile::Program> {
     let fe = crate::frontend::run(text, Vec::new(), &[]);
     if fe.has_errors() {
         return None;
     }
     let checked = fe.checked.as_ref()?;
-    let prog = crate::compile::compile(&fe.file, checked, None).ok()?;
+    crate::compile::compile(&fe.file, checked, None).ok()
+}
+
+/// `draw` for a compiled program.
+pub(crate) fn draw_compiled(
+    prog: &crate::compile::Program,
+    more: u32,
+    sink: &mut dyn crate::turtle::Sink,
+) -> Option<()> {
     let limits = crate::derive::Limits::default();
-    let axiom = crate::derive::axiom(&prog, &vec![0.0; prog.params.len()], 0).ok()?;
+    let axiom = crate::derive::axiom(prog, &vec![0.0; prog.params.len()], 0).ok()?;
     let steps = prog.derive.checked_add(more)?;
-    let string = crate::derive::derive(&prog, axiom, steps, 0, limits, &|_, _| {}).ok()?;
+    let string = crate::derive::derive(prog, axiom, steps, 0, limits, &|_, _| {}).ok()?;
     let state = crate::turtle::State::default();
-    crate::turtle::interpret_limited(&prog, &string, 0, state, limits, sink)
+    crate::turtle::interpret_limited(prog, &string, 0, state, limits, sink)
         .ok()
         .map(|_| ())
 }

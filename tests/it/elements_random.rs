@@ -29,7 +29,7 @@ const FLOORS: &[(Class, [usize; 5])] = &[
     (Class::Period, [20, 20, 20, 20, 20]),
     (Class::Grid, [20, 20, 20, 20, 19]),
     (Class::Linear, [20, 20, 20, 20, 16]),
-    (Class::Tree, [20, 16, 19, 16, 16]),
+    (Class::Tree, [20, 19, 19, 19, 16]),
 ];
 
 /// Jittered drawings, per class in the order of `FLOORS`, whose

@@ -8,6 +8,7 @@
 //! elements it draws are from the drawing's (`misfit`, by deriving and
 //! drawing it as `lsyc run` does). Must not infer.
 
+use crate::infer::svg::Seg;
 use crate::turtle::Sink;
 use glam::{DVec2, DVec3};
 
@@ -44,9 +45,10 @@ fn literals(line: &str) -> usize {
     count
 }
 
-/// The mean distance from each of `places` (where the drawing's elements'
-/// frames are) to the nearest element the program `text` draws; `None` if
-/// it does not run or draws another number of elements.
+/// The mean distance from each of `places` (the drawing's elements'
+/// [`mean_point`]s) to the nearest element the program `text` draws
+/// ([`drawn`]); `None` if it does not run or draws another number
+/// of elements.
 pub fn misfit(text: &str, places: &[DVec2]) -> Option<f64> {
     let drawn = drawn(text)?;
     if drawn.len() != places.len() || places.is_empty() {
@@ -64,21 +66,76 @@ pub fn misfit(text: &str, places: &[DVec2]) -> Option<f64> {
     Some(sum / places.len() as f64)
 }
 
-/// Where the program `text` draws its elements (seed 0).
-fn drawn(text: &str) -> Option<Vec<DVec2>> {
-    let mut sink = Places::default();
-    crate::infer::program::draw(text, 0, &mut sink)?;
-    Some(sink.0)
+/// Where the program `text` draws its elements (seed 0): for each, the
+/// mean of its outline's points (`path_centroid`), which moves with the
+/// outline whichever frame a program gives the element's path.
+pub fn drawn(text: &str) -> Option<Vec<DVec2>> {
+    let prog = crate::infer::program::compiled(text)?;
+    let means = prog
+        .elements
+        .iter()
+        .map(|e| path_centroid(&e.path).unwrap_or(DVec2::ZERO))
+        .collect();
+    let mut sink = Places {
+        means,
+        at: Vec::new(),
+    };
+    crate::infer::program::draw_compiled(&prog, 0, &mut sink)?;
+    Some(sink.at)
 }
 
-#[derive(Default)]
-struct Places(Vec<DVec2>);
+/// [`mean_point`] of SVG path data.
+fn path_centroid(d: &str) -> Option<DVec2> {
+    use kurbo::PathEl;
+    let at = |p: kurbo::Point| DVec2::new(p.x, p.y);
+    let path = crate::path::parse(d).ok()?;
+    mean_point(path.elements().iter().map(|el| match *el {
+        PathEl::MoveTo(a) => Seg::Move(at(a)),
+        PathEl::LineTo(a) => Seg::Line(at(a)),
+        PathEl::QuadTo(a, c) => Seg::Quad(at(a), at(c)),
+        PathEl::CurveTo(a, c, e) => Seg::Cubic(at(a), at(c), at(e)),
+        PathEl::ClosePath => Seg::Close,
+    }))
+}
+
+/// The mean of an outline's points, control points included and each
+/// subpath's closing point (its start again) left out: the same for an
+/// outline written from any of its points, and the centre of a round one.
+pub fn mean_point(segs: impl IntoIterator<Item = Seg>) -> Option<DVec2> {
+    let mut points: Vec<DVec2> = Vec::new();
+    let mut start = 0;
+    for seg in segs {
+        match seg {
+            Seg::Move(a) => {
+                start = points.len();
+                points.push(a);
+            }
+            Seg::Line(a) => points.push(a),
+            Seg::Quad(a, c) => points.extend([a, c]),
+            Seg::Cubic(a, c, e) => points.extend([a, c, e]),
+            Seg::Close => {
+                if points.len() > start + 1 && points.last() == points.get(start) {
+                    points.pop();
+                }
+            }
+        }
+    }
+    (!points.is_empty()).then(|| crate::geometry::mean(&points))
+}
+
+struct Places {
+    /// Per element definition: its centroid in its own frame.
+    means: Vec<DVec2>,
+    at: Vec<DVec2>,
+}
 
 impl Sink for Places {
     fn segment(&mut self, _a: DVec3, _b: DVec3, _width: f64, _color: u32) {}
     fn polygon(&mut self, _points: &[DVec3], _color: u32) {}
-    fn element(&mut self, _i: u16, at: DVec3, _h: DVec3, _l: DVec3, _s: f64, _c: u32) {
-        self.0.push(at.truncate());
+    fn element(&mut self, i: u16, at: DVec3, h: DVec3, l: DVec3, s: f64, _c: u32) {
+        let m = self.means.get(usize::from(i)).copied().unwrap_or_default();
+        let p = at + (-l * m.x + h * m.y) * s;
+        self.at.push(p.truncate());
     }
 }
 

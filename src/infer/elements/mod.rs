@@ -229,14 +229,18 @@ pub fn from_svg(
     // elements where the first does (a spiral of discs steps alike at every
     // disc, a row keeps the drawing's axes). A reading that reaches a work
     // limit is left out.
-    let turned: Vec<Instancing> = [Facing::Neighbour, Facing::Out, Facing::Path]
+    let turned: Vec<Instancing> = [Facing::Neighbour, Facing::Out, Facing::Path, Facing::Fork]
         .into_iter()
         .filter(|_| drawing.elements.len() <= MAX_REREAD)
         .filter_map(|f| inst.turned_round(f))
         .collect();
-    let places: Vec<glam::DVec2> = inst.of.iter().map(|(_, f)| f.pos).collect();
     let (mut grammar, mut file, mut text, mut emit_ms) =
         program(inst, progress).map_err(too_much)?;
+    let places: Vec<glam::DVec2> = drawing
+        .elements
+        .iter()
+        .filter_map(|e| choose::mean_point(e.subpaths.iter().flatten().copied()))
+        .collect();
     if !turned.is_empty() {
         // As near as the first, or (with `--symmetrize`) within the noise
         // of the drawing's placement.

@@ -391,6 +391,10 @@ impl Instancing {
             let points: Vec<DVec2> = members.iter().map(|&i| self.of[i].1.pos).collect();
             let heads = match facing {
                 Facing::Path => along_path(&points),
+                Facing::Fork => match toward_forks(&members, &self.of) {
+                    Some(heads) => heads,
+                    None => continue,
+                },
                 _ => {
                     let index = crate::geometry::index::PointGrid::new(&points);
                     let mean = points.iter().sum::<DVec2>() / points.len() as f64;
@@ -439,11 +443,220 @@ pub enum Facing {
     Out,
     /// The way the path through its kind runs (`along_path`).
     Path,
+    /// Towards the place its stem reaches (`toward_forks`).
+    Fork,
 }
 
 /// The turtle heading (local +y) along `d`; `None` for no direction.
 fn heading(d: DVec2) -> Option<f64> {
     (d.length_squared() > 0.0).then(|| (-d.x).atan2(d.y))
+}
+
+/// Headings of round stems (the elements `members` of one kind, among
+/// all elements `of`) towards where each one ends: a disc at the base of a
+/// stem hides its heading, but every stem of a branching reaches its
+/// children a distance proportional to its own size away, so the distance
+/// over scale shared by the most stems (within 1 %) says which of the
+/// places near each stem (its 16 nearest, a concentric one left out) is
+/// its tip. A stem's tip holds smaller stems of its kind, or elements of
+/// another kind; a larger stem is its parent. `None` for a stem with no
+/// place at that distance; no headings at all when fewer than half the
+/// stems (or fewer than 3) share one.
+fn toward_forks(members: &[usize], of: &[(usize, Frame)]) -> Option<Vec<Option<f64>>> {
+    const NEAR: usize = 16;
+    const WITHIN: f64 = 0.01;
+    let all: Vec<DVec2> = of.iter().map(|(_, f)| f.pos).collect();
+    let index = crate::geometry::index::PointGrid::new(&all);
+    let points: Vec<DVec2> = members.iter().map(|&i| all[i]).collect();
+    // (distance / scale, stem, place) for each stem's nearby places: the
+    // smaller stems of its kind first, then places of any kind.
+    let near = |stems_only: bool| {
+        let mut ratios: Vec<(f64, usize, usize)> = Vec::new();
+        for (a, &i) in members.iter().enumerate() {
+            let (
+                kind,
+                Frame {
+                    pos: p, scale: s, ..
+                },
+            ) = of[i];
+            for b in index.nearest(p, NEAR) {
+                let d = (all[b] - p).length();
+                let smaller = of[b].0 == kind && of[b].1.scale < s * (1.0 - 5e-3);
+                let child = smaller || (of[b].0 != kind && !stems_only);
+                if s > 0.0 && d > 1e-3 * s && child {
+                    ratios.push((d / s, a, b));
+                }
+            }
+        }
+        ratios.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let (count, low) = most_shared(&ratios, points.len(), WITHIN);
+        (ratios, count, low)
+    };
+    let (mut ratios, mut count, mut low) = near(true);
+    if count < 2 {
+        (ratios, count, low) = near(false);
+        if count < 3 || 2 * count < points.len() {
+            return None;
+        }
+    }
+    let high = low * (1.0 + WITHIN);
+    let mid = (low + high) / 2.0;
+    let member: std::collections::HashMap<usize, usize> =
+        members.iter().enumerate().map(|(a, &i)| (i, a)).collect();
+    let mut heads: Vec<Option<f64>> = vec![None; points.len()];
+    // Each stem's parent: the stem whose tip it sits at.
+    let mut parent: Vec<Option<usize>> = vec![None; points.len()];
+    let groups = concentric(members, of);
+    for group in &groups {
+        // The distinct places the group's stems reach: concentric stems of
+        // one size are alike, so each takes its own tip in turn.
+        let s = of[members[group[0]]].1.scale;
+        let mut tips: Vec<(DVec2, Vec<usize>)> = Vec::new();
+        for &(_, _, b) in ratios
+            .iter()
+            .filter(|x| x.0 >= low && x.0 <= high && group.contains(&x.1))
+        {
+            match tips
+                .iter_mut()
+                .find(|(t, _)| (*t - all[b]).length() < 1e-3 * mid * s)
+            {
+                Some((_, at)) => at.push(b),
+                None => tips.push((all[b], vec![b])),
+            }
+        }
+        tips.sort_by(|x, y| x.0.x.total_cmp(&y.0.x).then(x.0.y.total_cmp(&y.0.y)));
+        for (&a, (tip, at)) in group.iter().zip(&tips) {
+            heads[a] = heading(*tip - points[a]);
+            for b in at {
+                if let Some(&c) = member.get(b) {
+                    parent[c] = Some(a);
+                }
+            }
+        }
+    }
+    tips_by_turn(members, of, &groups, &parent, mid, &mut heads);
+    Some(heads)
+}
+
+/// The stems of `members` (by index) grouped where they are concentric
+/// and of one size, in order.
+fn concentric(members: &[usize], of: &[(usize, Frame)]) -> Vec<Vec<usize>> {
+    let points: Vec<DVec2> = members.iter().map(|&i| of[i].1.pos).collect();
+    let index = crate::geometry::index::PointGrid::new(&points);
+    let mut group = vec![usize::MAX; points.len()];
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for a in 0..points.len() {
+        if group[a] != usize::MAX {
+            continue;
+        }
+        let s = of[members[a]].1.scale;
+        let alike = |b: usize| {
+            let t = of[members[b]].1.scale;
+            (points[b] - points[a]).length() < 1e-3 * s && (t / s - 1.0).abs() < 5e-3
+        };
+        let mut g = vec![a];
+        for b in index.nearest(points[a], 8) {
+            if b != a && group[b] == usize::MAX && alike(b) {
+                g.push(b);
+            }
+        }
+        g.sort_unstable();
+        for &b in &g {
+            group[b] = groups.len();
+        }
+        groups.push(g);
+    }
+    groups
+}
+
+/// The window of `ratios` (sorted, each with its stem of `n`) within
+/// `within` of its first that holds the most distinct stems: their count
+/// and the window's first ratio.
+fn most_shared(ratios: &[(f64, usize, usize)], n: usize, within: f64) -> (usize, f64) {
+    let mut best = (0, 0.0);
+    let mut seen = vec![usize::MAX; n];
+    for (w, &(r, _, _)) in ratios.iter().enumerate() {
+        let mut count = 0;
+        for &(_, a, _) in ratios[w..].iter().take_while(|x| x.0 <= r * (1.0 + within)) {
+            if seen[a] != w {
+                seen[a] = w;
+                count += 1;
+            }
+        }
+        if count > best.0 {
+            best = (count, r);
+        }
+    }
+    best
+}
+
+/// Headings for the last stems of a branching (`toward_forks`), whose
+/// children are of another kind and sit anywhere near their tip: each
+/// turns from its parent as a stem of its size turns from its parent
+/// where both headings are known. Of the turns its scale allows, the stems
+/// of a concentric group take those whose tip, `reach` times the stem's
+/// scale ahead, is nearest an element of another kind, one each.
+fn tips_by_turn(
+    members: &[usize],
+    of: &[(usize, Frame)],
+    groups: &[Vec<usize>],
+    parent: &[Option<usize>],
+    reach: f64,
+    heads: &mut [Option<f64>],
+) {
+    let scale = |a: usize| of[members[a]].1.scale;
+    // (scale over the parent's, turn from the parent) where both are known.
+    let mut turns: Vec<(f64, f64)> = Vec::new();
+    for a in 0..members.len() {
+        let (Some(p), Some(h)) = (parent[a], heads[a]) else {
+            continue;
+        };
+        let Some(from) = heads[p] else {
+            continue;
+        };
+        let t = (scale(a) / scale(p), wrap(h - from));
+        let new = |u: &(f64, f64)| (u.0 / t.0 - 1.0).abs() > 0.01 || wrap(u.1 - t.1).abs() > 0.01;
+        if turns.iter().all(new) {
+            turns.push(t);
+        }
+    }
+    let kind = members.first().map(|&i| of[i].0);
+    let others: Vec<DVec2> = of
+        .iter()
+        .filter(|(k, _)| Some(*k) != kind)
+        .map(|(_, f)| f.pos)
+        .collect();
+    if turns.is_empty() || others.is_empty() {
+        return;
+    }
+    let index = crate::geometry::index::PointGrid::new(&others);
+    for group in groups {
+        let a = group[0];
+        let (None, Some(p)) = (heads[a], parent[a]) else {
+            continue;
+        };
+        let Some(from) = heads[p] else {
+            continue;
+        };
+        let ratio = scale(a) / scale(p);
+        let at = of[members[a]].1.pos;
+        let gap = |h: f64| {
+            let tip = at + rotate(DVec2::Y, h) * reach * scale(a);
+            index
+                .nearest(tip, 1)
+                .first()
+                .map_or(f64::INFINITY, |&o| (others[o] - tip).length())
+        };
+        let mut allowed: Vec<(f64, f64)> = turns
+            .iter()
+            .filter(|(r, _)| (r / ratio - 1.0).abs() < 0.01)
+            .map(|&(_, t)| (gap(wrap(from + t)), wrap(from + t)))
+            .collect();
+        allowed.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for (&b, &(_, h)) in group.iter().zip(&allowed) {
+            heads[b] = Some(h);
+        }
+    }
 }
 
 /// Headings along the nearest-neighbour tree of `points` read from one of
