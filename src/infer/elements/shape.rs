@@ -413,10 +413,16 @@ impl Instancing {
             };
             for (&i, head) in members.iter().zip(heads) {
                 if let Some(rot) = head {
-                    out.of[i].1.rot = rot;
+                    // Turned about the disc's centre: a frame off it keeps
+                    // its place in the disc's own frame.
+                    let f = &mut out.of[i].1;
+                    let c = self.shapes[i].centroid;
+                    f.pos = c + rotate(f.pos - c, rot - f.rot);
+                    f.rot = rot;
                 }
             }
             out.kinds[k].frame.rot = out.of[kind.representative].1.rot;
+            out.kinds[k].frame.pos = out.of[kind.representative].1.pos;
             any = true;
         }
         any.then_some(out)
@@ -468,17 +474,14 @@ fn toward_forks(members: &[usize], of: &[(usize, Frame)]) -> Option<Vec<Option<f
     let all: Vec<DVec2> = of.iter().map(|(_, f)| f.pos).collect();
     let index = crate::geometry::index::PointGrid::new(&all);
     let points: Vec<DVec2> = members.iter().map(|&i| all[i]).collect();
+    let member: std::collections::HashMap<usize, usize> =
+        members.iter().enumerate().map(|(a, &i)| (i, a)).collect();
     // (distance / scale, stem, place) for each stem's nearby places: the
     // smaller stems of its kind first, then places of any kind.
     let near = |stems_only: bool| {
         let mut ratios: Vec<(f64, usize, usize)> = Vec::new();
         for (a, &i) in members.iter().enumerate() {
-            let (
-                kind,
-                Frame {
-                    pos: p, scale: s, ..
-                },
-            ) = of[i];
+            let (kind, s, p) = (of[i].0, of[i].1.scale, all[i]);
             for b in index.nearest(p, NEAR) {
                 let d = (all[b] - p).length();
                 let smaller = of[b].0 == kind && of[b].1.scale < s * (1.0 - 5e-3);
@@ -489,7 +492,7 @@ fn toward_forks(members: &[usize], of: &[(usize, Frame)]) -> Option<Vec<Option<f
             }
         }
         ratios.sort_by(|x, y| x.0.total_cmp(&y.0));
-        let (count, low) = most_shared(&ratios, points.len(), WITHIN);
+        let (count, low) = most_shared(&ratios, points.len(), WITHIN, |b| member.get(&b).copied());
         (ratios, count, low)
     };
     let (mut ratios, mut count, mut low) = near(true);
@@ -501,32 +504,43 @@ fn toward_forks(members: &[usize], of: &[(usize, Frame)]) -> Option<Vec<Option<f
     }
     let high = low * (1.0 + WITHIN);
     let mid = (low + high) / 2.0;
-    let member: std::collections::HashMap<usize, usize> =
-        members.iter().enumerate().map(|(a, &i)| (i, a)).collect();
     let mut heads: Vec<Option<f64>> = vec![None; points.len()];
     // Each stem's parent: the stem whose tip it sits at.
     let mut parent: Vec<Option<usize>> = vec![None; points.len()];
-    let groups = concentric(members, of);
+    let groups = concentric(members, of, &all);
     for group in &groups {
-        // The distinct places the group's stems reach: concentric stems of
-        // one size are alike, so each takes its own tip in turn.
+        // The distinct places the group's stems reach, nearest the
+        // window's middle first: concentric stems of one size are alike,
+        // so each takes its own tip in turn; a stem alone takes the
+        // nearest, and every place in the window is a child of it.
         let s = of[members[group[0]]].1.scale;
-        let mut tips: Vec<(DVec2, Vec<usize>)> = Vec::new();
-        for &(_, _, b) in ratios
+        let mut tips: Vec<(f64, DVec2, Vec<usize>)> = Vec::new();
+        for &(r, _, b) in ratios
             .iter()
             .filter(|x| x.0 >= low && x.0 <= high && group.contains(&x.1))
         {
+            let off = (r - mid).abs();
             match tips
                 .iter_mut()
-                .find(|(t, _)| (*t - all[b]).length() < 1e-3 * mid * s)
+                .find(|(_, t, _)| (*t - all[b]).length() < 1e-3 * mid * s)
             {
-                Some((_, at)) => at.push(b),
-                None => tips.push((all[b], vec![b])),
+                Some((o, _, at)) => {
+                    *o = o.min(off);
+                    at.push(b);
+                }
+                None => tips.push((off, all[b], vec![b])),
             }
         }
-        tips.sort_by(|x, y| x.0.x.total_cmp(&y.0.x).then(x.0.y.total_cmp(&y.0.y)));
-        for (&a, (tip, at)) in group.iter().zip(&tips) {
-            heads[a] = heading(*tip - points[a]);
+        if group.len() > 1 {
+            tips.sort_by(|x, y| x.1.x.total_cmp(&y.1.x).then(x.1.y.total_cmp(&y.1.y)));
+        } else {
+            tips.sort_by(|x, y| x.0.total_cmp(&y.0));
+        }
+        for (k, (_, tip, at)) in tips.iter().enumerate() {
+            let a = group[k.min(group.len() - 1)];
+            if k < group.len() {
+                heads[a] = heading(*tip - points[a]);
+            }
             for b in at {
                 if let Some(&c) = member.get(b) {
                     parent[c] = Some(a);
@@ -534,14 +548,35 @@ fn toward_forks(members: &[usize], of: &[(usize, Frame)]) -> Option<Vec<Option<f
             }
         }
     }
-    tips_by_turn(members, of, &groups, &parent, mid, &mut heads);
+    // A stem whose centre is off its base reaches each side's child at
+    // its own ratio: the next fullest window gives the other side's
+    // parents (the headings stay the first window's).
+    let rest: Vec<(f64, usize, usize)> = ratios
+        .iter()
+        .filter(|x| {
+            (x.0 < low || x.0 > high) && member.get(&x.2).is_some_and(|&c| parent[c].is_none())
+        })
+        .copied()
+        .collect();
+    let (others, low2) = most_shared(&rest, points.len(), WITHIN, |b| member.get(&b).copied());
+    if others >= 2 {
+        for &(_, a, b) in rest
+            .iter()
+            .filter(|x| x.0 >= low2 && x.0 <= low2 * (1.0 + WITHIN))
+        {
+            if let Some(&c) = member.get(&b) {
+                parent[c].get_or_insert(a);
+            }
+        }
+    }
+    tips_by_turn(members, of, &all, &groups, &parent, mid, &mut heads);
     Some(heads)
 }
 
 /// The stems of `members` (by index) grouped where they are concentric
 /// and of one size, in order.
-fn concentric(members: &[usize], of: &[(usize, Frame)]) -> Vec<Vec<usize>> {
-    let points: Vec<DVec2> = members.iter().map(|&i| of[i].1.pos).collect();
+fn concentric(members: &[usize], of: &[(usize, Frame)], all: &[DVec2]) -> Vec<Vec<usize>> {
+    let points: Vec<DVec2> = members.iter().map(|&i| all[i]).collect();
     let index = crate::geometry::index::PointGrid::new(&points);
     let mut group = vec![usize::MAX; points.len()];
     let mut groups: Vec<Vec<usize>> = Vec::new();
@@ -569,25 +604,37 @@ fn concentric(members: &[usize], of: &[(usize, Frame)]) -> Vec<Vec<usize>> {
     groups
 }
 
-/// The window of `ratios` (sorted, each with its stem of `n`) within
-/// `within` of its first that holds the most distinct stems: their count
-/// and the window's first ratio.
-fn most_shared(ratios: &[(f64, usize, usize)], n: usize, within: f64) -> (usize, f64) {
-    let mut best = (0, 0.0);
+/// The window of `ratios` (sorted, each with its stem of `n` and a
+/// place) within `within` of its first that holds the most distinct
+/// stems: their count and the window's first ratio. Of windows as full,
+/// the one whose places are most often stems of the window themselves: a
+/// stem's children have children of their own at the same ratio, its
+/// smaller sibling (as far from it, and as often) has none.
+fn most_shared(
+    ratios: &[(f64, usize, usize)],
+    n: usize,
+    within: f64,
+    stem_of: impl Fn(usize) -> Option<usize>,
+) -> (usize, f64) {
+    let mut best = ((0, 0), 0.0);
     let mut seen = vec![usize::MAX; n];
     for (w, &(r, _, _)) in ratios.iter().enumerate() {
+        let window = || ratios[w..].iter().take_while(|x| x.0 <= r * (1.0 + within));
         let mut count = 0;
-        for &(_, a, _) in ratios[w..].iter().take_while(|x| x.0 <= r * (1.0 + within)) {
+        for &(_, a, _) in window() {
             if seen[a] != w {
                 seen[a] = w;
                 count += 1;
             }
         }
-        if count > best.0 {
-            best = (count, r);
+        let chained = window()
+            .filter(|x| stem_of(x.2).is_some_and(|c| seen[c] == w))
+            .count();
+        if (count, chained) > best.0 {
+            best = ((count, chained), r);
         }
     }
-    best
+    (best.0.0, best.1)
 }
 
 /// Headings for the last stems of a branching (`toward_forks`), whose
@@ -599,6 +646,7 @@ fn most_shared(ratios: &[(f64, usize, usize)], n: usize, within: f64) -> (usize,
 fn tips_by_turn(
     members: &[usize],
     of: &[(usize, Frame)],
+    all: &[DVec2],
     groups: &[Vec<usize>],
     parent: &[Option<usize>],
     reach: f64,
@@ -621,10 +669,9 @@ fn tips_by_turn(
         }
     }
     let kind = members.first().map(|&i| of[i].0);
-    let others: Vec<DVec2> = of
-        .iter()
-        .filter(|(k, _)| Some(*k) != kind)
-        .map(|(_, f)| f.pos)
+    let others: Vec<DVec2> = (0..of.len())
+        .filter(|&i| Some(of[i].0) != kind)
+        .map(|i| all[i])
         .collect();
     if turns.is_empty() || others.is_empty() {
         return;
@@ -639,7 +686,7 @@ fn tips_by_turn(
             continue;
         };
         let ratio = scale(a) / scale(p);
-        let at = of[members[a]].1.pos;
+        let at = all[members[a]];
         let gap = |h: f64| {
             let tip = at + rotate(DVec2::Y, h) * reach * scale(a);
             index
