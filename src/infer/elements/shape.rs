@@ -381,7 +381,8 @@ impl Instancing {
         let mut out = self.clone();
         let mut any = false;
         for (k, kind) in self.kinds.iter().enumerate() {
-            if kind.symmetry != 0 || kind.given {
+            let folded = kind.symmetry > 1 && facing == Facing::Fork;
+            if (kind.symmetry != 0 && !folded) || kind.given {
                 continue;
             }
             let members: Vec<usize> = (0..self.of.len()).filter(|&i| self.of[i].0 == k).collect();
@@ -411,6 +412,11 @@ impl Instancing {
                         .collect()
                 }
             };
+            if folded {
+                out.fold_toward(kind, &members, &heads);
+                any = true;
+                continue;
+            }
             for (&i, head) in members.iter().zip(heads) {
                 if let Some(rot) = head {
                     // Turned about the disc's centre: a frame off it keeps
@@ -426,6 +432,34 @@ impl Instancing {
             any = true;
         }
         any.then_some(out)
+    }
+
+    /// For a k-fold kind, each member's variant (its frame turned about
+    /// its centre by a k-th of a turn) that heads it as the kind's
+    /// representative (or first member with a heading) heads relative to
+    /// its own: a 2-fold stem of a tree then points along its branch, not
+    /// back down it.
+    fn fold_toward(&mut self, kind: &Kind, members: &[usize], heads: &[Option<f64>]) {
+        let step = TAU / kind.symmetry as f64;
+        let first = members
+            .iter()
+            .position(|&i| i == kind.representative)
+            .filter(|&a| heads[a].is_some())
+            .or_else(|| heads.iter().position(Option::is_some));
+        let Some(phi) = first.and_then(|a| Some(wrap(self.of[members[a]].1.rot - heads[a]?)))
+        else {
+            return;
+        };
+        for (&i, head) in members.iter().zip(heads) {
+            let Some(h) = head else {
+                continue;
+            };
+            let f = &mut self.of[i].1;
+            let turn = (wrap(h + phi - f.rot) / step).round() * step;
+            let c = self.shapes[i].centroid;
+            f.pos = c + rotate(f.pos - c, turn);
+            f.rot = wrap(f.rot + turn);
+        }
     }
 
     /// Moves kind `k`'s local frame by `change` (given in the old local
