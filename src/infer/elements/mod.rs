@@ -232,7 +232,7 @@ pub fn from_svg(
     let turned: Vec<Instancing> = [Facing::Neighbour, Facing::Out, Facing::Path, Facing::Fork]
         .into_iter()
         .filter(|_| drawing.elements.len() <= MAX_REREAD)
-        .filter_map(|f| inst.turned_round(f))
+        .filter_map(|f| inst.turned_round(f, if opts.symmetrize { 0.03 } else { 0.01 }))
         .collect();
     let (mut grammar, mut file, mut text, mut emit_ms) =
         program(inst, progress).map_err(too_much)?;

@@ -377,7 +377,7 @@ impl Instancing {
     /// are none. A disc has no heading of its own, and a spiral of discs
     /// steps and turns alike at every disc only if each heads the way the
     /// spiral runs, a ring of discs only if each heads out of the ring.
-    pub fn turned_round(&self, facing: Facing) -> Option<Instancing> {
+    pub fn turned_round(&self, facing: Facing, within: f64) -> Option<Instancing> {
         let mut out = self.clone();
         let mut any = false;
         for (k, kind) in self.kinds.iter().enumerate() {
@@ -392,7 +392,7 @@ impl Instancing {
             let points: Vec<DVec2> = members.iter().map(|&i| self.of[i].1.pos).collect();
             let heads = match facing {
                 Facing::Path => along_path(&points),
-                Facing::Fork => match toward_forks(&members, &self.of) {
+                Facing::Fork => match toward_forks(&members, &self.of, &self.shapes, within) {
                     Some(heads) => heads,
                     None => continue,
                 },
@@ -502,9 +502,22 @@ fn heading(d: DVec2) -> Option<f64> {
 /// another kind; a larger stem is its parent. `None` for a stem with no
 /// place at that distance; no headings at all when fewer than half the
 /// stems (or fewer than 3) share one.
-fn toward_forks(members: &[usize], of: &[(usize, Frame)]) -> Option<Vec<Option<f64>>> {
+fn toward_forks(
+    members: &[usize],
+    of: &[(usize, Frame)],
+    shapes: &[Shape],
+    within: f64,
+) -> Option<Vec<Option<f64>>> {
     const NEAR: usize = 16;
-    const WITHIN: f64 = 0.01;
+    // A place this near a stem is its concentric sibling: within its own
+    // outline when placed by hand (`within` over 1 %).
+    let apart = |i: usize, s: f64| {
+        if within > 0.01 {
+            shapes[i].radius
+        } else {
+            1e-3 * s
+        }
+    };
     let all: Vec<DVec2> = of.iter().map(|(_, f)| f.pos).collect();
     let index = crate::geometry::index::PointGrid::new(&all);
     let points: Vec<DVec2> = members.iter().map(|&i| all[i]).collect();
@@ -518,15 +531,15 @@ fn toward_forks(members: &[usize], of: &[(usize, Frame)]) -> Option<Vec<Option<f
             let (kind, s, p) = (of[i].0, of[i].1.scale, all[i]);
             for b in index.nearest(p, NEAR) {
                 let d = (all[b] - p).length();
-                let smaller = of[b].0 == kind && of[b].1.scale < s * (1.0 - 5e-3);
+                let smaller = of[b].0 == kind && of[b].1.scale < s * (1.0 - within / 2.0);
                 let child = smaller || (of[b].0 != kind && !stems_only);
-                if s > 0.0 && d > 1e-3 * s && child {
+                if s > 0.0 && d > apart(i, s) && child {
                     ratios.push((d / s, a, b));
                 }
             }
         }
         ratios.sort_by(|x, y| x.0.total_cmp(&y.0));
-        let (count, low) = most_shared(&ratios, points.len(), WITHIN, |b| member.get(&b).copied());
+        let (count, low) = most_shared(&ratios, points.len(), within, |b| member.get(&b).copied());
         (ratios, count, low)
     };
     let (mut ratios, mut count, mut low) = near(true);
@@ -536,12 +549,12 @@ fn toward_forks(members: &[usize], of: &[(usize, Frame)]) -> Option<Vec<Option<f
             return None;
         }
     }
-    let high = low * (1.0 + WITHIN);
+    let high = low * (1.0 + within);
     let mid = (low + high) / 2.0;
     let mut heads: Vec<Option<f64>> = vec![None; points.len()];
     // Each stem's parent: the stem whose tip it sits at.
     let mut parent: Vec<Option<usize>> = vec![None; points.len()];
-    let groups = concentric(members, of, &all);
+    let groups = concentric(members, of, &all, within, mid);
     for group in &groups {
         // The distinct places the group's stems reach, nearest the
         // window's middle first: concentric stems of one size are alike,
@@ -556,7 +569,7 @@ fn toward_forks(members: &[usize], of: &[(usize, Frame)]) -> Option<Vec<Option<f
             let off = (r - mid).abs();
             match tips
                 .iter_mut()
-                .find(|(_, t, _)| (*t - all[b]).length() < 1e-3 * mid * s)
+                .find(|(_, t, _)| (*t - all[b]).length() < within * mid * s)
             {
                 Some((o, _, at)) => {
                     *o = o.min(off);
@@ -592,24 +605,39 @@ fn toward_forks(members: &[usize], of: &[(usize, Frame)]) -> Option<Vec<Option<f
         })
         .copied()
         .collect();
-    let (others, low2) = most_shared(&rest, points.len(), WITHIN, |b| member.get(&b).copied());
+    let (others, low2) = most_shared(&rest, points.len(), within, |b| member.get(&b).copied());
     if others >= 2 {
         for &(_, a, b) in rest
             .iter()
-            .filter(|x| x.0 >= low2 && x.0 <= low2 * (1.0 + WITHIN))
+            .filter(|x| x.0 >= low2 && x.0 <= low2 * (1.0 + within))
         {
             if let Some(&c) = member.get(&b) {
                 parent[c].get_or_insert(a);
             }
         }
     }
-    tips_by_turn(members, of, &all, &groups, &parent, mid, &mut heads);
+    tips_by_turn(
+        members,
+        of,
+        &all,
+        &groups,
+        &parent,
+        (mid, within),
+        &mut heads,
+    );
     Some(heads)
 }
 
 /// The stems of `members` (by index) grouped where they are concentric
-/// and of one size, in order.
-fn concentric(members: &[usize], of: &[(usize, Frame)], all: &[DVec2]) -> Vec<Vec<usize>> {
+/// and of one size (within `within` of a stem's `reach` times its scale),
+/// in order.
+fn concentric(
+    members: &[usize],
+    of: &[(usize, Frame)],
+    all: &[DVec2],
+    within: f64,
+    reach: f64,
+) -> Vec<Vec<usize>> {
     let points: Vec<DVec2> = members.iter().map(|&i| all[i]).collect();
     let index = crate::geometry::index::PointGrid::new(&points);
     let mut group = vec![usize::MAX; points.len()];
@@ -621,7 +649,8 @@ fn concentric(members: &[usize], of: &[(usize, Frame)], all: &[DVec2]) -> Vec<Ve
         let s = of[members[a]].1.scale;
         let alike = |b: usize| {
             let t = of[members[b]].1.scale;
-            (points[b] - points[a]).length() < 1e-3 * s && (t / s - 1.0).abs() < 5e-3
+            (points[b] - points[a]).length() < within * reach * s
+                && (t / s - 1.0).abs() < within / 2.0
         };
         let mut g = vec![a];
         for b in index.nearest(points[a], 8) {
@@ -683,7 +712,7 @@ fn tips_by_turn(
     all: &[DVec2],
     groups: &[Vec<usize>],
     parent: &[Option<usize>],
-    reach: f64,
+    (reach, within): (f64, f64),
     heads: &mut [Option<f64>],
 ) {
     let scale = |a: usize| of[members[a]].1.scale;
@@ -697,7 +726,9 @@ fn tips_by_turn(
             continue;
         };
         let t = (scale(a) / scale(p), wrap(h - from));
-        let new = |u: &(f64, f64)| (u.0 / t.0 - 1.0).abs() > 0.01 || wrap(u.1 - t.1).abs() > 0.01;
+        let new = |u: &(f64, f64)| {
+            (u.0 / t.0 - 1.0).abs() > within || wrap(u.1 - t.1).abs() > 2.0 * within
+        };
         if turns.iter().all(new) {
             turns.push(t);
         }
@@ -730,7 +761,7 @@ fn tips_by_turn(
         };
         let mut allowed: Vec<(f64, f64)> = turns
             .iter()
-            .filter(|(r, _)| (r / ratio - 1.0).abs() < 0.01)
+            .filter(|(r, _)| (r / ratio - 1.0).abs() < within)
             .map(|&(_, t)| (gap(wrap(from + t)), wrap(from + t)))
             .collect();
         allowed.sort_by(|x, y| x.0.total_cmp(&y.0));
