@@ -803,6 +803,7 @@ fn extend_changing(
     near: &Near,
     tol: Tolerance,
 ) -> Vec<Vec<usize>> {
+    fill_gaps(insts, &mut chains, near, tol);
     let mut used: HashSet<usize> = chains.iter().flatten().copied().collect();
     let between = |a: usize, b: usize| {
         let f = &insts[a].frame;
@@ -846,6 +847,59 @@ fn extend_changing(
         }
     }
     chains
+}
+
+/// Instances on the way between two neighbours of a chain of three or
+/// more (a detour of at most a third of the distance tolerance, each part
+/// at least a fifth of the way), taken into it from wherever they were: a
+/// constant sequence that stood for a row whose steps change skips a short
+/// step where two of them add up to a step of its own length.
+fn fill_gaps(insts: &[Inst], chains: &mut Vec<Vec<usize>>, near: &Near, tol: Tolerance) {
+    let mut owner: HashMap<usize, usize> = HashMap::new();
+    for (c, chain) in chains.iter().enumerate() {
+        for &i in chain {
+            owner.insert(i, c);
+        }
+    }
+    for c in 0..chains.len() {
+        if chains[c].len() < 3 {
+            continue;
+        }
+        let mut k = 0;
+        while k + 1 < chains[c].len() {
+            let (a, b) = (
+                insts[chains[c][k]].frame.pos,
+                insts[chains[c][k + 1]].frame.pos,
+            );
+            let d = a.distance(b);
+            let on_way = near
+                .grid
+                .within((a + b) / 2.0, d / 2.0)
+                .into_iter()
+                .map(|g| near.ids[g])
+                .filter(|&j| owner.get(&j) != Some(&c))
+                .filter(|&j| {
+                    let p = insts[j].frame.pos;
+                    let (x, y) = (a.distance(p), p.distance(b));
+                    x + y <= d * (1.0 + tol.distance / 3.0) && x.min(y) >= d / 5.0
+                })
+                .min_by(|&x, &y| {
+                    a.distance(insts[x].frame.pos)
+                        .total_cmp(&a.distance(insts[y].frame.pos))
+                });
+            match on_way {
+                Some(j) => {
+                    if let Some(&o) = owner.get(&j) {
+                        chains[o].retain(|&i| i != j);
+                    }
+                    owner.insert(j, c);
+                    chains[c].insert(k + 1, j);
+                }
+                None => k += 1,
+            }
+        }
+    }
+    chains.retain(|c| !c.is_empty());
 }
 
 /// Chains grown at both ends while the next instance `t` leads to (or the
