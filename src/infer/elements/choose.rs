@@ -156,10 +156,31 @@ mod tests {
     fn a_program_drawing_its_elements_elsewhere_misfits() {
         let text = "element A { path \"M0 0 L1 0 L0 1 Z\"; }\n\
                     lsystem S {\n    derive 0;\n    axiom A f(10) A;\n}\n";
-        let here = [DVec2::ZERO, DVec2::new(0.0, 10.0)];
-        assert_eq!(misfit(text, &here), Some(0.0));
-        let there = [DVec2::ZERO, DVec2::new(0.0, 12.0)];
-        assert_eq!(misfit(text, &there), Some(1.0));
+        // Each element is where the mean of its outline's points is.
+        let o = DVec2::splat(1.0 / 3.0);
+        let here = [o, o + DVec2::new(0.0, 10.0)];
+        assert!(misfit(text, &here).is_some_and(|m| m < 1e-12));
+        let there = [o, o + DVec2::new(0.0, 12.0)];
+        assert!(misfit(text, &there).is_some_and(|m| (m - 1.0).abs() < 1e-12));
         assert_eq!(misfit(text, &here[..1]), None);
+    }
+
+    #[test]
+    fn an_outline_is_placed_by_its_points_whichever_it_starts_from() {
+        let square = |start: usize, closing: bool| {
+            let pts = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
+            let mut segs = vec![Seg::Move(pts[start])];
+            segs.extend((1..4).map(|k| Seg::Line(pts[(start + k) % 4])));
+            if closing {
+                segs.push(Seg::Line(pts[start]));
+            }
+            segs.push(Seg::Close);
+            mean_point(segs)
+        };
+        let centre = Some(DVec2::splat(0.5));
+        assert_eq!(square(0, false), centre);
+        assert_eq!(square(2, true), centre);
+        assert_eq!(path_centroid("M0 0 L1 0 L1 1 L0 1 L0 0 Z"), centre);
+        assert_eq!(mean_point([]), None);
     }
 }

@@ -380,6 +380,7 @@ impl Instancing {
     pub fn turned_round(&self, facing: Facing, within: f64) -> Option<Instancing> {
         let mut out = self.clone();
         let mut any = false;
+        let radii: Vec<f64> = self.shapes.iter().map(|sh| sh.radius).collect();
         for (k, kind) in self.kinds.iter().enumerate() {
             let folded = kind.symmetry > 1 && facing == Facing::Fork;
             if (kind.symmetry != 0 && !folded) || kind.given {
@@ -392,7 +393,7 @@ impl Instancing {
             let points: Vec<DVec2> = members.iter().map(|&i| self.of[i].1.pos).collect();
             let heads = match facing {
                 Facing::Path => along_path(&points),
-                Facing::Fork => match toward_forks(&members, &self.of, &self.shapes, within) {
+                Facing::Fork => match toward_forks(&members, &self.of, &radii, within) {
                     Some(heads) => heads,
                     None => continue,
                 },
@@ -493,30 +494,29 @@ fn heading(d: DVec2) -> Option<f64> {
 }
 
 /// Headings of round stems (the elements `members` of one kind, among
-/// all elements `of`) towards where each one ends: a disc at the base of a
-/// stem hides its heading, but every stem of a branching reaches its
-/// children a distance proportional to its own size away, so the distance
-/// over scale shared by the most stems (within 1 %) says which of the
-/// places near each stem (its 16 nearest, a concentric one left out) is
-/// its tip. A stem's tip holds smaller stems of its kind, or elements of
-/// another kind; a larger stem is its parent. `None` for a stem with no
-/// place at that distance; no headings at all when fewer than half the
-/// stems (or fewer than 3) share one.
+/// all elements `of`, each of outline radius `radii`) towards where each
+/// one ends: a disc at the base of a stem hides its heading, but every
+/// stem of a branching reaches its children a distance proportional to its
+/// own size away, so the distance over scale shared by the most stems
+/// (within `within`, relative) says which of the places near each stem
+/// (its 16 nearest) is its tip (`most_shared`). Smaller stems of its kind
+/// are counted first, then elements of any kind. A place nearer than
+/// 10⁻³ of its scale (with `within` over 1 %: within its own outline) is
+/// a concentric sibling, not a child. The last stems are turned by
+/// `tips_by_turn`. `None` for a stem nothing heads; no headings at all
+/// when fewer than two stems share a ratio with smaller stems and fewer
+/// than half (or 3) with any places.
 fn toward_forks(
     members: &[usize],
     of: &[(usize, Frame)],
-    shapes: &[Shape],
+    radii: &[f64],
     within: f64,
 ) -> Option<Vec<Option<f64>>> {
     const NEAR: usize = 16;
     // A place this near a stem is its concentric sibling: within its own
     // outline when placed by hand (`within` over 1 %).
     let apart = |i: usize, s: f64| {
-        if within > 0.01 {
-            shapes[i].radius
-        } else {
-            1e-3 * s
-        }
+        if within > 0.01 { radii[i] } else { 1e-3 * s }
     };
     let all: Vec<DVec2> = of.iter().map(|(_, f)| f.pos).collect();
     let index = crate::geometry::index::PointGrid::new(&all);
@@ -1225,6 +1225,48 @@ fn nearest_first(points: &[DVec2], k: usize) -> Vec<(usize, usize)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A tree of discs (kind 0), two children at each stem's tip turned
+    /// +30° and −40° and scaled 0.7 and 0.5, leaves (kind 1) at the last
+    /// stems' tips: each element with the heading it was drawn with.
+    fn disc_tree() -> (Vec<(usize, Frame)>, Vec<f64>) {
+        fn grow(f: Frame, depth: usize, of: &mut Vec<(usize, Frame)>, heads: &mut Vec<f64>) {
+            of.push((usize::from(depth == 0), Frame { rot: 0.0, ..f }));
+            heads.push(f.rot);
+            if depth == 0 {
+                return;
+            }
+            let tip = f.pos + rotate(DVec2::Y, f.rot) * 10.0 * f.scale;
+            for (turn, scale) in [(30f64, 0.7), (-40f64, 0.5)] {
+                let child = Frame {
+                    pos: tip,
+                    rot: wrap(f.rot + turn.to_radians()),
+                    scale: f.scale * scale,
+                };
+                grow(child, depth - 1, of, heads);
+            }
+        }
+        let (mut of, mut heads) = (Vec::new(), Vec::new());
+        grow(Frame::IDENTITY, 3, &mut of, &mut heads);
+        (of, heads)
+    }
+
+    #[test]
+    fn round_stems_head_towards_their_tips() {
+        let (of, truth) = disc_tree();
+        let members: Vec<usize> = (0..of.len()).filter(|&i| of[i].0 == 0).collect();
+        assert_eq!(members.len(), 7);
+        let heads =
+            toward_forks(&members, &of, &vec![1.0; of.len()], 0.01).expect("a fork reading");
+        for (&i, h) in members.iter().zip(heads) {
+            let h = h.expect("every stem heads somewhere");
+            assert!(
+                wrap(h - truth[i]).abs() < 1e-9,
+                "stem {i}: {h} for {}",
+                truth[i]
+            );
+        }
+    }
 
     fn poly(points: &[(f64, f64)], f: Frame) -> Vec<Vec<DVec2>> {
         let mut l: Vec<DVec2> = points
