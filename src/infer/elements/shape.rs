@@ -393,7 +393,7 @@ impl Instancing {
             let points: Vec<DVec2> = members.iter().map(|&i| self.of[i].1.pos).collect();
             let heads = match facing {
                 Facing::Path => along_path(&points),
-                Facing::Fork => match toward_forks(&members, &self.of, &radii, within) {
+                Facing::Fork => match toward_forks(&members, &self.of, &radii, (within, folded)) {
                     Some(heads) => heads,
                     None => continue,
                 },
@@ -505,12 +505,14 @@ fn heading(d: DVec2) -> Option<f64> {
 /// a concentric sibling, not a child. The last stems are turned by
 /// `tips_by_turn`. `None` for a stem nothing heads; no headings at all
 /// when fewer than two stems share a ratio with smaller stems and fewer
-/// than half (or 3) with any places.
+/// than half (or 3) with any places, or (`deep`: for a kind that shows a
+/// heading up to a k-th of a turn, which a ring or row reads as well)
+/// when no stem's child has children of its own at that ratio.
 fn toward_forks(
     members: &[usize],
     of: &[(usize, Frame)],
     radii: &[f64],
-    within: f64,
+    (within, deep): (f64, bool),
 ) -> Option<Vec<Option<f64>>> {
     const NEAR: usize = 16;
     // A place this near a stem is its concentric sibling: within its own
@@ -539,12 +541,16 @@ fn toward_forks(
             }
         }
         ratios.sort_by(|x, y| x.0.total_cmp(&y.0));
-        let (count, low) = most_shared(&ratios, points.len(), within, |b| member.get(&b).copied());
-        (ratios, count, low)
+        let ((count, chained), low) =
+            most_shared(&ratios, points.len(), within, |b| member.get(&b).copied());
+        (ratios, count, chained, low)
     };
-    let (mut ratios, mut count, mut low) = near(true);
+    let (mut ratios, mut count, chained, mut low) = near(true);
+    if deep && (count < 2 || chained == 0) {
+        return None;
+    }
     if count < 2 {
-        (ratios, count, low) = near(false);
+        (ratios, count, _, low) = near(false);
         if count < 3 || 2 * count < points.len() {
             return None;
         }
@@ -605,7 +611,7 @@ fn toward_forks(
         })
         .copied()
         .collect();
-    let (others, low2) = most_shared(&rest, points.len(), within, |b| member.get(&b).copied());
+    let ((others, _), low2) = most_shared(&rest, points.len(), within, |b| member.get(&b).copied());
     if others >= 2 {
         for &(_, a, b) in rest
             .iter()
@@ -669,7 +675,8 @@ fn concentric(
 
 /// The window of `ratios` (sorted, each with its stem of `n` and a
 /// place) within `within` of its first that holds the most distinct
-/// stems: their count and the window's first ratio. Of windows as full,
+/// stems: their count, how many of its places are stems of the window
+/// themselves, and the window's first ratio. Of windows as full,
 /// the one whose places are most often stems of the window themselves: a
 /// stem's children have children of their own at the same ratio, its
 /// smaller sibling (as far from it, and as often) has none.
@@ -678,7 +685,7 @@ fn most_shared(
     n: usize,
     within: f64,
     stem_of: impl Fn(usize) -> Option<usize>,
-) -> (usize, f64) {
+) -> ((usize, usize), f64) {
     let mut best = ((0, 0), 0.0);
     let mut seen = vec![usize::MAX; n];
     for (w, &(r, _, _)) in ratios.iter().enumerate() {
@@ -697,7 +704,7 @@ fn most_shared(
             best = ((count, chained), r);
         }
     }
-    (best.0.0, best.1)
+    best
 }
 
 /// Headings for the last stems of a branching (`toward_forks`), whose
@@ -1256,8 +1263,8 @@ mod tests {
         let (of, truth) = disc_tree();
         let members: Vec<usize> = (0..of.len()).filter(|&i| of[i].0 == 0).collect();
         assert_eq!(members.len(), 7);
-        let heads =
-            toward_forks(&members, &of, &vec![1.0; of.len()], 0.01).expect("a fork reading");
+        let heads = toward_forks(&members, &of, &vec![1.0; of.len()], (0.01, false))
+            .expect("a fork reading");
         for (&i, h) in members.iter().zip(heads) {
             let h = h.expect("every stem heads somewhere");
             assert!(
