@@ -561,6 +561,11 @@ fn toward_forks(
     // Each stem's parent: the stem whose tip it sits at.
     let mut parent: Vec<Option<usize>> = vec![None; points.len()];
     let groups = concentric(members, of, &all, within, mid);
+    // The window's places, per stem.
+    let mut reached: Vec<Vec<(f64, usize)>> = vec![Vec::new(); points.len()];
+    for &(r, a, b) in ratios.iter().filter(|x| x.0 >= low && x.0 <= high) {
+        reached[a].push((r, b));
+    }
     for group in &groups {
         // The distinct places the group's stems reach, nearest the
         // window's middle first: concentric stems of one size are alike,
@@ -568,10 +573,7 @@ fn toward_forks(
         // nearest, and every place in the window is a child of it.
         let s = of[members[group[0]]].1.scale;
         let mut tips: Vec<(f64, DVec2, Vec<usize>)> = Vec::new();
-        for &(r, _, b) in ratios
-            .iter()
-            .filter(|x| x.0 >= low && x.0 <= high && group.contains(&x.1))
-        {
+        for &(r, b) in group.iter().flat_map(|&a| &reached[a]) {
             let off = (r - mid).abs();
             match tips
                 .iter_mut()
@@ -686,22 +688,41 @@ fn most_shared(
     within: f64,
     stem_of: impl Fn(usize) -> Option<usize>,
 ) -> ((usize, usize), f64) {
+    // A window slid over the sorted ratios: per stem, its entries in the
+    // window and the entries whose place it is; `chained` counts entries
+    // whose place is a stem with entries of its own.
+    let mut own = vec![0usize; n];
+    let mut pointed = vec![0usize; n];
+    let (mut count, mut chained) = (0usize, 0usize);
     let mut best = ((0, 0), 0.0);
-    let mut seen = vec![usize::MAX; n];
+    let mut end = 0;
     for (w, &(r, _, _)) in ratios.iter().enumerate() {
-        let window = || ratios[w..].iter().take_while(|x| x.0 <= r * (1.0 + within));
-        let mut count = 0;
-        for &(_, a, _) in window() {
-            if seen[a] != w {
-                seen[a] = w;
+        while end < ratios.len() && ratios[end].0 <= r * (1.0 + within) {
+            let (_, a, b) = ratios[end];
+            own[a] += 1;
+            if own[a] == 1 {
                 count += 1;
+                chained += pointed[a];
             }
+            if let Some(c) = stem_of(b) {
+                pointed[c] += 1;
+                chained += usize::from(own[c] > 0);
+            }
+            end += 1;
         }
-        let chained = window()
-            .filter(|x| stem_of(x.2).is_some_and(|c| seen[c] == w))
-            .count();
         if (count, chained) > best.0 {
             best = ((count, chained), r);
+        }
+        // The window's first entry leaves before the next window.
+        let (_, a, b) = ratios[w];
+        if let Some(c) = stem_of(b) {
+            pointed[c] -= 1;
+            chained -= usize::from(own[c] > 0);
+        }
+        own[a] -= 1;
+        if own[a] == 0 {
+            count -= 1;
+            chained -= pointed[a];
         }
     }
     best
