@@ -28,7 +28,7 @@ const FLOORS: &[(Class, [usize; 5])] = &[
     (Class::Spiral, [20, 20, 20, 20, 20]),
     (Class::Period, [20, 20, 20, 20, 20]),
     (Class::Grid, [20, 20, 20, 20, 19]),
-    (Class::Linear, [20, 20, 20, 20, 16]),
+    (Class::Linear, [20, 20, 20, 20, 17]),
     (Class::Tree, [20, 20, 19, 20, 19]),
 ];
 

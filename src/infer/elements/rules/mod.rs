@@ -853,7 +853,8 @@ fn extend_changing(
 /// more (a detour of at most a third of the distance tolerance, each part
 /// at least a fifth of the way), taken into it from wherever they were: a
 /// constant sequence that stood for a row whose steps change skips a short
-/// step where two of them add up to a step of its own length.
+/// step where two of them add up to a step of its own length. A chain
+/// left with one copy is dropped (its copy is free to be grown into).
 fn fill_gaps(insts: &[Inst], chains: &mut Vec<Vec<usize>>, near: &Near, tol: Tolerance) {
     let mut owner: HashMap<usize, usize> = HashMap::new();
     for (c, chain) in chains.iter().enumerate() {
@@ -899,7 +900,8 @@ fn fill_gaps(insts: &[Inst], chains: &mut Vec<Vec<usize>>, near: &Near, tol: Tol
             }
         }
     }
-    chains.retain(|c| !c.is_empty());
+    // What a chain lost may leave one copy, which is no chain.
+    chains.retain(|c| c.len() >= 2);
 }
 
 /// Chains grown at both ends while the next instance `t` leads to (or the
@@ -1097,7 +1099,9 @@ fn choose(
             best = p;
         }
     }
-    if let Some(l) = hidden_change(insts, &cands[best], &hidden, tol) {
+    let change = hidden_change(insts, &cands[best], &hidden, tol)
+        .or_else(|| longer_change(insts, &cands[best], &hidden));
+    if let Some(l) = change {
         return Some(hidden.swap_remove(l));
     }
     Some(cands.swap_remove(best))
@@ -1158,23 +1162,7 @@ fn hidden_change(
     if shown.is_empty() {
         return None;
     }
-    // How far a fit draws its members from where they are: the mean
-    // square of the distance and of the size a wrong scale makes up (a
-    // row whose steps shrink linearly fits a geometric sequence by
-    // shrinking copies the drawing does not shrink).
-    let misfit = |chains: &[Vec<usize>], r: &regular::Regular| {
-        let (sum, n) =
-            chains
-                .iter()
-                .flatten()
-                .zip(&r.drawn)
-                .fold((0.0, 0usize), |(sum, n), (&i, d)| {
-                    let f = &insts[i].frame;
-                    let size = 0.5 * insts[i].size() * (f.scale / d.scale).ln();
-                    (sum + f.pos.distance_squared(d.pos) + size * size, n + 1)
-                });
-        sum / n.max(1) as f64
-    };
+    let misfit = |chains: &[Vec<usize>], r: &regular::Regular| misfit(insts, chains, r);
     let spread = regular::sequence(insts, chains, constant, tol)
         .map_or(f64::INFINITY, |r| misfit(chains, &r));
     shown.retain(|&i| match &cands[i].plan {
@@ -1187,6 +1175,58 @@ fn hidden_change(
     });
     shown
         .into_iter()
+        .max_by(|&x, &y| cands[x].pairs.cmp(&cands[y].pairs).then(y.cmp(&x)))
+}
+
+/// How far a fit draws its members from where they are: the mean square
+/// of the distance and of the size a wrong scale makes up (a row whose
+/// steps shrink linearly fits a geometric sequence by shrinking copies the
+/// drawing does not shrink).
+fn misfit(insts: &[Inst], chains: &[Vec<usize>], r: &regular::Regular) -> f64 {
+    let (sum, n) =
+        chains
+            .iter()
+            .flatten()
+            .zip(&r.drawn)
+            .fold((0.0, 0usize), |(sum, n), (&i, d)| {
+                let f = &insts[i].frame;
+                let size = 0.5 * insts[i].size() * (f.scale / d.scale).ln();
+                (sum + f.pos.distance_squared(d.pos) + size * size, n + 1)
+            });
+    sum / n.max(1) as f64
+}
+
+/// A linear candidate refitted from a constant sequence's grown chain
+/// (`cands`) that holds every copy of the linear change `best` and more,
+/// drawing them about as near (mean square at most four times `best`'s):
+/// a change found on part of a hand-placed row, whose ends the search's
+/// tolerance cut off (`--symmetrize`).
+fn longer_change(insts: &[Inst], best: &Candidate, cands: &[Candidate]) -> Option<usize> {
+    let Plan::Seq {
+        chains,
+        delta: Some(_),
+        fitted: Some(fit),
+        ..
+    } = &best.plan
+    else {
+        return None;
+    };
+    let members: HashSet<usize> = chains.iter().flatten().copied().collect();
+    let near = misfit(insts, chains, fit) * 4.0;
+    (0..cands.len())
+        .filter(|&i| cands[i].pairs > best.pairs)
+        .filter(|&i| match &cands[i].plan {
+            Plan::Seq {
+                chains,
+                delta: Some(_),
+                fitted: Some(r),
+                ..
+            } => {
+                let have: HashSet<usize> = chains.iter().flatten().copied().collect();
+                members.is_subset(&have) && misfit(insts, chains, r) <= near
+            }
+            _ => false,
+        })
         .max_by(|&x, &y| cands[x].pairs.cmp(&cands[y].pairs).then(y.cmp(&x)))
 }
 
