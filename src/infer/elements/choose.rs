@@ -106,19 +106,13 @@ pub fn mean_point(segs: impl IntoIterator<Item = Seg>) -> Option<DVec2> {
     let mut start = 0;
     for seg in segs {
         match seg {
-            Seg::Move(a) => {
-                start = points.len();
-                points.push(a);
+            Seg::Move(_) => start = points.len(),
+            Seg::Close if points.len() > start + 1 && points.last() == points.get(start) => {
+                points.pop();
             }
-            Seg::Line(a) => points.push(a),
-            Seg::Quad(a, c) => points.extend([a, c]),
-            Seg::Cubic(a, c, e) => points.extend([a, c, e]),
-            Seg::Close => {
-                if points.len() > start + 1 && points.last() == points.get(start) {
-                    points.pop();
-                }
-            }
+            _ => {}
         }
+        points.extend(crate::infer::svg::seg_points(&seg));
     }
     (!points.is_empty()).then(|| crate::geometry::mean(&points))
 }

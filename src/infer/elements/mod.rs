@@ -236,12 +236,12 @@ pub fn from_svg(
         .collect();
     let (mut grammar, mut file, mut text, mut emit_ms) =
         program(inst, progress).map_err(too_much)?;
-    let places: Vec<glam::DVec2> = drawing
-        .elements
-        .iter()
-        .filter_map(|e| choose::mean_point(e.subpaths.iter().flatten().copied()))
-        .collect();
     if !turned.is_empty() {
+        let places: Vec<glam::DVec2> = drawing
+            .elements
+            .iter()
+            .filter_map(|e| choose::mean_point(e.subpaths.iter().flatten().copied()))
+            .collect();
         // As near as the first, or (with `--symmetrize`) within the noise
         // of the drawing's placement.
         let first = choose::misfit(&text, &places).unwrap_or(f64::INFINITY);

@@ -420,12 +420,7 @@ impl Instancing {
             }
             for (&i, head) in members.iter().zip(heads) {
                 if let Some(rot) = head {
-                    // Turned about the disc's centre: a frame off it keeps
-                    // its place in the disc's own frame.
-                    let f = &mut out.of[i].1;
-                    let c = self.shapes[i].centroid;
-                    f.pos = c + rotate(f.pos - c, rot - f.rot);
-                    f.rot = rot;
+                    out.turn_about_centre(i, rot - out.of[i].1.rot);
                 }
             }
             out.kinds[k].frame.rot = out.of[kind.representative].1.rot;
@@ -455,12 +450,18 @@ impl Instancing {
             let Some(h) = head else {
                 continue;
             };
-            let f = &mut self.of[i].1;
-            let turn = (wrap(h + phi - f.rot) / step).round() * step;
-            let c = self.shapes[i].centroid;
-            f.pos = c + rotate(f.pos - c, turn);
-            f.rot = wrap(f.rot + turn);
+            let turn = (wrap(h + phi - self.of[i].1.rot) / step).round() * step;
+            self.turn_about_centre(i, turn);
         }
+    }
+
+    /// Element `i`'s frame turned by `turn` about the element's centre: a
+    /// frame off the centre keeps its place in the element's own frame.
+    fn turn_about_centre(&mut self, i: usize, turn: f64) {
+        let f = &mut self.of[i].1;
+        let c = self.shapes[i].centroid;
+        f.pos = c + rotate(f.pos - c, turn);
+        f.rot = wrap(f.rot + turn);
     }
 
     /// Moves kind `k`'s local frame by `change` (given in the old local
